@@ -1,0 +1,72 @@
+// States, per-step inputs, a recorded rollout and the gradients of a loss.
+#pragma once
+
+#include <vector>
+
+#include "diffpd/material.h"
+#include "diffpd/solver_options.h"
+#include "diffpd/types.h"
+
+namespace diffpd {
+
+// Nodal positions x (m) and velocities v (m/s), each 3n: node i axis d at 3i+d.
+struct State {
+  VectorXd x;
+  VectorXd v;
+};
+
+// What drives one step. An empty vector means "none" and costs nothing.
+struct StepInput {
+  VectorXd external_force;  // 3n, N, applied during the step (explicit)
+};
+
+// Outcome of one step.
+struct StepReport {
+  int iterations = 0;          // Newton / PD / L-BFGS iterations (0 for semi-implicit)
+  int line_search_steps = 0;   // total backtracking halvings
+  double initial_residual = 0; // ||grad g(x0)||
+  double final_residual = 0;   // ||grad g(x_{i+1})||
+  double seconds = 0;
+};
+
+// A recorded trajectory: states[0..K], inputs[0..K-1]. It stores exactly what
+// the backward pass needs: per step 2 x 3n doubles of state plus the step's
+// inputs (16 * 3n bytes + inputs per step), and the material and options it
+// was made with. Nothing per iteration is kept.
+struct Rollout {
+  std::vector<State> states;
+  std::vector<StepInput> inputs;
+  std::vector<StepReport> reports;
+  MaterialParameters material;
+  SolverOptions options;
+
+  int num_steps() const { return static_cast<int>(inputs.size()); }
+  double forward_seconds() const;
+};
+
+// dL/dx_k and dL/dv_k of a loss for k = 0..K (each 3n, or empty for zero).
+struct LossGradient {
+  std::vector<VectorXd> dx;
+  std::vector<VectorXd> dv;
+  // Sizes both lists for K steps with empty (zero) entries.
+  explicit LossGradient(int num_steps = 0) : dx(num_steps + 1), dv(num_steps + 1) {}
+};
+
+struct BackwardReport {
+  int linear_iterations = 0;  // iterations of the iterative adjoint solves, summed
+  int fallbacks = 0;          // adjoint solves that fell back to a direct solve
+  double seconds = 0;
+};
+
+// dL/d(input) for every differentiable input of a rollout.
+struct RolloutGradient {
+  VectorXd x0;                              // 3n
+  VectorXd v0;                              // 3n
+  std::vector<VectorXd> external_force;     // per step, 3n
+  double youngs_modulus = 0;                // dL/dE, per Pa
+  double poissons_ratio = 0;                // dL/dnu
+  double density = 0;                       // dL/drho, per kg/m^3
+  BackwardReport report;
+};
+
+}  // namespace diffpd

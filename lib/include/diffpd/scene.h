@@ -1,0 +1,45 @@
+// A scene: what a simulation contains. A scene declares only what it needs;
+// every force and energy it does not declare is never evaluated.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "diffpd/material.h"
+#include "diffpd/mesh.h"
+#include "diffpd/types.h"
+
+namespace diffpd {
+
+// Degrees of freedom held at prescribed positions. DoF d is axis d % 3 of
+// node d / 3. The simulator erases these DoFs from every solve: their position
+// stays at `values` and their velocity is (x_{i+1} - x_i) / h.
+struct DirichletBoundary {
+  std::vector<int> dofs;  // strictly increasing DoF indices in [0, 3n)
+  VectorXd values;        // same length as dofs, metres
+};
+
+struct Scene {
+  Mesh mesh;
+  MaterialParameters material;
+  // Elastic energy densities, summed. PD solvers need all of them projective
+  // (kPdCorotated, kPdVolume); Newton and PD-LBFGS accept any.
+  std::vector<ElasticEnergy> energies = {ElasticEnergy::kPdCorotated, ElasticEnergy::kPdVolume};
+  // Uniform gravitational acceleration (m/s^2), applied as M g when declared.
+  std::optional<Vec3> gravity;
+  DirichletBoundary dirichlet;
+
+  // Throws InvalidInputError naming the first problem: invalid mesh or
+  // material, no energy, Dirichlet DoF out of range or not increasing, a
+  // size mismatch, or a non-finite gravity/Dirichlet value.
+  void Validate() const;
+};
+
+// Fixes all three axes of `nodes` at their rest positions (sorted, merged
+// with the existing Dirichlet DoFs). Throws on an out-of-range node.
+void FixNodes(Scene* scene, const std::vector<int>& nodes);
+// Fixes the given axes (0 = x, 1 = y, 2 = z) of `nodes` at rest positions.
+void FixNodeAxes(Scene* scene, const std::vector<int>& nodes, const std::vector<int>& axes);
+
+}  // namespace diffpd

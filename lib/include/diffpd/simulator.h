@@ -1,0 +1,74 @@
+// The simulator: steps a scene forward in time and differentiates rollouts.
+//
+//   Simulator sim(scene, options);
+//   Rollout r = sim.Simulate(sim.RestState(), std::vector<StepInput>(25));
+//   LossGradient dl(r.num_steps());  dl.dx.back() = ...;
+//   RolloutGradient g = sim.Backward(r, dl);
+//
+// The simulator owns a copy of the scene, its FEM data and its solver caches
+// (the PD factor is computed once per (h, density, stiffness) and reused for
+// every step, iteration and rollout). It is not thread-safe; use one per thread.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "diffpd/rollout.h"
+#include "diffpd/scene.h"
+#include "diffpd/solver_options.h"
+
+namespace diffpd {
+
+namespace internal {
+class SimulatorImpl;
+}
+
+class Simulator {
+ public:
+  // Validates scene and options (InvalidInputError) and precomputes the FEM data.
+  Simulator(const Scene& scene, const SolverOptions& options);
+  ~Simulator();
+  Simulator(const Simulator&) = delete;
+  Simulator& operator=(const Simulator&) = delete;
+
+  const Scene& scene() const;
+  const SolverOptions& options() const;
+  int num_dofs() const;
+  // Replaces the options (validated). The PD factor is recomputed lazily,
+  // only if the time step changed.
+  void SetOptions(const SolverOptions& options);
+  // Replaces the material (validated); the PD factor follows lazily.
+  void SetMaterial(const MaterialParameters& material);
+
+  // Rest positions (Dirichlet DoFs at their prescribed values), zero velocity.
+  State RestState() const;
+  // Lumped mass per DoF (3n, kg).
+  VectorXd LumpedMass() const;
+  // Total elastic energy E(x) (J) of the scene at positions x (3n).
+  double ElasticEnergy(const VectorXd& x);
+
+  // One time step with the configured method. Throws InvalidInputError on
+  // mismatched sizes or non-finite input, SolverError when the step fails
+  // (non-convergence, inverted neo-Hookean element, factorisation failure).
+  State Step(const State& state, const StepInput& input, StepReport* report = nullptr);
+  // K = inputs.size() steps from `initial`, recorded for Backward().
+  Rollout Simulate(const State& initial, const std::vector<StepInput>& inputs);
+  // Reverse mode: gradients of a loss L(x_0..x_K, v_0..v_K) w.r.t. every
+  // differentiable input, given dL/dx_k and dL/dv_k. The rollout must come
+  // from this simulator with the same material and options.
+  RolloutGradient Backward(const Rollout& rollout, const LossGradient& loss);
+
+  // Equilibrium under the declared forces (gravity, `input.external_force`)
+  // and Dirichlet conditions, by Newton (newton-pcg if that is the method,
+  // else newton-cholesky), starting from `initial_positions` (3n).
+  VectorXd SolveQuasiStatic(const VectorXd& initial_positions, const StepInput& input,
+                            StepReport* report = nullptr);
+
+  // Number of numeric factorisations of the PD matrix A so far.
+  int num_pd_factorizations() const;
+
+ private:
+  std::unique_ptr<internal::SimulatorImpl> impl_;
+};
+
+}  // namespace diffpd

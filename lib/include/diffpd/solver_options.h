@@ -1,0 +1,69 @@
+// Options of the time integrators and their derivatives. Plain struct with
+// documented defaults; Validate() throws InvalidInputError on a bad value.
+#pragma once
+
+#include <string>
+
+namespace diffpd {
+
+enum class Method {
+  kSemiImplicit,    // symplectic Euler: explicit, needs a small time step
+  kNewtonCholesky,  // implicit Euler, Newton + CHOLMOD supernodal Cholesky
+  kNewtonPcg,       // implicit Euler, Newton + preconditioned conjugate gradients
+  kPd,              // implicit Euler, projective dynamics (local-global)
+  kPdLbfgs,         // implicit Euler, L-BFGS with the PD matrix as initial Hessian
+};
+// "semi-implicit", "newton-cholesky", "newton-pcg", "pd", "pd-lbfgs".
+const char* ToString(Method method);
+// Inverse of ToString; throws InvalidInputError listing the valid names.
+Method ParseMethod(const std::string& name);
+
+enum class PcgPreconditioner { kJacobi, kIncompleteCholesky };
+
+// How the PD backward solves hess g z = b with the forward factor of A.
+enum class PdBackwardMethod {
+  kFixedPoint,  // A z_{k+1} = b + dA z_k, the DiffPD iteration
+  kLbfgs,       // L-BFGS on 1/2 z^T H z - b^T z, A as initial Hessian, exact steps
+};
+
+struct SolverOptions {
+  Method method = Method::kPd;
+  // Time step h, seconds; > 0.
+  double time_step = 0.01;
+
+  // Convergence of each implicit step, the same test for every method:
+  //   ||grad g(x)||_2 <= abs_tolerance + rel_tolerance * ||grad g(x0)||_2,
+  // over the free DoFs, x0 the step's initial guess x_i + h v_i.
+  double abs_tolerance = 1e-9;  // N
+  double rel_tolerance = 1e-6;
+  int max_iterations = 1000;    // per step (Newton or PD iterations)
+
+  // Backtracking (Armijo) line search of Newton and PD-LBFGS.
+  double armijo_c = 1e-4;
+  int max_line_search_steps = 40;
+
+  // Newton-PCG: the linear solve stops at relative residual pcg_rel_tolerance
+  // (relative to the right-hand side) or after pcg_max_iterations.
+  PcgPreconditioner pcg_preconditioner = PcgPreconditioner::kIncompleteCholesky;
+  double pcg_rel_tolerance = 1e-8;
+  int pcg_max_iterations = 20000;
+
+  // PD-LBFGS and the PD backward's L-BFGS: number of stored pairs.
+  int lbfgs_history = 8;
+
+  // Backward (adjoint) linear solves: relative residual ||H z - b|| / ||b||.
+  PdBackwardMethod pd_backward = PdBackwardMethod::kLbfgs;
+  double backward_rel_tolerance = 1e-10;
+  int backward_max_iterations = 1000;
+
+  // Threads for the element loops (0: OpenMP's default). Never changes the
+  // process-wide OpenMP setting.
+  int num_threads = 0;
+  // 0: silent; 1: one line per step on stderr; 2: one line per iteration.
+  int verbosity = 0;
+
+  // Throws InvalidInputError naming the field, its value and the valid range.
+  void Validate() const;
+};
+
+}  // namespace diffpd

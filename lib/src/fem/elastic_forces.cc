@@ -1,0 +1,243 @@
+#include "fem/elastic_forces.h"
+
+#include <cmath>
+#include <exception>
+#include <mutex>
+
+#include <Eigen/Eigenvalues>
+
+#include "diffpd/error.h"
+#include "material/projections.h"
+#include "material/svd3.h"
+
+namespace diffpd::internal {
+namespace {
+
+// Runs body(e) for e in [0, m) in parallel and rethrows the first exception
+// after the loop (exceptions must not leave an OpenMP region).
+template <class Body>
+void ParallelForElements(int m, int threads, Body&& body) {
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  const int nt = threads > 0 ? threads : 0;
+#pragma omp parallel for schedule(static) num_threads(nt) if (nt != 1)
+  for (int e = 0; e < m; ++e) {
+    try {
+      body(e);
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (!error) error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
+}
+
+}  // namespace
+
+double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, double mu,
+                       double lambda, Mat3* stress, Mat9* dstress) {
+  double psi = 0;
+  if (stress) stress->setZero();
+  if (dstress) dstress->setZero();
+  bool have_svd = false;
+  Svd3 svd;
+  for (const ElasticEnergy energy : energies) {
+    if (energy == ElasticEnergy::kPdCorotated || energy == ElasticEnergy::kPdVolume) {
+      if (!have_svd) {
+        svd = ComputeSvd3(F);
+        have_svd = true;
+      }
+      const bool rot = energy == ElasticEnergy::kPdCorotated;
+      const double w = rot ? 2 * mu : lambda;
+      const Mat3 p = rot ? ProjectToRotation(svd) : ProjectToUnitDeterminant(svd);
+      const Mat3 diff = F - p;
+      psi += 0.5 * w * diff.squaredNorm();
+      if (stress) *stress += w * diff;
+      if (dstress) {
+        const Mat9 dp = rot ? RotationProjectionDifferential(svd) : UnitDeterminantProjectionDifferential(svd);
+        *dstress += w * (Mat9::Identity() - dp);
+      }
+    } else {
+      psi += EnergyDensity(energy, F, mu, lambda);
+      if (stress) *stress += FirstPiolaStress(energy, F, mu, lambda);
+      if (dstress) *dstress += StressDifferential(energy, F, mu, lambda);
+    }
+  }
+  return psi;
+}
+
+ElasticForces::ElasticForces(const FemModel& fem, std::vector<ElasticEnergy> energies)
+    : fem_(fem), energies_(std::move(energies)) {
+  for (const ElasticEnergy e : energies_) all_projective_ = all_projective_ && IsProjective(e);
+  element_buffer_.assign(static_cast<size_t>(fem_.num_elements()) * 3 * fem_.nodes_per_element(), 0.0);
+  element_energy_.assign(fem_.num_elements(), 0.0);
+}
+
+double ElasticForces::PdWeight(double mu, double lambda) const {
+  double w = 0;
+  for (const ElasticEnergy e : energies_) {
+    if (e == ElasticEnergy::kPdCorotated) w += 2 * mu;
+    else if (e == ElasticEnergy::kPdVolume) w += lambda;
+    else w += 2 * mu + lambda;
+  }
+  return w;
+}
+
+void ElasticForces::GatherElementBuffer(VectorXd* out, int threads) const {
+  const int n = fem_.num_nodes();
+  out->resize(3 * n);
+  const auto& off = fem_.node_offsets();
+  const auto& inc = fem_.node_incidences();
+  const int nt = threads > 0 ? threads : 0;
+#pragma omp parallel for schedule(static) num_threads(nt) if (nt != 1)
+  for (int i = 0; i < n; ++i) {
+    Vec3 sum = Vec3::Zero();
+    for (int j = off[i]; j < off[i + 1]; ++j) sum += Eigen::Map<const Vec3>(element_buffer_.data() + 3 * static_cast<size_t>(inc[j]));
+    out->segment<3>(3 * i) = sum;
+  }
+}
+
+template <int K>
+double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, double mu, double lambda, VectorXd* grad,
+                                            int threads) {
+  const Mesh& mesh = fem_.mesh();
+  const int q_per = fem_.samples_per_element();
+  ParallelForElements(fem_.num_elements(), threads, [&](int e) {
+    const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(mesh, x, e);
+    Eigen::Matrix<double, 3, K> fe = Eigen::Matrix<double, 3, K>::Zero();
+    double energy = 0;
+    for (int q = 0; q < q_per; ++q) {
+      const int s = e * q_per + q;
+      const double* g = fem_.grad(s);
+      const Mat3 F = DeformationGradient<K>(xe, g);
+      Mat3 P;
+      const double vol = fem_.sample_volume(s);
+      energy += vol * EvaluateDensity(energies_, F, mu, lambda, grad ? &P : nullptr, nullptr);
+      if (grad) fe.noalias() += (vol * P) * Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
+    }
+    element_energy_[e] = energy;
+    if (grad) Eigen::Map<Eigen::Matrix<double, 3, K>>(element_buffer_.data() + static_cast<size_t>(e) * 3 * K) = fe;
+  });
+  double total = 0;
+  for (double v : element_energy_) total += v;
+  if (!std::isfinite(total))
+    throw SolverError(SolverStatus::kNonFinite, "elastic energy is not finite at the current state");
+  if (grad) GatherElementBuffer(grad, threads);
+  return total;
+}
+
+double ElasticForces::EnergyAndGradient(const VectorXd& x, double mu, double lambda, VectorXd* grad,
+                                        int threads) {
+  return fem_.nodes_per_element() == 4 ? EnergyAndGradientImpl<4>(x, mu, lambda, grad, threads)
+                                       : EnergyAndGradientImpl<8>(x, mu, lambda, grad, threads);
+}
+
+template <int K>
+void ElasticForces::StressDifferentialsImpl(const VectorXd& x, double mu, double lambda, std::vector<Mat9>* d,
+                                            int threads) {
+  const Mesh& mesh = fem_.mesh();
+  const int q_per = fem_.samples_per_element();
+  d->resize(fem_.num_samples());
+  ParallelForElements(fem_.num_elements(), threads, [&](int e) {
+    const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(mesh, x, e);
+    for (int q = 0; q < q_per; ++q) {
+      const int s = e * q_per + q;
+      const Mat3 F = DeformationGradient<K>(xe, fem_.grad(s));
+      EvaluateDensity(energies_, F, mu, lambda, nullptr, &(*d)[s]);
+      (*d)[s] *= fem_.sample_volume(s);
+    }
+  });
+}
+
+void ElasticForces::StressDifferentials(const VectorXd& x, double mu, double lambda, std::vector<Mat9>* d,
+                                        int threads) {
+  if (fem_.nodes_per_element() == 4) StressDifferentialsImpl<4>(x, mu, lambda, d, threads);
+  else StressDifferentialsImpl<8>(x, mu, lambda, d, threads);
+}
+
+template <int K>
+void ElasticForces::ApplyHessianImpl(const std::vector<Mat9>& d, const VectorXd& z, VectorXd* out, int threads) {
+  const Mesh& mesh = fem_.mesh();
+  const int q_per = fem_.samples_per_element();
+  ParallelForElements(fem_.num_elements(), threads, [&](int e) {
+    const Eigen::Matrix<double, 3, K> ze = GatherElement<K>(mesh, z, e);
+    Eigen::Matrix<double, 3, K> fe = Eigen::Matrix<double, 3, K>::Zero();
+    for (int q = 0; q < q_per; ++q) {
+      const int s = e * q_per + q;
+      const Eigen::Map<const Eigen::Matrix<double, K, 3>> g(fem_.grad(s));
+      const Mat3 dF = ze * g;
+      Vec9 dp = d[s] * Eigen::Map<const Vec9>(dF.data());  // volume already folded into d
+      fe.noalias() += Eigen::Map<const Mat3>(dp.data()) * g.transpose();
+    }
+    Eigen::Map<Eigen::Matrix<double, 3, K>>(element_buffer_.data() + static_cast<size_t>(e) * 3 * K) = fe;
+  });
+  GatherElementBuffer(out, threads);
+}
+
+void ElasticForces::ApplyHessian(const std::vector<Mat9>& d, const VectorXd& z, VectorXd* out, int threads) {
+  if (fem_.nodes_per_element() == 4) ApplyHessianImpl<4>(d, z, out, threads);
+  else ApplyHessianImpl<8>(d, z, out, threads);
+}
+
+template <int K>
+void ElasticForces::ElementHessiansImpl(const VectorXd& x, double mu, double lambda, bool project_spd,
+                                        std::vector<double>* blocks, int threads) {
+  constexpr int N = 3 * K;
+  const Mesh& mesh = fem_.mesh();
+  const int q_per = fem_.samples_per_element();
+  blocks->resize(static_cast<size_t>(fem_.num_elements()) * N * N);
+  ParallelForElements(fem_.num_elements(), threads, [&](int e) {
+    const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(mesh, x, e);
+    Eigen::Map<Eigen::Matrix<double, N, N>> ke(blocks->data() + static_cast<size_t>(e) * N * N);
+    ke.setZero();
+    for (int q = 0; q < q_per; ++q) {
+      const int s = e * q_per + q;
+      const double* g = fem_.grad(s);
+      const Mat3 F = DeformationGradient<K>(xe, g);
+      Mat9 dP;
+      EvaluateDensity(energies_, F, mu, lambda, nullptr, &dP);
+      // dF/dx: vec(F)(i + 3j) = sum_a x(i, a) g(a, j); column 3a + i.
+      Eigen::Matrix<double, 9, N> dfdx = Eigen::Matrix<double, 9, N>::Zero();
+      for (int a = 0; a < K; ++a)
+        for (int j = 0; j < 3; ++j)
+          for (int i = 0; i < 3; ++i) dfdx(i + 3 * j, 3 * a + i) = g[a + K * j];
+      ke.noalias() += fem_.sample_volume(s) * dfdx.transpose() * dP * dfdx;
+    }
+    if (project_spd) {
+      const Eigen::Matrix<double, N, N> sym = 0.5 * (ke + ke.transpose());
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> eig(sym);
+      if (eig.eigenvalues().minCoeff() < 0) {
+        const Eigen::Matrix<double, N, 1> lam = eig.eigenvalues().cwiseMax(0.0);
+        ke = eig.eigenvectors() * lam.asDiagonal() * eig.eigenvectors().transpose();
+      }
+    }
+  });
+}
+
+void ElasticForces::ElementHessians(const VectorXd& x, double mu, double lambda, bool project_spd,
+                                    std::vector<double>* blocks, int threads) {
+  if (fem_.nodes_per_element() == 4) ElementHessiansImpl<4>(x, mu, lambda, project_spd, blocks, threads);
+  else ElementHessiansImpl<8>(x, mu, lambda, project_spd, blocks, threads);
+}
+
+template <int K>
+void ElasticForces::GatherImpl(const std::vector<double>& stress, VectorXd* out, int threads) {
+  const int q_per = fem_.samples_per_element();
+  ParallelForElements(fem_.num_elements(), threads, [&](int e) {
+    Eigen::Matrix<double, 3, K> fe = Eigen::Matrix<double, 3, K>::Zero();
+    for (int q = 0; q < q_per; ++q) {
+      const int s = e * q_per + q;
+      const Eigen::Map<const Mat3> S(stress.data() + 9 * static_cast<size_t>(s));
+      fe.noalias() += (fem_.sample_volume(s) * S) * Eigen::Map<const Eigen::Matrix<double, K, 3>>(fem_.grad(s)).transpose();
+    }
+    Eigen::Map<Eigen::Matrix<double, 3, K>>(element_buffer_.data() + static_cast<size_t>(e) * 3 * K) = fe;
+  });
+  GatherElementBuffer(out, threads);
+}
+
+void ElasticForces::GatherSampleStresses(const std::vector<double>& stress, VectorXd* out, int threads) {
+  if (fem_.nodes_per_element() == 4) GatherImpl<4>(stress, out, threads);
+  else GatherImpl<8>(stress, out, threads);
+}
+
+}  // namespace diffpd::internal

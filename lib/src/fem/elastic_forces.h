@@ -1,0 +1,81 @@
+// Elastic energy of a discretised body and its derivatives (internal).
+//
+// E(x) = sum_s vol_s * sum_{energies} Psi(F_s(x)), with F_s the deformation
+// gradient at sample s (see fem_model.h). Every density is linear in the Lame
+// parameters, so d grad E / d mu is grad E evaluated with (mu, lambda) = (1, 0).
+// All loops run over elements in parallel (OpenMP, `threads` threads, 0 means
+// the OpenMP default); results are gathered per node, so they are
+// deterministic for a given thread count.
+#pragma once
+
+#include <vector>
+
+#include "diffpd/material.h"
+#include "diffpd/types.h"
+#include "fem/fem_model.h"
+
+namespace diffpd::internal {
+
+class ElasticForces {
+ public:
+  // Does not take ownership of `fem`, which must outlive this object.
+  ElasticForces(const FemModel& fem, std::vector<ElasticEnergy> energies);
+
+  const std::vector<ElasticEnergy>& energies() const { return energies_; }
+  bool all_projective() const { return all_projective_; }
+
+  // Weight of the constant PD matrix: sum over energies of w (2 mu for
+  // pd-corotated, lambda for pd-volume; 2 mu + lambda for energies that are
+  // not of PD form, used only as the quasi-Newton initial Hessian).
+  double PdWeight(double mu, double lambda) const;
+
+  // Returns E(x) (J) and, if grad != nullptr, sets *grad = dE/dx (3n, N).
+  // Throws SolverError(kInvertedElement) for neo-Hookean with det F <= 0 and
+  // SolverError(kNonFinite) when x produces a non-finite value.
+  double EnergyAndGradient(const VectorXd& x, double mu, double lambda, VectorXd* grad, int threads);
+
+  // Per-sample exact stress differentials dP/dF (summed over energies) at x.
+  void StressDifferentials(const VectorXd& x, double mu, double lambda, std::vector<Mat9>* d,
+                           int threads);
+  // out = (d^2 E / dx^2) z using stress differentials from StressDifferentials.
+  void ApplyHessian(const std::vector<Mat9>& d, const VectorXd& z, VectorXd* out, int threads);
+
+  // Element Hessians (3K x 3K each, column-major, concatenated) at x; with
+  // project_spd each is replaced by its projection onto the PSD cone
+  // (negative eigenvalues clamped to zero), the definiteness fix of Newton.
+  void ElementHessians(const VectorXd& x, double mu, double lambda, bool project_spd,
+                       std::vector<double>* blocks, int threads);
+
+  // out = sum_s vol_s G_s^T S_s where S_s (3x3 per sample) are given stresses;
+  // i.e. the generic "G^T" gather used by every force. `stress` holds 9 doubles
+  // per sample (column-major).
+  void GatherSampleStresses(const std::vector<double>& stress, VectorXd* out, int threads);
+
+ private:
+  template <int K>
+  double EnergyAndGradientImpl(const VectorXd& x, double mu, double lambda, VectorXd* grad, int threads);
+  template <int K>
+  void StressDifferentialsImpl(const VectorXd& x, double mu, double lambda, std::vector<Mat9>* d, int threads);
+  template <int K>
+  void ApplyHessianImpl(const std::vector<Mat9>& d, const VectorXd& z, VectorXd* out, int threads);
+  template <int K>
+  void ElementHessiansImpl(const VectorXd& x, double mu, double lambda, bool project_spd,
+                           std::vector<double>* blocks, int threads);
+  template <int K>
+  void GatherImpl(const std::vector<double>& stress, VectorXd* out, int threads);
+  // Sums the per-element 3 x K buffer into a 3n vector, in parallel over nodes.
+  void GatherElementBuffer(VectorXd* out, int threads) const;
+
+  const FemModel& fem_;
+  std::vector<ElasticEnergy> energies_;
+  bool all_projective_ = true;
+  std::vector<double> element_buffer_;  // 3 * K per element
+  std::vector<double> element_energy_;  // per element
+};
+
+// Energy density, stress and (optionally) stress differential of the sum of
+// `energies` at F. Throws SolverError for inverted neo-Hookean elements.
+double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, double mu,
+                       double lambda, Mat3* stress, Mat9* dstress);
+
+}  // namespace diffpd::internal

@@ -1,0 +1,154 @@
+// Signed 3x3 SVD by one-sided (Hestenes) Jacobi followed by a Givens QR.
+//
+// Method (McAdams et al. 2011, "Computing the singular value decomposition of
+// 3x3 matrices with minimal branching and elementary floating point
+// operations", with exact instead of approximate Jacobi rotations):
+//  1. B = F V: cyclic sweeps of plane rotations applied to the columns of B
+//     (and accumulated in V) until every pair of columns is orthogonal to
+//     working precision, |b_p . b_q| <= eps |b_p| |b_q|. This is Jacobi on
+//     F^T F without ever forming F^T F, so small singular values keep their
+//     accuracy relative to |F| (no squaring of the condition number).
+//  2. Sort the columns by decreasing norm; flip the last column of B and V if
+//     needed so that det V = +1.
+//  3. B = U R by three Givens rotations: U is a product of rotations (hence
+//     orthogonal with det +1 to rounding, even when B has zero columns), R is
+//     upper triangular with R00, R11 >= 0 and diagonal |b_i| up to the sign
+//     of R22, which carries the sign of det F. R's off-diagonal entries are
+//     O(eps |F|) because B's columns are orthogonal, so sigma = diag(R).
+//
+// Why not Eigen::JacobiSVD<Matrix3d>: on the benchmark machine it is ~4x
+// slower (about 0.9 us vs 0.2 us per call at -O3, random F), returns unsigned
+// singular values and improper U, V that need a further fix-up, and is no more
+// accurate (both reach ~1e-16 reconstruction and orthogonality errors).
+#include "material/svd3.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include <Eigen/LU>
+
+namespace diffpd::internal {
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+// Each sweep is 3 rotations; quadratic convergence needs 4 to 6 sweeps.
+constexpr int kMaxSweeps = 20;
+
+// Rotates columns p and q of B (and V) so that they become orthogonal.
+// Returns false (and does nothing) when they already are to working precision.
+inline bool OrthogonalizeColumns(Mat3& B, Mat3& V, int p, int q) {
+  const double alpha = B.col(p).squaredNorm();
+  const double beta = B.col(q).squaredNorm();
+  const double gamma = B.col(p).dot(B.col(q));
+  if (!(gamma * gamma > kEps * kEps * alpha * beta)) return false;
+  // t = tan(theta), the root of smaller magnitude of t^2 + 2 zeta t - 1 = 0
+  // with zeta = (beta - alpha) / (2 gamma), diagonalises
+  // [[alpha, gamma], [gamma, beta]] (Rutishauser), written with one division.
+  const double diff = beta - alpha;
+  const double root = std::sqrt(diff * diff + 4.0 * gamma * gamma);
+  const double t = 2.0 * gamma / (diff >= 0.0 ? diff + root : diff - root);
+  // For |t| < 1e-8, 1/sqrt(1 + t^2) rounds to 1.
+  const double c = std::abs(t) < 1e-8 ? 1.0 : 1.0 / std::sqrt(1.0 + t * t);
+  const double s = c * t;
+  for (int r = 0; r < 3; ++r) {
+    const double bp = B(r, p), bq = B(r, q);
+    B(r, p) = c * bp - s * bq;
+    B(r, q) = s * bp + c * bq;
+    const double vp = V(r, p), vq = V(r, q);
+    V(r, p) = c * vp - s * vq;
+    V(r, q) = s * vp + c * vq;
+  }
+  return true;
+}
+
+// Givens rotation on rows (p, q) of B zeroing B(q, col) with B(p, col) >= 0;
+// accumulates U <- U G^T so that U B stays constant.
+inline void GivensZero(Mat3& B, Mat3& U, int p, int q, int col) {
+  const double a = B(p, col), b = B(q, col);
+  const double r = std::sqrt(a * a + b * b);
+  if (r == 0.0) return;
+  const double c = a / r, s = b / r;
+  for (int j = 0; j < 3; ++j) {
+    const double bp = B(p, j), bq = B(q, j);
+    B(p, j) = c * bp + s * bq;
+    B(q, j) = -s * bp + c * bq;
+    const double up = U(j, p), uq = U(j, q);
+    U(j, p) = c * up + s * uq;
+    U(j, q) = -s * up + c * uq;
+  }
+  B(p, col) = r;
+  B(q, col) = 0.0;
+}
+
+inline void SwapColumns(Mat3& B, Mat3& V, Vec3& norms, int i, int j) {
+  B.col(i).swap(B.col(j));
+  V.col(i).swap(V.col(j));
+  std::swap(norms(i), norms(j));
+}
+
+}  // namespace
+
+Svd3 ComputeSvd3(const Mat3& F) {
+  Svd3 svd;
+  svd.U.setIdentity();
+  svd.V.setIdentity();
+  const double max_abs = F.cwiseAbs().maxCoeff();
+  if (!(max_abs <= std::numeric_limits<double>::max())) {  // NaN or infinity
+    svd.sigma.setConstant(std::numeric_limits<double>::quiet_NaN());
+    return svd;
+  }
+  if (max_abs == 0.0) {
+    svd.sigma.setZero();
+    return svd;
+  }
+  // Exact power-of-two rescaling keeps squared norms clear of under/overflow.
+  int exponent = 0;
+  Mat3 B = F;
+  if (max_abs < 1e-100 || max_abs > 1e100) {
+    exponent = std::ilogb(max_abs);
+    B *= std::ldexp(1.0, -exponent);
+  }
+  const double det_sign_reference = B.determinant();
+
+  Mat3& V = svd.V;
+  for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
+    bool rotated = OrthogonalizeColumns(B, V, 0, 1);
+    rotated = OrthogonalizeColumns(B, V, 0, 2) || rotated;
+    rotated = OrthogonalizeColumns(B, V, 1, 2) || rotated;
+    if (!rotated) break;
+  }
+
+  Vec3 norms = B.colwise().squaredNorm().transpose();
+  bool odd = false;
+  if (norms(0) < norms(1)) { SwapColumns(B, V, norms, 0, 1); odd = !odd; }
+  if (norms(0) < norms(2)) { SwapColumns(B, V, norms, 0, 2); odd = !odd; }
+  if (norms(1) < norms(2)) { SwapColumns(B, V, norms, 1, 2); odd = !odd; }
+  if (odd) {
+    B.col(2) = -B.col(2);
+    V.col(2) = -V.col(2);
+  }
+
+  Mat3& U = svd.U;
+  GivensZero(B, U, 0, 1, 0);
+  GivensZero(B, U, 0, 2, 0);
+  GivensZero(B, U, 1, 2, 1);
+
+  Vec3& sigma = svd.sigma;
+  sigma << B(0, 0), B(1, 1), B(2, 2);
+  // Rounding can leave (nearly) repeated values out of order by an ulp.
+  sigma(1) = std::min(sigma(1), sigma(0));
+  if (std::abs(sigma(2)) > sigma(1)) sigma(2) = std::copysign(sigma(1), sigma(2));
+  // When det F is at round-off level its computed sign and R22's may
+  // disagree; R22 is then itself at round-off level and flipping it costs
+  // O(eps |F|) in the reconstruction while keeping sign(sigma2) = sign(det F).
+  const bool negative = sigma(2) < 0.0;
+  if (negative != (det_sign_reference < 0.0) && std::abs(sigma(2)) <= 8.0 * kEps * sigma(0)) {
+    sigma(2) = -sigma(2);
+  }
+  if (exponent != 0) sigma *= std::ldexp(1.0, exponent);
+  return svd;
+}
+
+}  // namespace diffpd::internal

@@ -1,0 +1,20 @@
+// Signed singular value decomposition of 3x3 matrices (internal).
+#pragma once
+
+#include "diffpd/types.h"
+
+namespace diffpd::internal {
+
+// F = U diag(sigma) V^T with U, V proper rotations (det = +1),
+// sigma(0) >= sigma(1) >= |sigma(2)|; sigma(2) < 0 exactly when det F < 0.
+struct Svd3 {
+  Mat3 U;
+  Vec3 sigma;
+  Mat3 V;
+};
+
+// Accurate to a few ulps in U, V orthogonality and in F reconstruction
+// (relative to |F|), including repeated and zero singular values.
+Svd3 ComputeSvd3(const Mat3& F);
+
+}  // namespace diffpd::internal

@@ -1,0 +1,263 @@
+// The closest point d to sigma on {d : d_0 d_1 d_2 = 1} (Euclidean norm),
+// and its derivative. This is the singular-value part of the PD volume
+// projection Proj_{det=1}(F) = U diag(d) V^T.
+//
+// Structure of the problem (stationarity d_i (d_i - sigma_i) = mu, i = 0..2):
+//  - Sign patterns: since sigma_0 >= sigma_1 >= |sigma_2|, flipping two
+//    signs of d towards sigma's signs never increases the distance, so the
+//    minimiser is either all positive, or (only when sigma_2 < 0) of signs
+//    (+, -, -), i.e. the all-positive problem for s = (sigma_0, -sigma_1, -sigma_2).
+//  - All-positive problem for a target s: each d_i is a root of
+//    d^2 - s_i d - mu = 0. At a minimiser at most one d_i is the smaller root
+//    ("shrinking branch", d_i < s_i / 2; the Lagrangian Hessian is negative
+//    there), and only for the smallest s_k (swapping two entries otherwise
+//    shortens the distance). Parametrising by t = d_k, mu(t) = t (t - s_k)
+//    and d_j = D(s_j, mu), the larger root, for j != k, every candidate is a
+//    root of h(t) = log(t d_i d_j) on (0, inf):
+//      * t >= s_k / 2: h is strictly increasing: at most one root, found by a
+//        safeguarded Newton iteration (the common case, ~3 iterations from
+//        t = s_k / cbrt(prod s));
+//      * 0 < t < s_k / 3 (s_k > 0 only): h is strictly increasing too
+//        (t h' >= (s_k - 3t) / (s_k - t) > 0);
+//      * s_k / 3 <= t < s_k / 2: h may be non-monotone; scanned on a grid.
+//    These shrinking-branch roots exist only if t d_i d_j >= 1 somewhere,
+//    which needs prod(s) >= 2 (t <= s_k / 2 and d_j <= s_j there), so the
+//    extra work is skipped for all but large volume expansions.
+//  The candidate closest to sigma wins.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <Eigen/LU>
+
+#include "material/projections.h"
+
+namespace diffpd::internal {
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+constexpr int kMaxIterations = 200;
+constexpr int kScanIntervals = 8;
+
+// Larger root D >= s/2 of D^2 - s D - mu = 0 (needs s^2 + 4 mu >= 0, and
+// mu >= 0 when s < 0), without cancellation; r = 2 D - s = sqrt(s^2 + 4 mu).
+struct Root {
+  double d;
+  double r;
+};
+inline Root LargerRoot(double s, double mu) {
+  const double r = std::sqrt(std::max(s * s + 4.0 * mu, 0.0));
+  return {s >= 0.0 ? 0.5 * (s + r) : 2.0 * mu / (r - s), r};
+}
+
+// A point of the stationary path of the all-positive problem for target s,
+// parametrised by t = d_k (k: index of the smallest entry of s).
+struct PathPoint {
+  Vec3 d;
+  double h;     // log(d_0 d_1 d_2)
+  double dh;    // dh / dt
+  double mu;    // multiplier: d_i (d_i - s_i) = mu
+};
+
+class StationaryPath {
+ public:
+  explicit StationaryPath(const Vec3& s) : s_(s) { s.minCoeff(&k_); }
+  int k() const { return k_; }
+  double sk() const { return s_(k_); }
+  const Vec3& s() const { return s_; }
+
+  PathPoint Evaluate(double t) const {
+    PathPoint p;
+    p.mu = t * (t - s_(k_));
+    const double dmu = 2.0 * t - s_(k_);
+    p.d(k_) = t;
+    double product = t;
+    p.dh = 1.0 / t;
+    for (int j = 0; j < 3; ++j) {
+      if (j == k_) continue;
+      const Root root = LargerRoot(s_(j), p.mu);
+      p.d(j) = root.d;
+      product *= root.d;
+      if (dmu != 0.0) p.dh += dmu / (root.r * root.d);
+    }
+    p.h = std::log(product);
+    return p;
+  }
+
+ private:
+  Vec3 s_;
+  int k_ = 0;
+};
+
+// Midpoint for bisection of a positive bracket: geometric when wide.
+inline double Midpoint(double lo, double hi) {
+  return hi > 4.0 * lo ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
+}
+
+// Root of the path's h in [lo, hi] (0 < lo <= hi) where h changes sign,
+// increasing (direction = +1) or decreasing (direction = -1) through it.
+// Newton steps, bisection whenever a step leaves the bracket.
+PathPoint FindRoot(const StationaryPath& path, double lo, double hi, double direction,
+                   double guess) {
+  double t = std::clamp(guess, lo, hi);
+  PathPoint p = path.Evaluate(t);
+  for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
+    const double f = direction * p.h;
+    if (std::abs(f) <= 4.0 * kEps) break;
+    if (f < 0.0) lo = t; else hi = t;
+    if (hi - lo <= 4.0 * kEps * hi) break;
+    double next = t - p.h / p.dh;
+    if (!(next > lo && next < hi)) next = Midpoint(lo, hi);
+    if (std::abs(next - t) <= 4.0 * kEps * t) break;
+    t = next;
+    p = path.Evaluate(t);
+  }
+  return p;
+}
+
+// Appends the roots of h on the increasing part t >= max(s_k / 2, 0).
+void GrowingBranchRoots(const StationaryPath& path, std::vector<PathPoint>* roots) {
+  const Vec3& s = path.s();
+  const double sk = path.sk();
+  double lo;
+  if (sk > 0.0) {
+    lo = 0.5 * sk;
+    if (path.Evaluate(lo).h > 0.0) return;  // every t >= s_k/2 has t d_i d_j > 1
+  } else {
+    // For t <= 1: mu <= 1 + |s_k|, d_j <= max(s_j, 0) + sqrt(1 + |s_k|).
+    const double bound = std::sqrt(1.0 - sk);
+    double c = 1.0;
+    for (int j = 0; j < 3; ++j) {
+      if (j != path.k()) c *= std::max(s(j), 0.0) + bound;
+    }
+    lo = 1.0 / c;  // h(lo) <= 0
+  }
+  const double hi = std::max(lo, 1.0);  // d_j >= t there, so h(1) >= 0
+  const double product = std::abs(s.prod());
+  const double guess = product > 0.0 && std::isfinite(product) ? std::abs(sk) / std::cbrt(product)
+                                                               : Midpoint(lo, hi);
+  roots->push_back(FindRoot(path, lo, hi, 1.0, guess));
+}
+
+// Appends the roots of h on 0 < t < s_k / 2 (the shrinking branch of d_k).
+void ShrinkingBranchRoots(const StationaryPath& path, std::vector<PathPoint>* roots) {
+  const Vec3& s = path.s();
+  const double sk = path.sk();
+  if (!(sk > 0.0) || !(s.prod() >= 2.0)) return;
+  // (0, s_k/3]: h increasing, h(t) <= log(t s_i s_j).
+  const double third = sk / 3.0;
+  const PathPoint at_third = path.Evaluate(third);
+  if (at_third.h >= 0.0) {
+    const double lo = std::min(0.5 * sk / s.prod(), third);
+    roots->push_back(FindRoot(path, lo, third, 1.0, 0.5 * (lo + third)));
+  }
+  // [s_k/3, s_k/2): grid; within each interval h is assumed to have at most
+  // one critical point, located by bisection on h' when the signs of h' at
+  // the ends say it may reach zero.
+  PathPoint a = at_third;
+  for (int n = 1; n <= kScanIntervals; ++n) {
+    const double tb = third + (0.5 * sk - third) * n / kScanIntervals;
+    const PathPoint b = path.Evaluate(tb);
+    const double ta = a.d(path.k());
+    if ((a.h < 0.0) != (b.h < 0.0)) {
+      roots->push_back(FindRoot(path, ta, tb, a.h < 0.0 ? 1.0 : -1.0, 0.5 * (ta + tb)));
+    } else if ((a.dh > 0.0) != (b.dh > 0.0) && (a.dh > 0.0) == (a.h < 0.0)) {
+      double lo = ta, hi = tb;  // h' changes sign between lo and hi
+      for (int iteration = 0; iteration < 60 && hi - lo > 4.0 * kEps * hi; ++iteration) {
+        const double mid = 0.5 * (lo + hi);
+        if ((path.Evaluate(mid).dh > 0.0) == (a.dh > 0.0)) lo = mid; else hi = mid;
+      }
+      const PathPoint extremum = path.Evaluate(0.5 * (lo + hi));
+      if ((extremum.h < 0.0) != (a.h < 0.0)) {
+        const double te = extremum.d(path.k());
+        const double direction = a.h < 0.0 ? 1.0 : -1.0;
+        roots->push_back(FindRoot(path, ta, te, direction, 0.5 * (ta + te)));
+        roots->push_back(FindRoot(path, te, tb, -direction, 0.5 * (te + tb)));
+      }
+    }
+    a = b;
+  }
+}
+
+// Closest candidate for the all-positive problem with target s; returns the
+// squared distance (infinity if no candidate was found).
+double SolvePositive(const Vec3& s, VolumeProjection* best) {
+  const StationaryPath path(s);
+  std::vector<PathPoint> roots;
+  roots.reserve(4);
+  GrowingBranchRoots(path, &roots);
+  ShrinkingBranchRoots(path, &roots);
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (const PathPoint& root : roots) {
+    const double distance = (root.d - s).squaredNorm();
+    if (distance < best_distance) {
+      best_distance = distance;
+      best->d = root.d;
+      best->multiplier = root.mu;
+    }
+  }
+  return best_distance;
+}
+
+}  // namespace
+
+VolumeProjection ProjectSingularValuesToUnitDeterminant(const Vec3& sigma) {
+  if (!sigma.allFinite()) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    return {Vec3::Constant(nan), nan};
+  }
+  VolumeProjection best{Vec3::Ones(), 0.0};
+  const double distance = SolvePositive(sigma, &best);
+  if (sigma(2) < 0.0) {
+    // Signs (+, -, -): d = flip .* d', d' the all-positive solution for
+    // s = flip .* sigma; the multiplier is unchanged (d_i - sigma_i = mu / d_i).
+    const Vec3 flip(1.0, -1.0, -1.0);
+    VolumeProjection flipped{Vec3::Ones(), 0.0};
+    if (SolvePositive(flip.cwiseProduct(sigma), &flipped) < distance) {
+      best.d = flip.cwiseProduct(flipped.d);
+      best.multiplier = flipped.multiplier;
+    }
+  }
+  return best;
+}
+
+Mat3 UnitDeterminantProjectionJacobian(const Vec3& sigma, const VolumeProjection& projection) {
+  // Differentiating d_i - sigma_i - mu / d_i = 0 and sum_i log|d_i| = 0:
+  //   [diag(1 + mu / d_i^2)  -1/d] [dd ]   [dsigma]
+  //   [1/d^T                  0  ] [dmu] = [  0   ].
+  const Vec3& d = projection.d;
+  const double mu = projection.multiplier;
+  Eigen::Matrix4d kkt = Eigen::Matrix4d::Zero();
+  for (int i = 0; i < 3; ++i) {
+    kkt(i, i) = 1.0 + mu / (d(i) * d(i));
+    kkt(i, 3) = -1.0 / d(i);
+    kkt(3, i) = 1.0 / d(i);
+  }
+  Eigen::Matrix<double, 4, 3> rhs = Eigen::Matrix<double, 4, 3>::Zero();
+  rhs.topRows<3>().setIdentity();
+  const Eigen::Matrix<double, 4, 3> solution = kkt.fullPivLu().solve(rhs);
+  return solution.topRows<3>();
+}
+
+IsotropicDifferentialCoefficients UnitDeterminantProjectionCoefficients(
+    const Vec3& sigma, const VolumeProjection& projection) {
+  const Vec3& d = projection.d;
+  const Mat3 jacobian = UnitDeterminantProjectionJacobian(sigma, projection);
+  IsotropicDifferentialCoefficients c = DividedDifferenceCoefficients(sigma, d, jacobian);
+  for (int k = 0; k < 3; ++k) {
+    const int i = kPairFirst[k], j = kPairSecond[k];
+    // Branch of d_i: larger root when (2 d_i - sigma_i) sign(d_i) >= 0.
+    const bool same_sign = (d(i) > 0.0) == (d(j) > 0.0);
+    const bool larger_i = (2.0 * d(i) - sigma(i)) * d(i) >= 0.0;
+    const bool larger_j = (2.0 * d(j) - sigma(j)) * d(j) >= 0.0;
+    if (same_sign && larger_i == larger_j) continue;
+    const double threshold =
+        kRepeatedSingularValueTolerance * std::max(std::abs(sigma(i)), std::abs(sigma(j)));
+    const double denominator = std::max({sigma(i) - sigma(j), threshold, DenominatorFloor(sigma)});
+    c.symmetric(k) = (d(i) - d(j)) / denominator;
+  }
+  return c;
+}
+
+}  // namespace diffpd::internal

@@ -1,0 +1,76 @@
+#include "mesh/line_reader.h"
+
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+#include "diffpd/error.h"
+
+namespace diffpd::internal {
+
+bool ParseInt(const std::string& token, long* value) {
+  const char* begin = token.data();
+  const char* end = begin + token.size();
+  if (begin != end && *begin == '+') ++begin;
+  const auto result = std::from_chars(begin, end, *value);
+  return result.ec == std::errc() && result.ptr == end && begin != end;
+}
+
+bool ParseDouble(const std::string& token, double* value) {
+  const char* begin = token.data();
+  const char* end = begin + token.size();
+  if (begin != end && *begin == '+') ++begin;
+  const auto result = std::from_chars(begin, end, *value);
+  return result.ec == std::errc() && result.ptr == end && begin != end && std::isfinite(*value);
+}
+
+LineReader::LineReader(std::string path, char comment)
+    : path_(std::move(path)), comment_(comment), stream_(path_) {
+  if (!stream_) throw InvalidInputError("cannot open '" + path_ + "'");
+}
+
+bool LineReader::Next() {
+  while (std::getline(stream_, line_)) {
+    ++line_number_;
+    if (comment_ != '\0') {
+      const size_t pos = line_.find(comment_);
+      if (pos != std::string::npos) line_.erase(pos);
+    }
+    const size_t first = line_.find_first_not_of(" \t\r\n");
+    if (first == std::string::npos) continue;
+    line_ = line_.substr(first, line_.find_last_not_of(" \t\r\n") - first + 1);
+    tokens_.clear();
+    std::istringstream split(line_);
+    for (std::string token; split >> token;) tokens_.push_back(token);
+    return true;
+  }
+  tokens_.clear();
+  line_.clear();
+  return false;
+}
+
+void LineReader::Fail(const std::string& message) const {
+  throw InvalidInputError(path_ + ":" + std::to_string(line_number_) + ": " + message);
+}
+
+void LineReader::RequireTokens(size_t n, const std::string& what) const {
+  if (tokens_.size() < n) Fail("expected " + what + ", got '" + line_ + "'");
+}
+
+long LineReader::ParseInt(size_t i, const std::string& what) const {
+  long value = 0;
+  if (i >= tokens_.size()) Fail("expected " + what + ", got end of line");
+  if (!internal::ParseInt(tokens_[i], &value)) Fail("expected " + what + ", got '" + tokens_[i] + "'");
+  return value;
+}
+
+double LineReader::ParseDouble(size_t i, const std::string& what) const {
+  double value = 0;
+  if (i >= tokens_.size()) Fail("expected " + what + ", got end of line");
+  if (!internal::ParseDouble(tokens_[i], &value)) {
+    Fail("expected " + what + " (a finite number), got '" + tokens_[i] + "'");
+  }
+  return value;
+}
+
+}  // namespace diffpd::internal

@@ -1,0 +1,68 @@
+#include "diffpd/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "diffpd/error.h"
+
+namespace diffpd {
+
+void Scene::Validate() const {
+  ValidateMesh(mesh);
+  material.Validate();
+  if (energies.empty()) throw InvalidInputError("scene: no elastic energy declared (energies is empty)");
+  if (gravity && !gravity->allFinite()) throw InvalidInputError("scene: gravity has a non-finite component");
+  const int n = mesh.num_dofs();
+  if (static_cast<Eigen::Index>(dirichlet.dofs.size()) != dirichlet.values.size()) {
+    std::ostringstream msg;
+    msg << "scene: dirichlet.dofs has " << dirichlet.dofs.size() << " entries but dirichlet.values has "
+        << dirichlet.values.size();
+    throw InvalidInputError(msg.str());
+  }
+  for (size_t k = 0; k < dirichlet.dofs.size(); ++k) {
+    const int d = dirichlet.dofs[k];
+    if (d < 0 || d >= n) {
+      std::ostringstream msg;
+      msg << "scene: Dirichlet DoF " << d << " is out of range [0, " << n << ")";
+      throw InvalidInputError(msg.str());
+    }
+    if (k > 0 && d <= dirichlet.dofs[k - 1]) {
+      std::ostringstream msg;
+      msg << "scene: Dirichlet DoFs must be strictly increasing (" << dirichlet.dofs[k - 1] << " then " << d << ")";
+      throw InvalidInputError(msg.str());
+    }
+    if (!std::isfinite(dirichlet.values(k))) {
+      std::ostringstream msg;
+      msg << "scene: the Dirichlet value of DoF " << d << " is not finite";
+      throw InvalidInputError(msg.str());
+    }
+  }
+}
+
+void FixNodeAxes(Scene* scene, const std::vector<int>& nodes, const std::vector<int>& axes) {
+  std::vector<std::pair<int, double>> all;
+  for (size_t k = 0; k < scene->dirichlet.dofs.size(); ++k)
+    all.emplace_back(scene->dirichlet.dofs[k], scene->dirichlet.values(k));
+  for (const int i : nodes) {
+    if (i < 0 || i >= scene->mesh.num_vertices()) {
+      std::ostringstream msg;
+      msg << "FixNodes: node " << i << " is out of range [0, " << scene->mesh.num_vertices() << ")";
+      throw InvalidInputError(msg.str());
+    }
+    for (const int a : axes) all.emplace_back(3 * i + a, scene->mesh.vertices(a, i));
+  }
+  std::sort(all.begin(), all.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
+  all.erase(std::unique(all.begin(), all.end(), [](const auto& p, const auto& q) { return p.first == q.first; }),
+            all.end());
+  scene->dirichlet.dofs.resize(all.size());
+  scene->dirichlet.values.resize(all.size());
+  for (size_t k = 0; k < all.size(); ++k) {
+    scene->dirichlet.dofs[k] = all[k].first;
+    scene->dirichlet.values(k) = all[k].second;
+  }
+}
+
+void FixNodes(Scene* scene, const std::vector<int>& nodes) { FixNodeAxes(scene, nodes, {0, 1, 2}); }
+
+}  // namespace diffpd

@@ -1,0 +1,16 @@
+// Backtracking (Armijo) line search shared by Newton and PD-LBFGS (internal).
+#pragma once
+
+#include "solver/simulator_impl.h"
+
+namespace diffpd::internal {
+
+// Tries x + alpha d for alpha = 1, 1/2, 1/4, ... until
+//   g(x + alpha d) <= g(x) + c alpha grad^T d.
+// On success sets *x, *value, *grad to the accepted point and returns the
+// number of halvings. Throws SolverError(kLineSearchFailed) when d is not a
+// descent direction or no step is accepted within the limit.
+int BacktrackingLineSearch(StepObjective& objective, const VectorXd& d, VectorXd* x, double* value,
+                           VectorXd* grad);
+
+}  // namespace diffpd::internal

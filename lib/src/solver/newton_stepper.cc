@@ -1,0 +1,69 @@
+// Newton's method on one implicit step: projected (SPD) element Hessians,
+// linear solve by CHOLMOD (pattern analysed once) or by PCG, Armijo line search.
+#include <Eigen/IterativeLinearSolvers>
+
+#include "diffpd/error.h"
+#include "solver/line_search.h"
+#include "solver/simulator_impl.h"
+
+namespace diffpd::internal {
+namespace {
+
+VectorXd SolveNewtonSystem(SimulatorImpl& sim, const SparseMatrix& h, const VectorXd& rhs) {
+  if (sim.options.method == Method::kNewtonPcg) {
+    VectorXd dx;
+    bool ok = false;
+    if (sim.options.pcg_preconditioner == PcgPreconditioner::kJacobi) {
+      Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper> cg;
+      cg.setTolerance(sim.options.pcg_rel_tolerance);
+      cg.setMaxIterations(sim.options.pcg_max_iterations);
+      cg.compute(h);
+      dx = cg.solve(rhs);
+      ok = cg.info() == Eigen::Success;
+    } else {
+      Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>> cg;
+      cg.setTolerance(sim.options.pcg_rel_tolerance);
+      cg.setMaxIterations(sim.options.pcg_max_iterations);
+      cg.compute(h);
+      dx = cg.solve(rhs);
+      ok = cg.info() == Eigen::Success;
+    }
+    if (!ok)
+      throw SolverError(SolverStatus::kDiverged, "newton-pcg: the conjugate-gradient solve did not reach its tolerance");
+    return dx;
+  }
+  CholmodSolver& llt = sim.newton_solver();
+  if (!llt.Factorize(h))
+    throw SolverError(SolverStatus::kFactorizationFailed,
+                      "newton-cholesky: the projected Hessian is not positive definite (a free rigid mode?)");
+  return llt.Solve(rhs);
+}
+
+}  // namespace
+
+VectorXd NewtonSolve(StepObjective& objective, const VectorXd& x0, StepReport* report) {
+  SimulatorImpl& sim = objective.sim();
+  VectorXd x = x0;
+  VectorXd grad;
+  double value = objective.Evaluate(x, &grad);
+  const double initial = grad.norm();
+  report->initial_residual = initial;
+  std::vector<double> blocks;
+  SparseMatrix h;
+  for (int it = 0;; ++it) {
+    const double norm = grad.norm();
+    report->iterations = it;
+    report->final_residual = norm;
+    if (Converged(sim.options, norm, initial)) return x;
+    if (it >= sim.options.max_iterations) ThrowNotConverged(sim.options, it, norm, initial);
+    sim.elastic.ElementHessians(x, sim.mu(), sim.lambda(), /*project_spd=*/true, &blocks, sim.threads());
+    sim.hessian_assembler().Assemble(blocks, objective.inertia_diagonal(), sim.fixed, &h);
+    VectorXd rhs = -grad;
+    VectorXd dx = SolveNewtonSystem(sim, h, rhs);
+    sim.ZeroFixed(&dx);
+    CheckFinite(dx, "the Newton step");
+    report->line_search_steps += BacktrackingLineSearch(objective, dx, &x, &value, &grad);
+  }
+}
+
+}  // namespace diffpd::internal

@@ -1,0 +1,57 @@
+// The constant matrix of projective dynamics and its factorisation (internal).
+//
+//   A = M / h^2 + w sum_s vol_s G_s^T G_s  =  A_s (x) I_3,
+//   A_s = (rho / h^2) diag(m_unit) + w L,   L_ab = sum_s vol_s grad_a(s) . grad_b(s),
+//
+// a scalar n x n matrix acting identically on x, y and z. Dirichlet DoFs erase
+// rows and columns per axis; axes whose fixed-node sets agree share one
+// CHOLMOD factor and are solved together as several right-hand sides.
+// The factor is recomputed exactly when (h, rho, w) changes (the mesh and the
+// Dirichlet set are fixed for the object's lifetime).
+#pragma once
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "diffpd/types.h"
+#include "fem/fem_model.h"
+#include "solver/cholmod_solver.h"
+
+namespace diffpd::internal {
+
+class PdSystem {
+ public:
+  // `fixed` has 3n flags (DoF 3i + d fixed). Does not take ownership of fem.
+  PdSystem(const FemModel& fem, const std::vector<char>& fixed);
+
+  // Makes the factor current for (h, rho, w); returns true if it refactorised.
+  // Throws SolverError(kFactorizationFailed) if A is not positive definite.
+  bool Update(double h, double rho, double w);
+
+  // Solves A dx = r over the free DoFs: returns dx (3n) with zero fixed DoFs.
+  // Entries of r at fixed DoFs are ignored. Several vectors: columns of R.
+  VectorXd Solve(const VectorXd& r) const;
+  MatrixXd Solve(const MatrixXd& r) const;
+  // y = A x over the free DoFs (fixed rows and columns erased).
+  VectorXd Apply(const VectorXd& x) const;
+
+  int num_factorizations() const { return num_factorizations_; }
+  int num_groups() const { return static_cast<int>(groups_.size()); }
+
+ private:
+  struct Group {
+    std::vector<int> axes;
+    std::vector<char> fixed_node;  // n flags
+    SparseMatrix matrix;
+    std::unique_ptr<CholmodSolver> solver;
+  };
+  const FemModel& fem_;
+  SparseMatrix laplacian_;
+  std::vector<Group> groups_;
+  std::array<int, 3> group_of_axis_{};
+  double h_ = -1, rho_ = -1, w_ = -1;
+  int num_factorizations_ = 0;
+};
+
+}  // namespace diffpd::internal

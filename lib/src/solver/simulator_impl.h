@@ -1,0 +1,118 @@
+// State shared by the simulator's steppers and adjoints (internal).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "diffpd/rollout.h"
+#include "diffpd/scene.h"
+#include "diffpd/solver_options.h"
+#include "fem/elastic_forces.h"
+#include "fem/fem_model.h"
+#include "solver/cholmod_solver.h"
+#include "solver/hessian_assembler.h"
+#include "solver/pd_system.h"
+
+namespace diffpd::internal {
+
+class SimulatorImpl {
+ public:
+  SimulatorImpl(const Scene& scene, const SolverOptions& options);
+
+  Scene scene;
+  SolverOptions options;
+  FemModel fem;
+  ElasticForces elastic;
+  std::vector<char> fixed;  // 3n flags
+  VectorXd fixed_values;    // 3n, Dirichlet positions (zero at free DoFs)
+  VectorXd unit_mass;       // 3n, lumped mass per DoF for unit density (m^3)
+
+  double mu() const { return scene.material.mu(); }
+  double lambda() const { return scene.material.lambda(); }
+  double rho() const { return scene.material.density; }
+  double h() const { return options.time_step; }
+  int threads() const { return options.num_threads; }
+  int num_dofs() const { return fem.mesh().num_dofs(); }
+
+  // Mass per DoF (3n, kg).
+  VectorXd Mass() const { return rho() * unit_mass; }
+  // Explicit force of a step: gravity (if declared) plus the input's force.
+  VectorXd ExplicitForce(const StepInput& input) const;
+  // Sets fixed DoFs of v to zero.
+  void ZeroFixed(VectorXd* v) const;
+
+  // Lazily built solvers.
+  HessianAssembler& hessian_assembler();
+  PdSystem& pd_system();  // factor made current for (h, rho, PD weight)
+  CholmodSolver& newton_solver() { return newton_llt_; }
+  int pd_factorizations() const { return pd_ ? pd_->num_factorizations() : 0; }
+
+ private:
+  std::unique_ptr<HessianAssembler> hessian_;
+  std::unique_ptr<PdSystem> pd_;
+  CholmodSolver newton_llt_;
+};
+
+// The objective of one implicit Euler step over the free DoFs:
+//   g(x) = 1/(2 h^2) (x - xhat)^T M (x - xhat) - f^T x + E(x),
+//   grad g(x) = M (x - xhat) / h^2 - f + grad E(x),
+// with xhat = x_i + h v_i and f the explicit force. With `static_problem`
+// the inertia term is dropped (equilibrium solve).
+class StepObjective {
+ public:
+  StepObjective(SimulatorImpl& sim, VectorXd xhat, VectorXd force, bool static_problem = false);
+  // g(x); if grad != nullptr also grad g (zero at fixed DoFs).
+  double Evaluate(const VectorXd& x, VectorXd* grad);
+  // Diagonal of the inertia term (3n): M / h^2, or zero for a static problem.
+  const VectorXd& inertia_diagonal() const { return inertia_; }
+  SimulatorImpl& sim() { return sim_; }
+
+ private:
+  SimulatorImpl& sim_;
+  VectorXd xhat_;
+  VectorXd force_;
+  VectorXd inertia_;
+};
+
+// Exact Hessian of one step's objective at a point, over the free DoFs,
+// solved for one or several right-hand sides by the method's own machinery
+// (direct factorisation for Newton; PD-preconditioned iteration with a
+// direct fallback for PD and PD-LBFGS).
+class StepLinearization {
+ public:
+  StepLinearization(SimulatorImpl& sim, const VectorXd& x, bool static_problem = false);
+  // Solves H z = b (3n; fixed entries of b ignored, of z zero).
+  VectorXd Solve(const VectorXd& b, BackwardReport* report);
+  // H z (3n, free rows only).
+  VectorXd Apply(const VectorXd& z);
+
+ private:
+  bool DirectSolve(const VectorXd& b, VectorXd* z);
+  bool IterativeSolve(const VectorXd& b, VectorXd* z, int* iterations);
+  bool PcgSolve(const VectorXd& b, VectorXd* z, int* iterations);
+
+  SimulatorImpl& sim_;
+  VectorXd x_;
+  VectorXd inertia_;
+  std::vector<Mat9> dstress_;
+  SparseMatrix matrix_;  // assembled exact H (lazily)
+  bool have_matrix_ = false;
+  bool factored_ = false;
+  std::unique_ptr<CholmodSolver> llt_;
+};
+
+// Forward solvers of one implicit step. Each returns x_{i+1} and fills the
+// report; each throws SolverError when the step does not converge.
+VectorXd NewtonSolve(StepObjective& objective, const VectorXd& x0, StepReport* report);
+VectorXd PdSolve(StepObjective& objective, const VectorXd& x0, StepReport* report);
+VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* report);
+
+// True when ||grad|| meets the common convergence test.
+bool Converged(const SolverOptions& options, double grad_norm, double initial_norm);
+// Throws SolverError(kMaxIterations) with a message naming method and residuals.
+[[noreturn]] void ThrowNotConverged(const SolverOptions& options, int iterations, double grad_norm,
+                                    double initial_norm);
+// Throws SolverError(kNonFinite) if v has a non-finite entry.
+void CheckFinite(const VectorXd& v, const char* what);
+
+}  // namespace diffpd::internal

@@ -1,0 +1,61 @@
+#include "diffpd/solver_options.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "diffpd/error.h"
+
+namespace diffpd {
+namespace {
+constexpr Method kMethods[] = {Method::kSemiImplicit, Method::kNewtonCholesky, Method::kNewtonPcg, Method::kPd,
+                               Method::kPdLbfgs};
+
+template <class T>
+[[noreturn]] void Reject(const char* field, T value, const char* range) {
+  std::ostringstream msg;
+  msg << "solver options: " << field << " = " << value << " is invalid: must be " << range;
+  throw InvalidInputError(msg.str());
+}
+}  // namespace
+
+const char* ToString(Method method) {
+  switch (method) {
+    case Method::kSemiImplicit: return "semi-implicit";
+    case Method::kNewtonCholesky: return "newton-cholesky";
+    case Method::kNewtonPcg: return "newton-pcg";
+    case Method::kPd: return "pd";
+    case Method::kPdLbfgs: return "pd-lbfgs";
+  }
+  return "unknown";
+}
+
+Method ParseMethod(const std::string& name) {
+  std::string valid;
+  for (const Method m : kMethods) {
+    if (name == ToString(m)) return m;
+    valid += valid.empty() ? "" : ", ";
+    valid += ToString(m);
+  }
+  throw InvalidInputError("unknown method '" + name + "': valid methods are " + valid);
+}
+
+void SolverOptions::Validate() const {
+  if (!(std::isfinite(time_step) && time_step > 0)) Reject("time_step", time_step, "finite and > 0 (s)");
+  if (!(std::isfinite(abs_tolerance) && abs_tolerance >= 0)) Reject("abs_tolerance", abs_tolerance, "finite and >= 0");
+  if (!(std::isfinite(rel_tolerance) && rel_tolerance >= 0 && rel_tolerance < 1))
+    Reject("rel_tolerance", rel_tolerance, "in [0, 1)");
+  if (abs_tolerance == 0 && rel_tolerance == 0)
+    throw InvalidInputError("solver options: abs_tolerance and rel_tolerance are both 0; at least one must be > 0");
+  if (max_iterations < 1) Reject("max_iterations", max_iterations, ">= 1");
+  if (!(armijo_c > 0 && armijo_c < 1)) Reject("armijo_c", armijo_c, "in (0, 1)");
+  if (max_line_search_steps < 1) Reject("max_line_search_steps", max_line_search_steps, ">= 1");
+  if (!(pcg_rel_tolerance > 0 && pcg_rel_tolerance < 1)) Reject("pcg_rel_tolerance", pcg_rel_tolerance, "in (0, 1)");
+  if (pcg_max_iterations < 1) Reject("pcg_max_iterations", pcg_max_iterations, ">= 1");
+  if (lbfgs_history < 1) Reject("lbfgs_history", lbfgs_history, ">= 1");
+  if (!(backward_rel_tolerance > 0 && backward_rel_tolerance < 1))
+    Reject("backward_rel_tolerance", backward_rel_tolerance, "in (0, 1)");
+  if (backward_max_iterations < 1) Reject("backward_max_iterations", backward_max_iterations, ">= 1");
+  if (num_threads < 0) Reject("num_threads", num_threads, ">= 0 (0: OpenMP default)");
+}
+
+}  // namespace diffpd

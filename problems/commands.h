@@ -1,0 +1,31 @@
+// The subcommands of the diffpd program. Each returns the process exit code;
+// with json = true stdout carries exactly one JSON document and everything
+// else goes to stderr.
+#pragma once
+
+#include <string>
+
+#include "diffpd/solver_options.h"
+
+namespace diffpd::problems {
+
+// Settings shared by the subcommands that simulate a problem.
+struct CommandArgs {
+  std::string problem;
+  Method method = Method::kPd;
+  int threads = 0;
+  int steps = -1;        // -1: the problem's default
+  double dt = -1;        // -1: the problem's default (s)
+  double rel_tolerance = -1;  // -1: the command's default
+  std::string out_dir;   // "" : no files
+  bool json = false;
+};
+
+int ListCommand(bool json);
+int RunCommand(const CommandArgs& args);
+int GradcheckCommand(const CommandArgs& args);
+
+// Solver options for a problem from the shared arguments.
+SolverOptions OptionsFromArgs(const CommandArgs& args, double default_dt, double default_rel_tolerance);
+
+}  // namespace diffpd::problems

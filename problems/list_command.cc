@@ -1,0 +1,29 @@
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "problem_registry.h"
+
+namespace diffpd::problems {
+
+int ListCommand(bool json) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& p : AllProblems()) {
+    if (json) out.push_back({{"name", p->name()}, {"description", p->description()}});
+    else std::printf("%-24s %s\n", p->name().c_str(), p->description().c_str());
+  }
+  if (json) std::printf("%s\n", out.dump(2).c_str());
+  return 0;
+}
+
+SolverOptions OptionsFromArgs(const CommandArgs& args, double default_dt, double default_rel_tolerance) {
+  SolverOptions o;
+  o.method = args.method;
+  o.num_threads = args.threads;
+  o.time_step = args.dt > 0 ? args.dt : default_dt;
+  o.rel_tolerance = args.rel_tolerance > 0 ? args.rel_tolerance : default_rel_tolerance;
+  return o;
+}
+
+}  // namespace diffpd::problems

@@ -1,0 +1,72 @@
+// diffpd: command-line front end of the DiffPD library.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "commands.h"
+#include "diffpd/error.h"
+
+namespace {
+
+using diffpd::problems::CommandArgs;
+
+// Adds the options shared by the simulating subcommands.
+void AddCommonOptions(CLI::App* cmd, CommandArgs* args, std::string* method) {
+  cmd->add_option("problem", args->problem, "problem name (see `diffpd list`)")->required();
+  cmd->add_option("--method", *method,
+                  "semi-implicit, newton-cholesky, newton-pcg, pd or pd-lbfgs")->capture_default_str();
+  cmd->add_option("--threads", args->threads, "threads for element loops (0: OpenMP default)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--steps", args->steps, "number of time steps (default: the problem's)");
+  cmd->add_option("--dt", args->dt, "time step in seconds (default: the problem's)");
+  cmd->add_option("--rtol", args->rel_tolerance, "relative tolerance on |grad g| per step");
+  cmd->add_flag("--json", args->json, "print one JSON document on stdout");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"diffpd: differentiable soft-body simulation by projective dynamics"};
+  app.require_subcommand(1);
+  bool list_json = false;
+  CLI::App* list = app.add_subcommand("list", "list the problems with a one-line description");
+  list->add_flag("--json", list_json, "print a JSON list");
+
+  CommandArgs run_args, grad_args;
+  std::string run_method = "pd", grad_method = "pd";
+  CLI::App* run = app.add_subcommand("run", "simulate a problem, print a per-step table and write results");
+  AddCommonOptions(run, &run_args, &run_method);
+  run->add_option("--out", run_args.out_dir, "directory for VTK frames (.vtu + .pvd) and summary.json");
+
+  CLI::App* grad = app.add_subcommand("gradcheck", "compare rollout gradients with central finite differences");
+  AddCommonOptions(grad, &grad_args, &grad_method);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    if (*list) return diffpd::problems::ListCommand(list_json);
+    if (*run) {
+      run_args.method = diffpd::ParseMethod(run_method);
+      return diffpd::problems::RunCommand(run_args);
+    }
+    if (*grad) {
+      grad_args.method = diffpd::ParseMethod(grad_method);
+      return diffpd::problems::GradcheckCommand(grad_args);
+    }
+  } catch (const diffpd::InvalidInputError& e) {
+    std::fprintf(stderr, "diffpd: invalid input: %s\n", e.what());
+    return 2;
+  } catch (const diffpd::SolverError& e) {
+    std::fprintf(stderr, "diffpd: solver failed (%s): %s\n", diffpd::ToString(e.status()), e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "diffpd: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

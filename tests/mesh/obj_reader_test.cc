@@ -1,0 +1,113 @@
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "diffpd/error.h"
+#include "diffpd/surface_mesh.h"
+
+namespace diffpd {
+namespace {
+
+class ReadObjTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    directory_ = std::filesystem::path(::testing::TempDir()) /
+                 ("diffpd_obj_reader_test_" + std::to_string(getpid()));
+    std::filesystem::create_directories(directory_);
+  }
+  void TearDown() override { std::filesystem::remove_all(directory_); }
+
+  // Writes `text` to a file in the test's directory; returns its path.
+  std::string Write(const std::string& name, const std::string& text) {
+    const std::string path = (directory_ / name).string();
+    std::ofstream(path) << text;
+    return path;
+  }
+
+  // The message of ReadObj on a file holding `text`, "<path>" replaced by "F".
+  std::string ErrorOf(const std::string& text) {
+    const std::string path = Write("bad.obj", text);
+    try {
+      ReadObj(path);
+    } catch (const InvalidInputError& error) {
+      std::string message = error.what();
+      if (message.rfind(path, 0) == 0) message = "F" + message.substr(path.size());
+      return message;
+    }
+    return "no exception";
+  }
+
+  std::filesystem::path directory_;
+};
+
+const char kTetrahedron[] =
+    "# a tetrahedron\n"
+    "mtllib none.mtl\n"
+    "o tet\n"
+    "v 0 0 0\n"
+    "v 1.0 0 0   # trailing comment\n"
+    "v 0 1e0 0\n"
+    "v 0 0 +1 1.0\n"
+    "vn 0 0 1\n"
+    "vt 0 0\n"
+    "s off\n"
+    "f 1 3 2\n"
+    "f 1/1 2/1 4/1\n"
+    "f 1//1 4//1 3//1\n"
+    "\n"
+    "f -3/1/1 -2/1/1 -1/1/1\n";
+
+TEST_F(ReadObjTest, ReadsVerticesFacesAndIndexForms) {
+  const SurfaceMesh surface = ReadObj(Write("tet.obj", kTetrahedron));
+  ASSERT_EQ(surface.vertices.cols(), 4);
+  ASSERT_EQ(surface.triangles.cols(), 4);
+  EXPECT_EQ(surface.vertices.col(3), Vec3(0, 0, 1));
+  EXPECT_EQ(surface.triangles.col(0), Eigen::Vector3i(0, 2, 1));
+  EXPECT_EQ(surface.triangles.col(3), Eigen::Vector3i(1, 2, 3));
+  EXPECT_NO_THROW(ValidateWatertight(surface));
+  EXPECT_NEAR(EnclosedVolume(surface), 1.0 / 6.0, 1e-15);
+}
+
+TEST_F(ReadObjTest, FanTriangulatesPolygons) {
+  const SurfaceMesh surface =
+      ReadObj(Write("pentagon.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0.5 2 0\nv 0 1 0\nf 1 2 3 4 5\n"));
+  ASSERT_EQ(surface.triangles.cols(), 3);
+  EXPECT_EQ(surface.triangles.col(0), Eigen::Vector3i(0, 1, 2));
+  EXPECT_EQ(surface.triangles.col(1), Eigen::Vector3i(0, 2, 3));
+  EXPECT_EQ(surface.triangles.col(2), Eigen::Vector3i(0, 3, 4));
+}
+
+TEST_F(ReadObjTest, Errors) {
+  EXPECT_EQ(ErrorOf("v 0 0 0\nv 1 2\n"), "F:2: expected x y z coordinates, got 'v 1 2'");
+  EXPECT_EQ(ErrorOf("v 0 abc 0\n"), "F:1: expected y coordinate (a finite number), got 'abc'");
+  EXPECT_EQ(ErrorOf("v 0 nan 0\n"), "F:1: expected y coordinate (a finite number), got 'nan'");
+  EXPECT_EQ(ErrorOf("v 0 0 0\nv 1 0 0\nf 1 2\n"), "F:3: a face needs at least 3 vertices, got 2");
+  EXPECT_EQ(ErrorOf("v 0 0 0\nf 1 1/a x\n"), "F:2: malformed face entry 'x'");
+  EXPECT_EQ(ErrorOf("v 0 0 0\nf 1 a/1 1\n"), "F:2: malformed face entry 'a/1'");
+  EXPECT_EQ(ErrorOf("v 0 0 0\nf 1 0 1\n"), "F:2: face index 0 is invalid (OBJ indices start at 1)");
+  EXPECT_EQ(ErrorOf("v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 12\nv 0 0 1\n"),
+            "F:5: face index 12 out of range (file has 4 vertices)");
+  EXPECT_EQ(ErrorOf("v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n"),
+            "F:3: face index -3 out of range (2 vertices read before this line)");
+  EXPECT_EQ(ErrorOf("# nothing\n"), "F: no vertices");
+  EXPECT_EQ(ErrorOf("v 0 0 0\n"), "F: no faces");
+  const std::string missing = (directory_ / "missing.obj").string();
+  try {
+    ReadObj(missing);
+    ADD_FAILURE() << "no exception";
+  } catch (const InvalidInputError& error) {
+    EXPECT_EQ(std::string(error.what()), "cannot open '" + missing + "'");
+  }
+}
+
+TEST_F(ReadObjTest, ForwardReferencesAreAllowed) {
+  const SurfaceMesh surface = ReadObj(Write("forward.obj", "f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"));
+  EXPECT_EQ(surface.triangles.col(0), Eigen::Vector3i(0, 1, 2));
+}
+
+}  // namespace
+}  // namespace diffpd

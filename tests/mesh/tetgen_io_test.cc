@@ -1,0 +1,169 @@
+#include "diffpd/tetgen_io.h"
+
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "diffpd/error.h"
+#include "diffpd/surface_mesh.h"
+#include "mesh/subprocess.h"
+
+namespace diffpd {
+namespace {
+
+// Two tets sharing the face (1, 2, 3) (1-based), with attributes, boundary
+// markers and comments.
+const char kNodes1[] =
+    "# five points\n"
+    "5 3 1 1\n"
+    "1  0 0 0   7.5 1\n"
+    "2  1 0 0   7.5 1  # marker\n"
+    "3  0 1 0   7.5 0\n"
+    "\n"
+    "4  0 0 1   7.5 1\n"
+    "5  1 1 1   7.5 1\n";
+const char kEle1[] =
+    "2 4 1\n"
+    "1  1 2 3 4  10\n"
+    "2  2 5 3 4  10  # second\n";
+
+class TetGenTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    directory_ = std::filesystem::path(::testing::TempDir()) /
+                 ("diffpd_tetgen_io_test_" + std::to_string(getpid()));
+    std::filesystem::create_directories(directory_);
+  }
+  void TearDown() override { std::filesystem::remove_all(directory_); }
+
+  std::string Write(const std::string& name, const std::string& text) {
+    const std::string path = (directory_ / name).string();
+    std::ofstream(path) << text;
+    return path;
+  }
+
+  // The message of ReadTetGen on the two texts, with the paths replaced by
+  // "N" and "E".
+  std::string ErrorOf(const std::string& nodes, const std::string& elements) {
+    const std::string node_path = Write("m.node", nodes), ele_path = Write("m.ele", elements);
+    try {
+      ReadTetGen(node_path, ele_path);
+    } catch (const InvalidInputError& error) {
+      std::string message = error.what();
+      if (message.rfind(node_path, 0) == 0) message = "N" + message.substr(node_path.size());
+      if (message.rfind(ele_path, 0) == 0) message = "E" + message.substr(ele_path.size());
+      return message;
+    }
+    return "no exception";
+  }
+
+  std::filesystem::path directory_;
+};
+
+TEST_F(TetGenTest, ReadsOneBasedFiles) {
+  const Mesh mesh = ReadTetGen(Write("a.node", kNodes1), Write("a.ele", kEle1));
+  EXPECT_EQ(mesh.type, ElementType::kTet4);
+  ASSERT_EQ(mesh.num_vertices(), 5);
+  ASSERT_EQ(mesh.num_elements(), 2);
+  EXPECT_EQ(mesh.vertices.col(4), Vec3(1, 1, 1));
+  EXPECT_EQ(mesh.elements.col(1), Eigen::Vector4i(1, 4, 2, 3));
+  EXPECT_DOUBLE_EQ(SignedElementVolume(mesh, mesh.vertices, 0), 1.0 / 6.0);
+  EXPECT_DOUBLE_EQ(SignedElementVolume(mesh, mesh.vertices, 1), 1.0 / 3.0);
+}
+
+TEST_F(TetGenTest, ReadsZeroBasedFiles) {
+  const Mesh mesh = ReadTetGen(Write("b.node", "5 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n4 1 1 1\n"),
+                               Write("b.ele", "2 4 0\n0 0 1 2 3\n1 1 4 2 3\n"));
+  EXPECT_EQ(mesh.elements.col(0), Eigen::Vector4i(0, 1, 2, 3));
+  EXPECT_EQ(mesh.elements.col(1), Eigen::Vector4i(1, 4, 2, 3));
+}
+
+TEST_F(TetGenTest, Errors) {
+  EXPECT_EQ(ErrorOf("5 2 0 0\n", kEle1), "N:1: expected dimension 3, got 2");
+  EXPECT_EQ(ErrorOf("x 3 0 0\n", kEle1), "N:1: expected the number of points, got 'x'");
+  EXPECT_EQ(ErrorOf("2 3 0 0\n5 0 0 0\n", kEle1), "N:2: first point number must be 0 or 1, got 5");
+  EXPECT_EQ(ErrorOf("3 3 0 0\n1 0 0 0\n2 1 0 0\n4 0 1 0\n", kEle1), "N:4: point number 4 out of sequence (expected 3)");
+  EXPECT_EQ(ErrorOf("5 3 0 0\n1 0 0 0\n2 1 0 0\n", kEle1), "N: file ends after 2 of 5 points");
+  EXPECT_EQ(ErrorOf("1 3 0 0\n1 0 0\n", kEle1), "N:2: expected z coordinate, got end of line");
+  EXPECT_EQ(ErrorOf(kNodes1, "2 10 0\n"), "E:1: only 4-node tetrahedra are supported, got 10 nodes per tetrahedron");
+  EXPECT_EQ(ErrorOf(kNodes1, "2 4 0\n1 1 2 3 4\n2 2 5 3 9\n"),
+            "E:3: node 9 out of range (the .node file numbers its 5 points 1..5)");
+  EXPECT_EQ(ErrorOf(kNodes1, "2 4 0\n1 1 2 3 4\n"), "E: file ends after 1 of 2 tetrahedra");
+  EXPECT_EQ(ErrorOf(kNodes1, "2 4 0\n1 1 2 3 4\n3 2 5 3 4\n"),
+            "E:3: tetrahedron number 3 out of sequence (expected 2)");
+  // Validation by ValidateMesh, with the .ele path as `what`.
+  EXPECT_EQ(ErrorOf(kNodes1, "2 4 0\n1 1 2 3 4\n2 2 3 5 4\n"),
+            "E: element 1 is inverted or degenerate (signed volume -0.333333 m^3)");
+  EXPECT_EQ(ErrorOf(kNodes1, "1 4 0\n1 1 2 3 4\n"), "E: vertex 4 is not referenced by any element");
+  const std::string missing = (directory_ / "missing.node").string();
+  try {
+    ReadTetGen(missing, missing);
+    ADD_FAILURE() << "no exception";
+  } catch (const InvalidInputError& error) {
+    EXPECT_EQ(std::string(error.what()), "cannot open '" + missing + "'");
+  }
+}
+
+bool HaveTetGen() { return !internal::FindOnPath("tetgen").empty(); }
+
+TEST(TetrahedralizeSurfaceTest, SphereVolumeMatchesSurface) {
+  if (!HaveTetGen()) GTEST_SKIP() << "the tetgen program is not installed";
+  const SurfaceMesh sphere = ReadObj(DIFFPD_SHARED_DIR "/data/meshes/sphere.obj");
+  const Mesh mesh = TetrahedralizeSurface(sphere);
+  EXPECT_EQ(mesh.type, ElementType::kTet4);
+  EXPECT_NO_THROW(ValidateMesh(mesh));
+  EXPECT_GE(mesh.num_vertices(), sphere.vertices.cols());
+  double volume = 0.0;
+  for (int e = 0; e < mesh.num_elements(); ++e) volume += SignedElementVolume(mesh, mesh.vertices, e);
+  EXPECT_NEAR(volume / EnclosedVolume(sphere), 1.0, 0.01);
+
+  const Mesh scaled = TetrahedralizeSurface(sphere, "pq1.414Y", 2.0);
+  double scaled_volume = 0.0;
+  for (int e = 0; e < scaled.num_elements(); ++e) scaled_volume += SignedElementVolume(scaled, scaled.vertices, e);
+  EXPECT_NEAR(scaled_volume / (8.0 * EnclosedVolume(sphere)), 1.0, 0.01);
+}
+
+TEST(TetrahedralizeSurfaceTest, Errors) {
+  const SurfaceMesh sphere = ReadObj(DIFFPD_SHARED_DIR "/data/meshes/sphere.obj");
+  auto message = [&](const SurfaceMesh& surface, const std::string& switches, double scale) {
+    try {
+      TetrahedralizeSurface(surface, switches, scale);
+    } catch (const std::exception& error) {
+      return std::string(error.what());
+    }
+    return std::string("no exception");
+  };
+  EXPECT_EQ(message(sphere, "-pq", 1.0),
+            "TetrahedralizeSurface: switches '-pq' must be one word without '-' or spaces, e.g. \"pq1.414Y\"");
+  EXPECT_EQ(message(sphere, "pqN", 1.0),
+            "TetrahedralizeSurface: switch 'N' in 'pqN' is not supported (it changes the files TetGen reads or "
+            "writes)");
+  EXPECT_EQ(message(sphere, "pq", -1.0), "TetrahedralizeSurface: scale = -1, must be finite and > 0");
+  EXPECT_EQ(message(SurfaceMesh{}, "pq", 1.0), "TetrahedralizeSurface: the surface has no triangles");
+
+  const std::string path = getenv("PATH") ? getenv("PATH") : "";
+  setenv("PATH", "/nonexistent-diffpd-dir", 1);
+  EXPECT_EQ(message(sphere, "pq", 1.0), "tetgen program not found: install the Debian package 'tetgen'");
+  setenv("PATH", path.c_str(), 1);
+
+  if (!HaveTetGen()) GTEST_SKIP() << "the tetgen program is not installed";
+  SurfaceMesh triangle;  // not a closed surface: TetGen gives up
+  triangle.vertices.resize(3, 3);
+  triangle.vertices << 0, 1, 0,  //
+      0, 0, 1,                    //
+      0, 0, 0;
+  triangle.triangles.resize(3, 1);
+  triangle.triangles << 0, 1, 2;
+  const std::string failure = message(triangle, "pq1.414Y", 1.0);
+  EXPECT_EQ(failure.rfind("tetgen failed (", 0), 0u) << failure;
+  EXPECT_NE(failure.find(") with switches 'pq1.414Y': "), std::string::npos) << failure;
+}
+
+}  // namespace
+}  // namespace diffpd
