@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "diffpd/error.h"
+#include "diffpd/types.h"
 
 namespace diffpd {
 namespace {
@@ -113,15 +114,15 @@ TEST_F(ReadGmshTest, ContentErrors) {
                             "$Nodes\n1 5 1 5\n3 1 0 5\n1\n2\n3\n4\n5\n"
                             "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n$EndNodes\n";
   EXPECT_EQ(ErrorOf(std::string(kHeader) + "$Nodes\n1 2 1 2\n3 1 0 2\n1\n1\n0 0 0\n1 0 0\n$EndNodes\n"),
-            "F:9: node tag 1 appears twice");
+            "F:8: node tag 1 appears twice");
   EXPECT_EQ(ErrorOf(nodes + "$Elements\n1 1 1 1\n3 1 4 1\n7 1 2 3 99\n$EndElements\n"),
-            "F:23: element 7 references node tag 99, which is not in $Nodes");
+            "F:21: element 7 references node tag 99, which is not in $Nodes");
   EXPECT_EQ(ErrorOf(nodes + "$Elements\n1 1 1 1\n3 1 5 1\n7 1 2 3 4\n$EndElements\n"),
-            "F:23: element 7 has 4 node tags, expected 8 for type 5 (hex8)");
+            "F:21: element 7 has 4 node tags, expected 8 for type 5 (hex8)");
   EXPECT_EQ(ErrorOf(nodes + "$Elements\n1 1 1 1\n3 1 11 1\n7 1 2 3 4 5 1 2 3 4 5\n$EndElements\n"),
-            "F:22: 3D element type 11 is not supported (only 4 = tet4 and 5 = hex8)");
+            "F:20: 3D element type 11 is not supported (only 4 = tet4 and 5 = hex8)");
   EXPECT_EQ(ErrorOf(std::string(kHeader) + kCube + "$Elements\n1 1 1 1\n3 1 4 1\n9 10 20 30 50\n$EndElements\n"),
-            "F:37: the file mixes tet4 and hex8 elements (a mesh has one element type)");
+            "F:48: the file mixes tet4 and hex8 elements (a mesh has one element type)");
   // Validation by ValidateMesh, with the file name as `what`.
   EXPECT_EQ(ErrorOf(nodes + "$Elements\n1 1 1 1\n3 1 4 1\n7 1 3 2 4\n$EndElements\n"),
             "F: element 0 is inverted or degenerate (signed volume -0.166667 m^3)");

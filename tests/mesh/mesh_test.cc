@@ -172,7 +172,7 @@ TEST(ValidateMeshTest, HexWithNegativeJacobianAtAGaussPoint) {
     ADD_FAILURE() << "no exception";
   } catch (const InvalidInputError& error) {
     EXPECT_EQ(std::string(error.what()),
-              "m: element 0 is inverted or degenerate (signed volume 0.6625 m^3; det J = -0.012937 at Gauss point 7)");
+              "m: element 0 is inverted or degenerate (signed volume 0.2875 m^3; det J = -0.0965905 at Gauss point 7)");
   }
 }
 

@@ -146,6 +146,10 @@ TEST(TetrahedralizeSurfaceTest, Errors) {
             "writes)");
   EXPECT_EQ(message(sphere, "pq", -1.0), "TetrahedralizeSurface: scale = -1, must be finite and > 0");
   EXPECT_EQ(message(SurfaceMesh{}, "pq", 1.0), "TetrahedralizeSurface: the surface has no triangles");
+  SurfaceMesh broken = sphere;
+  broken.triangles(1, 5) = 162;
+  EXPECT_EQ(message(broken, "pq", 1.0),
+            "TetrahedralizeSurface: triangle 5 references vertex 162, but the surface has 162 vertices");
 
   const std::string path = getenv("PATH") ? getenv("PATH") : "";
   setenv("PATH", "/nonexistent-diffpd-dir", 1);

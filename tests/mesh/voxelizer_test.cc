@@ -116,7 +116,7 @@ TEST(VoxelizeSurfaceTest, UnitCube) {
 }
 
 TEST(VoxelizeSurfaceTest, ScaleAppliesAboutTheOrigin) {
-  const Mesh mesh = VoxelizeSurface(BoxSurface(Vec3::Ones(), Vec3::Constant(2.0)), 0.5, 2.0);
+  const Mesh mesh = VoxelizeSurface(BoxSurface(Vec3::Ones(), Vec3::Constant(2.0)), 1.0, 2.0);
   EXPECT_EQ(mesh.num_elements(), 8);
   EXPECT_NEAR(mesh.vertices.minCoeff(), 2.0, 1e-15);
   EXPECT_NEAR(mesh.vertices.maxCoeff(), 4.0, 1e-15);
@@ -137,10 +137,10 @@ TEST(VoxelizeSurfaceTest, OctahedronWithRaysThroughVertices) {
 
 TEST(VoxelizeSurfaceTest, SphereVolumeMatchesSurface) {
   const SurfaceMesh sphere = ReadObj(DIFFPD_SHARED_DIR "/data/meshes/sphere.obj");
-  const double dx = 0.0015;  // radius 0.03: 40 cells across
+  const double dx = 0.002;  // radius 0.03: 30 cells across
   const Mesh mesh = VoxelizeSurface(sphere, dx);
   EXPECT_NO_THROW(ValidateMesh(mesh, "voxelized sphere"));
-  EXPECT_NEAR(TotalVolume(mesh) / EnclosedVolume(sphere), 1.0, 0.03);
+  EXPECT_NEAR(TotalVolume(mesh) / EnclosedVolume(sphere), 1.0, 0.02);
   // Every kept cell centre is inside by the winding number, and the kept
   // count equals the number of inside centres.
   int inside_cells = 0;
@@ -176,6 +176,8 @@ TEST(VoxelizeSurfaceTest, RejectsBadInput) {
             "VoxelizeSurface: dx = -0.5, must be finite and > 0");
   EXPECT_EQ(ErrorOf([&] { VoxelizeSurface(triangle, 0.5, 0.0); }),
             "VoxelizeSurface: scale = 0, must be finite and > 0");
+  EXPECT_EQ(ErrorOf([&] { VoxelizeSurface(triangle, 1e-5); }),
+            "VoxelizeSurface: dx = 1e-05 gives more than 2^31 cells for a bounding box of size (1 1 0)");
   triangle.triangles(2, 0) = 3;
   EXPECT_EQ(ErrorOf([&] { VoxelizeSurface(triangle, 0.5); }),
             "VoxelizeSurface: triangle 0 references vertex 3, but the surface has 3 vertices");

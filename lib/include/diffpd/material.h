@@ -19,11 +19,19 @@ struct MaterialParameters {
   double poissons_ratio = 0.45; // nu, dimensionless; must lie in (-1, 0.5)
   double density = 1e3;         // rho, kg/m^3; must be finite and > 0
 
-  // Throws InvalidInputError naming the parameter, its value and its range.
+  // Throws InvalidInputError naming the parameter, its value and its range,
+  // checking E, then nu, then rho; e.g.
+  //   "youngs_modulus = 0 is invalid: must be finite and > 0 (Pa)"
+  //   "poissons_ratio = 0.5 is invalid: must be finite and in (-1, 0.5)"
+  //   "density = 0 is invalid: must be finite and > 0 (kg/m^3)"
+  // (values printed with std::ostream's default formatting).
   void Validate() const;
   double mu() const;      // shear modulus, Pa
   double lambda() const;  // first Lame parameter, Pa
-  // d mu / d E, d mu / d nu, d lambda / d E, d lambda / d nu.
+  // d mu / d E, d mu / d nu, d lambda / d E, d lambda / d nu:
+  //   1 / (2 (1 + nu)),  -E / (2 (1 + nu)^2),
+  //   nu / ((1 + nu)(1 - 2 nu)),  E (1 + 2 nu^2) / ((1 + nu)(1 - 2 nu))^2.
+  // Any output pointer may be nullptr (not wanted).
   void LameDerivatives(double* dmu_dE, double* dmu_dnu, double* dlambda_dE,
                        double* dlambda_dnu) const;
 };
@@ -37,7 +45,8 @@ enum class ElasticEnergy {
   // decomposition. Newton and PD-LBFGS.
   kCorotated,
   // (mu/2)(|F|^2 - 3) - mu log J + (lambda/2) (log J)^2, J = det F.
-  // Undefined for J <= 0: evaluation throws SolverError(kInvertedElement).
+  // Undefined for J <= 0: evaluation throws SolverError(kInvertedElement) with
+  // message "neohookean energy: det F = <J> <= 0 (inverted element)".
   kNeoHookean,
   // PD corotated: (w/2) |F - Proj_SO(3)(F)|^2 with w = 2 mu. PD-compatible.
   kPdCorotated,
@@ -53,7 +62,12 @@ bool IsProjective(ElasticEnergy energy);
 // Energy density (J/m^3), first Piola-Kirchhoff stress P = dPsi/dF (Pa) and
 // stress differential dP/dF (9x9, column-major flattening, see types.h) of one
 // energy at deformation gradient F. These are the reference implementations
-// the solvers' kernels are tested against.
+// the solvers' kernels are tested against. Where a rotation derivative
+// dR/dF is involved (corotated, pd-corotated), its denominators
+// sigma_i + sigma_j are clamped below at 1e-10 max(sigma_0, 1) (R jumps
+// there: rank <= 1 or sigma_1 = -sigma_2); pd-volume's projection is the global
+// minimiser, which jumps where two minimisers tie (large expansions, e.g.
+// F = s I with s >~ 1.905).
 double EnergyDensity(ElasticEnergy energy, const Mat3& F, double mu, double lambda);
 Mat3 FirstPiolaStress(ElasticEnergy energy, const Mat3& F, double mu, double lambda);
 Mat9 StressDifferential(ElasticEnergy energy, const Mat3& F, double mu, double lambda);

@@ -33,16 +33,29 @@ struct Mesh {
   int num_dofs() const { return 3 * num_vertices(); }
 };
 
-// Checks a mesh and throws InvalidInputError naming the first violation:
-// non-finite coordinates, wrong number of rows in `elements`, an index out of
-// [0, n), a repeated node inside an element, a degenerate or inverted element
-// (message gives the element index and its signed volume), an unreferenced
-// vertex, an empty mesh. `what` names the mesh in messages (e.g. a file name).
+// Checks a mesh and throws InvalidInputError naming the first violation.
+// `what` names the mesh in messages (e.g. a file name). Checks, in order, and
+// their messages (indices are 0-based; volumes in m^3, printed with 6
+// significant digits):
+//  1. at least one element:     "<what>: the mesh has no elements"
+//  2. k rows in `elements`:     "<what>: elements must have 8 rows for hex8, got 4"
+//  3. finite coordinates:       "<what>: vertex 5 has a non-finite coordinate"
+//  4. indices in [0, n):        "<what>: element 3 references vertex 99, but the mesh has 50 vertices"
+//  5. distinct element nodes:   "<what>: element 4 repeats vertex 2"
+//     (4 and 5 are checked element by element, 6 likewise)
+//  6. positive volume:          "<what>: element 12 is inverted or degenerate (signed volume -1.5e-07 m^3)"
+//     An element is degenerate when its signed volume V <= 1e-12 V_box, V_box
+//     the volume of its axis-aligned bounding box (a scale-free threshold).
+//     Hexes must also have det J > 1e-12 V_box / 8 at each of the 8 Gauss
+//     points (V = sum of det J there):
+//       "<what>: element 12 is inverted or degenerate (signed volume 0.2875 m^3; det J = -0.0965905 at Gauss point 7)"
+//  7. every vertex referenced:  "<what>: vertex 7 is not referenced by any element"
 void ValidateMesh(const Mesh& mesh, const std::string& what = "mesh");
 
 // Signed volume of element e at the given positions (3 x n): for tets the
-// usual determinant formula, for hexes the integral of det J by 2x2x2 Gauss
-// quadrature. Does not validate.
+// usual determinant formula det[x1-x0, x2-x0, x3-x0] / 6, for hexes the
+// integral of det J over the reference cube by 2x2x2 Gauss quadrature (exact
+// for the trilinear map). Units of positions cubed. Does not validate.
 double SignedElementVolume(const Mesh& mesh, const Eigen::Matrix3Xd& positions, int e);
 
 }  // namespace diffpd

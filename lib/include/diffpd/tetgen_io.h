@@ -39,13 +39,16 @@ Mesh ReadTetGen(const std::string& node_path, const std::string& ele_path);
 // resulting .node/.ele are read back and the directory is removed.
 // TetGen's tet orientation is not part of its documented format (1.5 writes
 // positive volumes under mesh.h's convention), so each tet with negative
-// signed volume has its last two nodes swapped, here only; points TetGen leaves unused
-// are dropped; then the mesh is validated (`what` = "TetrahedralizeSurface").
-// Throws InvalidInputError for a bad scale, an empty surface or invalid
-// switches (empty, containing whitespace or '-', or one of 'r', 'N', 'E',
-// 'I', which change what TetGen reads or writes), and std::runtime_error
+// signed volume has its last two nodes swapped (here only, not in
+// ReadTetGen); points TetGen leaves unused are dropped; then the mesh is
+// validated (`what` = "TetrahedralizeSurface").
+// Throws InvalidInputError for a bad scale, an empty surface, a triangle
+// index out of range, or invalid switches (empty, containing whitespace or
+// '-', or one of 'r', 'N', 'E', 'I', which change what TetGen reads or
+// writes), and std::runtime_error
 //   "tetgen program not found: install the Debian package 'tetgen'",
-//   "tetgen failed (exit status 1) with switches '...': <its last output lines>",
+//   "tetgen failed (exit status 1) with switches '...': <its last 5 output lines>"
+//   (or "(killed by signal 6)": TetGen 1.5 aborts on a surface it cannot mesh),
 // or when TetGen writes no .node/.ele file.
 Mesh TetrahedralizeSurface(const SurfaceMesh& surface, const std::string& switches = "pq1.414Y",
                            double scale = 1.0);

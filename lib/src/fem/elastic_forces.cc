@@ -13,14 +13,17 @@
 namespace diffpd::internal {
 namespace {
 
+constexpr int kMinParallelElements = 256;
+
 // Runs body(e) for e in [0, m) in parallel and rethrows the first exception
 // after the loop (exceptions must not leave an OpenMP region).
 template <class Body>
 void ParallelForElements(int m, int threads, Body&& body) {
   std::exception_ptr error;
   std::mutex error_mutex;
+  // Small meshes run serially: a parallel region costs more than it saves.
   const int nt = threads > 0 ? threads : 0;
-#pragma omp parallel for schedule(static) num_threads(nt) if (nt != 1)
+#pragma omp parallel for schedule(static) num_threads(nt) if (nt != 1 && m >= kMinParallelElements)
   for (int e = 0; e < m; ++e) {
     try {
       body(e);
@@ -89,7 +92,7 @@ void ElasticForces::GatherElementBuffer(VectorXd* out, int threads) const {
   const auto& off = fem_.node_offsets();
   const auto& inc = fem_.node_incidences();
   const int nt = threads > 0 ? threads : 0;
-#pragma omp parallel for schedule(static) num_threads(nt) if (nt != 1)
+#pragma omp parallel for schedule(static) num_threads(nt) if (nt != 1 && n >= 4 * kMinParallelElements)
   for (int i = 0; i < n; ++i) {
     Vec3 sum = Vec3::Zero();
     for (int j = off[i]; j < off[i + 1]; ++j) sum += Eigen::Map<const Vec3>(element_buffer_.data() + 3 * static_cast<size_t>(inc[j]));
@@ -100,6 +103,7 @@ void ElasticForces::GatherElementBuffer(VectorXd* out, int threads) const {
 template <int K>
 double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, double mu, double lambda, VectorXd* grad,
                                             int threads) {
+  if (!x.allFinite()) throw SolverError(SolverStatus::kNonFinite, "positions are not finite");
   const Mesh& mesh = fem_.mesh();
   const int q_per = fem_.samples_per_element();
   ParallelForElements(fem_.num_elements(), threads, [&](int e) {

@@ -25,7 +25,10 @@ namespace diffpd::internal {
 // True for the energies whose kernels use the SVD of F.
 bool NeedsSvd(ElasticEnergy energy);
 
-// Plain kernels (compute the SVD themselves when needed).
+// Plain kernels (compute the SVD themselves when needed). Call the 4-argument
+// StressDifferential qualified, internal::StressDifferential(...): argument-
+// dependent lookup also finds diffpd::StressDifferential (same parameters),
+// so an unqualified call is ambiguous.
 double Energy(ElasticEnergy energy, const Mat3& F, double mu, double lambda);
 Mat3 Stress(ElasticEnergy energy, const Mat3& F, double mu, double lambda);
 Mat9 StressDifferential(ElasticEnergy energy, const Mat3& F, double mu, double lambda);

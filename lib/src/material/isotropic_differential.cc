@@ -18,13 +18,14 @@ inline Vec9 VecOuter(const Vec3& a, const Vec3& b) {
 }  // namespace
 
 Mat9 AssembleIsotropicDifferential(const Svd3& svd, const IsotropicDifferentialCoefficients& c) {
+  // Sum over the three blocks of (modes) (coefficients) (modes)^T.
   const Mat3& U = svd.U;
   const Mat3& V = svd.V;
   Mat9 result = Mat9::Zero();
   if (!c.dp_dsigma.isZero(0.0)) {
     Mat93 diagonal;
     for (int i = 0; i < 3; ++i) diagonal.col(i) = VecOuter(U.col(i), V.col(i));
-    result.noalias() += diagonal * c.dp_dsigma * diagonal.transpose();
+    result.noalias() += (diagonal * c.dp_dsigma) * diagonal.transpose();
   }
   const double inv_sqrt2 = 1.0 / std::sqrt(2.0);
   for (int sign = 0; sign < 2; ++sign) {
@@ -37,7 +38,7 @@ Mat9 AssembleIsotropicDifferential(const Svd3& svd, const IsotropicDifferentialC
       const Vec9 ji = VecOuter(U.col(j), V.col(i));
       modes.col(k) = (ij + (sign == 0 ? 1.0 : -1.0) * ji) * inv_sqrt2;
     }
-    result.noalias() += modes * coefficient.asDiagonal() * modes.transpose();
+    result.noalias() += (modes * coefficient.asDiagonal()) * modes.transpose();
   }
   return result;
 }

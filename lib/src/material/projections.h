@@ -53,13 +53,16 @@ IsotropicDifferentialCoefficients UnitDeterminantProjectionCoefficients(
 //    any sigma (sigma_0 >= sigma_1 >= |sigma_2|): d_0 > 0 always; for
 //    sigma_2 < 0 the minimiser may have d_1, d_2 < 0 (a rotation by pi away),
 //    which is still a matrix of determinant +1. The constrained problem is not
-//    convex: for a large uniform expansion (sigma_i > ~1.89) the closest point
-//    keeps two directions and crushes the third, and the projection is
-//    discontinuous where two local minimisers tie. `multiplier` is mu with
+//    convex: for a uniform expansion F = s I with s > ~1.905 the closest point
+//    keeps two directions and crushes the last (s = 2: d = (1.618, 1.618,
+//    0.382)), and the projection is discontinuous where two local minimisers
+//    tie. The Newton iteration runs on t = d_k (smallest target entry), which
+//    fixes the multiplier as mu = t (t - s_k); `multiplier` is mu with
 //    d_i - sigma_i = mu / d_i (= mu prod(d) / d_i). Relative accuracy ~1e-15.
 //  - UnitDeterminantProjectionDifferential: exact (implicit differentiation
 //    of the KKT system and the SVD-derivative formulas; see
 //    isotropic_differential.h), same denominator floor.
+
 // Muscle fibre projection: the closest point to f on the sphere |p| = radius,
 //   p = radius f / |f|   (f, p: 3-vectors, same units as radius).
 // For f = 0 every point of the sphere is equally close; returns radius e_x.

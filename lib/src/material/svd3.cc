@@ -16,10 +16,15 @@
 //     of R22, which carries the sign of det F. R's off-diagonal entries are
 //     O(eps |F|) because B's columns are orthogonal, so sigma = diag(R).
 //
-// Why not Eigen::JacobiSVD<Matrix3d>: on the benchmark machine it is ~4x
-// slower (about 0.9 us vs 0.2 us per call at -O3, random F), returns unsigned
-// singular values and improper U, V that need a further fix-up, and is no more
-// accurate (both reach ~1e-16 reconstruction and orthogonality errors).
+// Why not Eigen::JacobiSVD<Matrix3d> (two-sided Jacobi): measured at -O3 over
+// 2e5 random matrices (entries uniform in [-1, 1], and I + 0.1 * that) on the
+// development machine (a shared 2-core AMD EPYC, so absolute numbers are
+// noisy): ~0.36 us per call here vs ~0.70 us for JacobiSVD with full U and V;
+// worst relative reconstruction error 1.7e-15 vs 3.6e-15 and worst
+// orthogonality error |U^T U - I|_F 3.0e-15 vs 3.4e-15. JacobiSVD also returns
+// unsigned singular values and possibly improper U, V, which would need a
+// further sign fix-up. Random matrices take 3 or 4 sweeps (rarely 2 or 5)
+// plus one sweep that finds nothing left to rotate.
 #include "material/svd3.h"
 
 #include <algorithm>
@@ -33,32 +38,35 @@ namespace diffpd::internal {
 namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
-// Each sweep is 3 rotations; quadratic convergence needs 4 to 6 sweeps.
+// Each sweep is 3 rotations; convergence is quadratic (see above).
 constexpr int kMaxSweeps = 20;
 
-// Rotates columns p and q of B (and V) so that they become orthogonal.
+// Rotates columns i and j of B (and V) so that they become orthogonal.
 // Returns false (and does nothing) when they already are to working precision.
-inline bool OrthogonalizeColumns(Mat3& B, Mat3& V, int p, int q) {
-  const double alpha = B.col(p).squaredNorm();
-  const double beta = B.col(q).squaredNorm();
-  const double gamma = B.col(p).dot(B.col(q));
+inline bool OrthogonalizeColumns(Mat3& B, Mat3& V, int i, int j) {
+  const double alpha = B.col(i).squaredNorm();
+  const double beta = B.col(j).squaredNorm();
+  const double gamma = B.col(i).dot(B.col(j));
   if (!(gamma * gamma > kEps * kEps * alpha * beta)) return false;
-  // t = tan(theta), the root of smaller magnitude of t^2 + 2 zeta t - 1 = 0
-  // with zeta = (beta - alpha) / (2 gamma), diagonalises
-  // [[alpha, gamma], [gamma, beta]] (Rutishauser), written with one division.
+  // Rutishauser's rotation: t = tan(theta), the root of smaller magnitude of
+  // t^2 + 2 zeta t - 1 = 0, zeta = (beta - alpha) / (2 gamma), diagonalises
+  // [[alpha, gamma], [gamma, beta]]. With root = sqrt(diff^2 + 4 gamma^2) and
+  // q = |diff| + root, t = 2 gamma sign(diff) / q and 1 + t^2 = 2 root / q, so
+  //   c = q / sqrt(2 q root),  s = 2 gamma sign(diff) / sqrt(2 q root)
+  // (two square roots and one division).
   const double diff = beta - alpha;
   const double root = std::sqrt(diff * diff + 4.0 * gamma * gamma);
-  const double t = 2.0 * gamma / (diff >= 0.0 ? diff + root : diff - root);
-  // For |t| < 1e-8, 1/sqrt(1 + t^2) rounds to 1.
-  const double c = std::abs(t) < 1e-8 ? 1.0 : 1.0 / std::sqrt(1.0 + t * t);
-  const double s = c * t;
+  const double q = std::abs(diff) + root;
+  const double w = 1.0 / std::sqrt(2.0 * q * root);
+  const double c = q * w;
+  const double s = (diff >= 0.0 ? 2.0 : -2.0) * gamma * w;
   for (int r = 0; r < 3; ++r) {
-    const double bp = B(r, p), bq = B(r, q);
-    B(r, p) = c * bp - s * bq;
-    B(r, q) = s * bp + c * bq;
-    const double vp = V(r, p), vq = V(r, q);
-    V(r, p) = c * vp - s * vq;
-    V(r, q) = s * vp + c * vq;
+    const double bi = B(r, i), bj = B(r, j);
+    B(r, i) = c * bi - s * bj;
+    B(r, j) = s * bi + c * bj;
+    const double vi = V(r, i), vj = V(r, j);
+    V(r, i) = c * vi - s * vj;
+    V(r, j) = s * vi + c * vj;
   }
   return true;
 }
@@ -94,11 +102,11 @@ Svd3 ComputeSvd3(const Mat3& F) {
   Svd3 svd;
   svd.U.setIdentity();
   svd.V.setIdentity();
-  const double max_abs = F.cwiseAbs().maxCoeff();
-  if (!(max_abs <= std::numeric_limits<double>::max())) {  // NaN or infinity
+  if (!F.allFinite()) {
     svd.sigma.setConstant(std::numeric_limits<double>::quiet_NaN());
     return svd;
   }
+  const double max_abs = F.cwiseAbs().maxCoeff();
   if (max_abs == 0.0) {
     svd.sigma.setZero();
     return svd;

@@ -62,7 +62,12 @@ struct PathPoint {
 
 class StationaryPath {
  public:
-  explicit StationaryPath(const Vec3& s) : s_(s) { s.minCoeff(&k_); }
+  // k: the last index of the smallest entry (ties: the last one shrinks).
+  explicit StationaryPath(const Vec3& s) : s_(s) {
+    for (int j = 1; j < 3; ++j) {
+      if (s(j) <= s(k_)) k_ = j;
+    }
+  }
   int k() const { return k_; }
   double sk() const { return s_(k_); }
   const Vec3& s() const { return s_; }
@@ -224,20 +229,28 @@ VolumeProjection ProjectSingularValuesToUnitDeterminant(const Vec3& sigma) {
 
 Mat3 UnitDeterminantProjectionJacobian(const Vec3& sigma, const VolumeProjection& projection) {
   // Differentiating d_i - sigma_i - mu / d_i = 0 and sum_i log|d_i| = 0:
-  //   [diag(1 + mu / d_i^2)  -1/d] [dd ]   [dsigma]
-  //   [1/d^T                  0  ] [dmu] = [  0   ].
+  //   [H    -g] [dd ]   [dsigma]
+  //   [g^T   0] [dmu] = [  0   ],  H = diag(1 + mu / d_i^2), g = 1 / d.
+  // With w = H^-1 g: dd/dsigma = H^-1 - w w^T / (g^T w). H is singular only
+  // where the smallest d_i switches solution branch (d_i = sigma_i / 2); there
+  // the bordered system is solved as it stands.
   const Vec3& d = projection.d;
   const double mu = projection.multiplier;
-  Eigen::Matrix4d kkt = Eigen::Matrix4d::Zero();
-  for (int i = 0; i < 3; ++i) {
-    kkt(i, i) = 1.0 + mu / (d(i) * d(i));
-    kkt(i, 3) = -1.0 / d(i);
-    kkt(3, i) = 1.0 / d(i);
+  const Vec3 g = d.cwiseInverse();
+  const Vec3 h = Vec3::Ones() + mu * g.cwiseProduct(g);
+  if (h.cwiseAbs().minCoeff() > 1e-4) {  // cancellation error <= ~eps / 1e-4
+    const Vec3 w = g.cwiseQuotient(h);
+    Mat3 jacobian = -(w * w.transpose()) / g.dot(w);
+    jacobian.diagonal() += h.cwiseInverse();
+    return jacobian;
   }
+  Eigen::Matrix4d kkt = Eigen::Matrix4d::Zero();
+  kkt.topLeftCorner<3, 3>() = h.asDiagonal();
+  kkt.topRightCorner<3, 1>() = -g;
+  kkt.bottomLeftCorner<1, 3>() = g.transpose();
   Eigen::Matrix<double, 4, 3> rhs = Eigen::Matrix<double, 4, 3>::Zero();
   rhs.topRows<3>().setIdentity();
-  const Eigen::Matrix<double, 4, 3> solution = kkt.fullPivLu().solve(rhs);
-  return solution.topRows<3>();
+  return kkt.fullPivLu().solve(rhs).topRows<3>();
 }
 
 IsotropicDifferentialCoefficients UnitDeterminantProjectionCoefficients(

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <utility>
 
+#include <Eigen/Geometry>
+
 #include "diffpd/error.h"
 
 namespace diffpd {

@@ -13,6 +13,7 @@
 #include "diffpd/error.h"
 #include "diffpd/tetgen_io.h"
 #include "mesh/subprocess.h"
+#include "mesh/surface_indices.h"
 #include "mesh/tetgen_reader.h"
 
 namespace diffpd {
@@ -112,7 +113,7 @@ Mesh TetrahedralizeSurface(const SurfaceMesh& surface, const std::string& switch
     s << "TetrahedralizeSurface: scale = " << scale << ", must be finite and > 0";
     throw InvalidInputError(s.str());
   }
-  if (surface.triangles.cols() == 0) throw InvalidInputError("TetrahedralizeSurface: the surface has no triangles");
+  internal::CheckTriangleIndices(surface, "TetrahedralizeSurface");
   CheckSwitches(switches);
   const std::string tetgen = internal::FindOnPath("tetgen");
   if (tetgen.empty()) throw std::runtime_error("tetgen program not found: install the Debian package 'tetgen'");

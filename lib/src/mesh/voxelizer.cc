@@ -8,6 +8,7 @@
 #include "diffpd/error.h"
 #include "mesh/hex_grid.h"
 #include "mesh/ray_parity.h"
+#include "mesh/surface_indices.h"
 
 namespace diffpd {
 namespace {
@@ -60,18 +61,7 @@ Mesh VoxelizeSdf(const std::function<double(const Vec3&)>& sdf, const Vec3& orig
 Mesh VoxelizeSurface(const SurfaceMesh& surface, double dx, double scale) {
   CheckSpacing("VoxelizeSurface", "dx", dx);
   CheckSpacing("VoxelizeSurface", "scale", scale);
-  if (surface.triangles.cols() == 0) throw InvalidInputError("VoxelizeSurface: the surface has no triangles");
-  const long n = surface.vertices.cols();
-  for (int t = 0; t < surface.triangles.cols(); ++t) {
-    for (int c = 0; c < 3; ++c) {
-      if (surface.triangles(c, t) < 0 || surface.triangles(c, t) >= n) {
-        std::ostringstream s;
-        s << "VoxelizeSurface: triangle " << t << " references vertex " << surface.triangles(c, t)
-          << ", but the surface has " << n << " vertices";
-        throw InvalidInputError(s.str());
-      }
-    }
-  }
+  internal::CheckTriangleIndices(surface, "VoxelizeSurface");
   SurfaceMesh scaled = surface;
   scaled.vertices *= scale;
   if (!scaled.vertices.allFinite()) throw InvalidInputError("VoxelizeSurface: non-finite vertex coordinate");

@@ -1,5 +1,6 @@
 #include "solver/line_search.h"
 
+#include <cmath>
 #include <sstream>
 
 #include "diffpd/error.h"
@@ -28,7 +29,13 @@ int BacktrackingLineSearch(StepObjective& objective, const VectorXd& d, VectorXd
       if (e.status() != SolverStatus::kNonFinite && e.status() != SolverStatus::kInvertedElement) throw;
       ok = false;
     }
-    if (ok && trial_value <= *value + options.armijo_c * alpha * slope) {
+    // Armijo; or, where g's change is lost in rounding (near convergence),
+    // a strict decrease of |grad g|.
+    const bool moved = (trial - *x).cwiseAbs().maxCoeff() > 0;
+    const bool armijo = ok && moved && trial_value < *value && trial_value <= *value + options.armijo_c * alpha * slope;
+    const bool rounding = ok && moved && std::abs(trial_value - *value) <= 1e-12 * std::abs(*value) &&
+                          trial_grad.norm() < grad->norm();
+    if (armijo || rounding) {
       *x = trial;
       *value = trial_value;
       *grad = trial_grad;
@@ -38,7 +45,8 @@ int BacktrackingLineSearch(StepObjective& objective, const VectorXd& d, VectorXd
   }
   std::ostringstream msg;
   msg << ToString(options.method) << ": the line search found no decrease of g after "
-      << options.max_line_search_steps << " halvings";
+      << options.max_line_search_steps << " halvings (|grad g| = " << grad->norm()
+      << "; if this is the rounding floor, raise abs_tolerance)";
   throw SolverError(SolverStatus::kLineSearchFailed, msg.str());
 }
 

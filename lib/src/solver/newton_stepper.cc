@@ -1,5 +1,7 @@
 // Newton's method on one implicit step: projected (SPD) element Hessians,
 // linear solve by CHOLMOD (pattern analysed once) or by PCG, Armijo line search.
+#include <cstdio>
+
 #include <Eigen/IterativeLinearSolvers>
 
 #include "diffpd/error.h"
@@ -54,6 +56,7 @@ VectorXd NewtonSolve(StepObjective& objective, const VectorXd& x0, StepReport* r
     const double norm = grad.norm();
     report->iterations = it;
     report->final_residual = norm;
+    if (sim.options.verbosity >= 2) std::fprintf(stderr, "  %s iteration %d |grad g| = %.3e\n", ToString(sim.options.method), it, norm);
     if (Converged(sim.options, norm, initial)) return x;
     if (it >= sim.options.max_iterations) ThrowNotConverged(sim.options, it, norm, initial);
     sim.elastic.ElementHessians(x, sim.mu(), sim.lambda(), /*project_spd=*/true, &blocks, sim.threads());

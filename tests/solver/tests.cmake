@@ -1,0 +1,5 @@
+diffpd_add_test(simulator_gradient_test ${CMAKE_CURRENT_LIST_DIR}/simulator_gradient_test.cc LIBS diffpd_problems)
+diffpd_add_test(solver_agreement_test ${CMAKE_CURRENT_LIST_DIR}/solver_agreement_test.cc)
+diffpd_add_test(physics_test ${CMAKE_CURRENT_LIST_DIR}/physics_test.cc)
+diffpd_add_test(solver_options_test ${CMAKE_CURRENT_LIST_DIR}/solver_options_test.cc)
+diffpd_add_test(pd_system_test ${CMAKE_CURRENT_LIST_DIR}/pd_system_test.cc)
