@@ -3,9 +3,14 @@
 // else goes to stderr.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "diffpd/solver_options.h"
+
+namespace CLI {
+class App;
+}
 
 namespace diffpd::problems {
 
@@ -24,6 +29,16 @@ struct CommandArgs {
 int ListCommand(bool json);
 int RunCommand(const CommandArgs& args);
 int GradcheckCommand(const CommandArgs& args);
+
+// A subcommand that declares its own options: `app` is the CLI11 subcommand
+// (true once parsed), `run` runs it after parsing.
+struct Subcommand {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+Subcommand AddBenchCommand(CLI::App* parent);     // bench_command.cc
+Subcommand AddTradeoffCommand(CLI::App* parent);  // tradeoff_command.cc
+Subcommand AddStressCommand(CLI::App* parent);    // stress_command.cc
 
 // Solver options for a problem from the shared arguments.
 SolverOptions OptionsFromArgs(const CommandArgs& args, double default_dt, double default_rel_tolerance);

@@ -34,6 +34,9 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   std::vector<StepInput> inputs(steps);
   const double node_force = sim.LumpedMass().maxCoeff() * 9.81;
   for (auto& in : inputs) in.external_force = 0.1 * node_force * RandomVector(&rng, n);
+  const int num_muscles = static_cast<int>(scene.muscles.size());
+  if (num_muscles > 0)
+    for (auto& in : inputs) in.activation = VectorXd::Constant(num_muscles, 0.9) + 0.02 * RandomVector(&rng, num_muscles);
 
   auto loss = [&](Simulator& s, const State& init, const std::vector<StepInput>& in) {
     const Rollout r = s.Simulate(init, in);
@@ -80,6 +83,63 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
              return loss(sim, initial, in);
            },
            analytic, 100 * check.relative_step);  // forces act almost linearly: a larger step beats rounding
+    if (num_muscles > 0) {
+      std::vector<VectorXd> da(steps);
+      double analytic_a = 0;
+      for (int i = 0; i < steps; ++i) {
+        da[i] = RandomVector(&rng, num_muscles) / std::sqrt(double(num_muscles * steps));
+        analytic_a += grad.activation[i].dot(da[i]);
+      }
+      record("activation", long(num_muscles) * steps,
+             [&](double e) {
+               std::vector<StepInput> in = inputs;
+               for (int i = 0; i < steps; ++i) in[i].activation += e * da[i];
+               return loss(sim, initial, in);
+             },
+             analytic_a, check.relative_step);
+    }
+  }
+  // State-force parameters: a fresh simulator per perturbed scene.
+  auto scene_loss = [&](const Scene& perturbed) {
+    Simulator s(perturbed, options);
+    return loss(s, initial, inputs);
+  };
+  auto record_scene = [&](const std::string& name, const std::function<void(Scene*, double)>& perturb,
+                          double analytic, double eps) {
+    record(name, 1,
+           [&](double e) {
+             Scene p = scene;
+             perturb(&p, e);
+             return scene_loss(p);
+           },
+           analytic, eps);
+  };
+  if (scene.linear_damping)
+    record_scene("linear_damping", [](Scene* p, double e) { *p->linear_damping += e; },
+                 grad.state_forces.linear_damping, check.relative_step * std::max(1.0, *scene.linear_damping));
+  if (scene.hydrodynamics) {
+    const Hydrodynamics& hy = *scene.hydrodynamics;
+    record_scene("fluid_density", [](Scene* p, double e) { p->hydrodynamics->fluid_density += e; },
+                 grad.state_forces.fluid_density, check.relative_step * std::max(1.0, hy.fluid_density));
+    record_scene("drag_tangential", [](Scene* p, double e) { p->hydrodynamics->drag_tangential += e; },
+                 grad.state_forces.drag_tangential, check.relative_step);
+    record_scene("drag_normal", [](Scene* p, double e) { p->hydrodynamics->drag_normal += e; },
+                 grad.state_forces.drag_normal, check.relative_step);
+    record_scene("thrust", [](Scene* p, double e) { p->hydrodynamics->thrust += e; }, grad.state_forces.thrust,
+                 check.relative_step);
+  }
+  bool any_friction = false;
+  for (const auto& c : scene.penalty_contacts) any_friction = any_friction || c.friction > 0;
+  if (any_friction) {
+    double analytic = 0;
+    for (size_t c = 0; c < scene.penalty_contacts.size(); ++c)
+      if (scene.penalty_contacts[c].friction > 0) analytic += grad.state_forces.penalty_friction[c];
+    record_scene("penalty_friction",
+                 [](Scene* p, double e) {
+                   for (auto& c : p->penalty_contacts)
+                     if (c.friction > 0) c.friction += e;
+                 },
+                 analytic, check.relative_step);
   }
   const MaterialParameters base = scene.material;
   auto material_loss = [&](MaterialParameters m) {

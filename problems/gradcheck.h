@@ -5,6 +5,10 @@
 // per-step external forces, Young's modulus, Poisson's ratio, density) and
 // each of `directions` random directions d, compares dL/dtheta . d with
 //   (L(theta + eps d) - L(theta - eps d)) / (2 eps).
+// Scenes that declare them add: "activation" (per-step muscle activations,
+// baseline 0.9 + 0.02 N(0,1)), "linear_damping", the hydrodynamic parameters
+// "fluid_density", "drag_tangential", "drag_normal", "thrust", and
+// "penalty_friction" (all penalty contacts' mu along one direction).
 #pragma once
 
 #include <cstdint>

@@ -42,6 +42,9 @@ int main(int argc, char** argv) {
 
   CLI::App* grad = app.add_subcommand("gradcheck", "compare rollout gradients with central finite differences");
   AddCommonOptions(grad, &grad_args, &grad_method);
+  const auto bench = diffpd::problems::AddBenchCommand(&app);
+  const auto tradeoff = diffpd::problems::AddTradeoffCommand(&app);
+  const auto stress = diffpd::problems::AddStressCommand(&app);
 
   try {
     app.parse(argc, argv);
@@ -58,6 +61,9 @@ int main(int argc, char** argv) {
       grad_args.method = diffpd::ParseMethod(grad_method);
       return diffpd::problems::GradcheckCommand(grad_args);
     }
+    if (*bench.app) return bench.run();
+    if (*tradeoff.app) return tradeoff.run();
+    if (*stress.app) return stress.run();
   } catch (const diffpd::InvalidInputError& e) {
     std::fprintf(stderr, "diffpd: invalid input: %s\n", e.what());
     return 2;

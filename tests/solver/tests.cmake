@@ -3,3 +3,4 @@ diffpd_add_test(solver_agreement_test ${CMAKE_CURRENT_LIST_DIR}/solver_agreement
 diffpd_add_test(physics_test ${CMAKE_CURRENT_LIST_DIR}/physics_test.cc)
 diffpd_add_test(solver_options_test ${CMAKE_CURRENT_LIST_DIR}/solver_options_test.cc)
 diffpd_add_test(pd_system_test ${CMAKE_CURRENT_LIST_DIR}/pd_system_test.cc)
+diffpd_add_test(tangent_rollout_test ${CMAKE_CURRENT_LIST_DIR}/tangent_rollout_test.cc)

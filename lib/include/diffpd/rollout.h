@@ -5,6 +5,7 @@
 
 #include "diffpd/material.h"
 #include "diffpd/solver_options.h"
+#include "diffpd/state_forces.h"
 #include "diffpd/types.h"
 
 namespace diffpd {
@@ -18,6 +19,9 @@ struct State {
 // What drives one step. An empty vector means "none" and costs nothing.
 struct StepInput {
   VectorXd external_force;  // 3n, N, applied during the step (explicit)
+  // One activation per Scene::muscles entry (muscle.h), finite and >= 0;
+  // empty: all at rest (1). Held during the step.
+  VectorXd activation;
 };
 
 // Outcome of one step.
@@ -27,12 +31,19 @@ struct StepReport {
   double initial_residual = 0; // ||grad g(x0)||
   double final_residual = 0;   // ||grad g(x_{i+1})||
   double seconds = 0;
+  // Frictional contact (contact.h): the step's final active set (sorted node
+  // indices), the contact force on each of those nodes (3 x |set|, N, the
+  // surface's push on the node) and the number of active-set passes (solves).
+  std::vector<int> contact_nodes;
+  Eigen::Matrix3Xd contact_forces;
+  int active_set_passes = 0;
 };
 
 // A recorded trajectory: states[0..K], inputs[0..K-1]. It stores exactly what
 // the backward pass needs: per step 2 x 3n doubles of state plus the step's
 // inputs (16 * 3n bytes + inputs per step), and the material and options it
-// was made with. Nothing per iteration is kept.
+// was made with. Nothing per iteration is kept. With frictional contact the
+// backward pass reads each step's active set from `reports`.
 struct Rollout {
   std::vector<State> states;
   std::vector<StepInput> inputs;
@@ -63,6 +74,8 @@ struct RolloutGradient {
   VectorXd x0;                              // 3n
   VectorXd v0;                              // 3n
   std::vector<VectorXd> external_force;     // per step, 3n
+  std::vector<VectorXd> activation;         // per step, one per muscle (empty if none)
+  StateForceGradient state_forces;          // declared state-force parameters
   double youngs_modulus = 0;                // dL/dE, per Pa
   double poissons_ratio = 0;                // dL/dnu
   double density = 0;                       // dL/drho, per kg/m^3

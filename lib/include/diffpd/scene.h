@@ -6,8 +6,11 @@
 #include <string>
 #include <vector>
 
+#include "diffpd/contact.h"
 #include "diffpd/material.h"
 #include "diffpd/mesh.h"
+#include "diffpd/muscle.h"
+#include "diffpd/state_forces.h"
 #include "diffpd/types.h"
 
 namespace diffpd {
@@ -30,9 +33,23 @@ struct Scene {
   std::optional<Vec3> gravity;
   DirichletBoundary dirichlet;
 
+  // Optional terms; each costs nothing unless declared (empty / unset).
+  // Muscle actuators (muscle.h); StepInput::activation drives them.
+  std::vector<Muscle> muscles;
+  // Frictional contact surfaces with their candidate nodes (contact.h).
+  std::vector<FrictionalContact> frictional_contacts;
+  FrictionalContactOptions frictional_contact_options;
+  // Penalty contact half-spaces (contact.h).
+  std::vector<PenaltyContact> penalty_contacts;
+  // State forces (state_forces.h): drag and thrust on surface triangles, and
+  // mass-proportional damping f = -c M v (c in 1/s).
+  std::optional<Hydrodynamics> hydrodynamics;
+  std::optional<double> linear_damping;
+
   // Throws InvalidInputError naming the first problem: invalid mesh or
   // material, no energy, Dirichlet DoF out of range or not increasing, a
-  // size mismatch, or a non-finite gravity/Dirichlet value.
+  // size mismatch, or a non-finite gravity/Dirichlet value; then the optional
+  // terms (messages listed in muscle.h, contact.h and state_forces.h).
   void Validate() const;
 };
 

@@ -16,6 +16,7 @@
 #include "diffpd/rollout.h"
 #include "diffpd/scene.h"
 #include "diffpd/solver_options.h"
+#include "diffpd/tangent_rollout.h"
 
 namespace diffpd {
 
@@ -57,6 +58,15 @@ class Simulator {
   // differentiable input, given dL/dx_k and dL/dv_k. The rollout must come
   // from this simulator with the same material and options.
   RolloutGradient Backward(const Rollout& rollout, const LossGradient& loss);
+  // Forward mode: tangents of every state of the rollout along each of the
+  // P directions (tangent_rollout.h), all P solved together per step with the
+  // step's exact Hessian H (PD: the forward factor of A, A z = b + dA z or
+  // L-BFGS; Newton: one factorisation of H):
+  //   H dx_{i+1} = M (dx_i + h dv_i) / h^2 + df_i - d(grad g)/dtheta . dtheta,
+  //   dv_{i+1} = (dx_{i+1} - dx_i) / h.
+  // Same preconditions and exceptions as Backward; InvalidInputError also for
+  // no direction or a direction with wrongly sized or non-finite entries.
+  TangentRollout Tangents(const Rollout& rollout, const std::vector<InputDirection>& directions);
 
   // Equilibrium under the declared forces (gravity, `input.external_force`)
   // and Dirichlet conditions, by Newton (newton-pcg if that is the method,

@@ -48,8 +48,9 @@ struct SolverOptions {
   double pcg_rel_tolerance = 1e-8;
   int pcg_max_iterations = 20000;
 
-  // PD-LBFGS and the PD backward's L-BFGS: number of stored pairs.
-  int lbfgs_history = 8;
+  // PD-LBFGS and the PD backward's L-BFGS: number of stored pairs (20 measured
+  // best on the cantilever: 73 iterations per step vs 90 with 8 and 130 with 5).
+  int lbfgs_history = 20;
 
   // Backward (adjoint) linear solves: relative residual ||H z - b|| / ||b||.
   PdBackwardMethod pd_backward = PdBackwardMethod::kLbfgs;

@@ -2,7 +2,7 @@
 // (metres, kilograms, seconds, pascals) unless a header says otherwise.
 #pragma once
 
-#include <Eigen/Core>
+#include <Eigen/Dense>  // Core, LU (inverse, determinant), Geometry (cross), ...
 #include <Eigen/SparseCore>
 
 namespace diffpd {

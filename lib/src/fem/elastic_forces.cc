@@ -7,7 +7,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "diffpd/error.h"
-#include "material/projections.h"
+#include "material/density_kernels.h"
 #include "material/svd3.h"
 
 namespace diffpd::internal {
@@ -38,33 +38,22 @@ void ParallelForElements(int m, int threads, Body&& body) {
 }  // namespace
 
 double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, double mu,
-                       double lambda, Mat3* stress, Mat9* dstress) {
+                       double lambda, Mat3* stress, Mat9* dstress, Mat3* v_cache) {
+  bool need_svd = false;
+  for (const ElasticEnergy energy : energies) need_svd = need_svd || NeedsSvd(energy);
+  Svd3 svd;
+  if (need_svd) {
+    svd = v_cache ? ComputeSvd3(F, *v_cache) : ComputeSvd3(F);
+    if (v_cache) *v_cache = svd.V;
+  }
   double psi = 0;
   if (stress) stress->setZero();
   if (dstress) dstress->setZero();
-  bool have_svd = false;
-  Svd3 svd;
+  Mat3 p;
   for (const ElasticEnergy energy : energies) {
-    if (energy == ElasticEnergy::kPdCorotated || energy == ElasticEnergy::kPdVolume) {
-      if (!have_svd) {
-        svd = ComputeSvd3(F);
-        have_svd = true;
-      }
-      const bool rot = energy == ElasticEnergy::kPdCorotated;
-      const double w = rot ? 2 * mu : lambda;
-      const Mat3 p = rot ? ProjectToRotation(svd) : ProjectToUnitDeterminant(svd);
-      const Mat3 diff = F - p;
-      psi += 0.5 * w * diff.squaredNorm();
-      if (stress) *stress += w * diff;
-      if (dstress) {
-        const Mat9 dp = rot ? RotationProjectionDifferential(svd) : UnitDeterminantProjectionDifferential(svd);
-        *dstress += w * (Mat9::Identity() - dp);
-      }
-    } else {
-      psi += EnergyDensity(energy, F, mu, lambda);
-      if (stress) *stress += FirstPiolaStress(energy, F, mu, lambda);
-      if (dstress) *dstress += StressDifferential(energy, F, mu, lambda);
-    }
+    psi += EnergyAndStress(energy, F, svd, mu, lambda, stress ? &p : nullptr);
+    if (stress) *stress += p;
+    if (dstress) *dstress += internal::StressDifferential(energy, F, svd, mu, lambda);
   }
   return psi;
 }
@@ -74,6 +63,7 @@ ElasticForces::ElasticForces(const FemModel& fem, std::vector<ElasticEnergy> ene
   for (const ElasticEnergy e : energies_) all_projective_ = all_projective_ && IsProjective(e);
   element_buffer_.assign(static_cast<size_t>(fem_.num_elements()) * 3 * fem_.nodes_per_element(), 0.0);
   element_energy_.assign(fem_.num_elements(), 0.0);
+  v_cache_.assign(fem_.num_samples(), Mat3::Identity());
 }
 
 double ElasticForces::PdWeight(double mu, double lambda) const {
@@ -116,7 +106,7 @@ double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, double mu, double
       const Mat3 F = DeformationGradient<K>(xe, g);
       Mat3 P;
       const double vol = fem_.sample_volume(s);
-      energy += vol * EvaluateDensity(energies_, F, mu, lambda, grad ? &P : nullptr, nullptr);
+      energy += vol * EvaluateDensity(energies_, F, mu, lambda, grad ? &P : nullptr, nullptr, &v_cache_[s]);
       if (grad) fe.noalias() += (vol * P) * Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
     }
     element_energy_[e] = energy;

@@ -71,11 +71,15 @@ class ElasticForces {
   bool all_projective_ = true;
   std::vector<double> element_buffer_;  // 3 * K per element
   std::vector<double> element_energy_;  // per element
+  // Per-sample V of the last SVD: warm start of the next one (see svd3.h).
+  std::vector<Mat3> v_cache_;
 };
 
 // Energy density, stress and (optionally) stress differential of the sum of
-// `energies` at F. Throws SolverError for inverted neo-Hookean elements.
+// `energies` at F, with one SVD shared by the energies that need it (warm
+// started from and written back to *v_cache when given). Throws SolverError
+// for inverted neo-Hookean elements.
 double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, double mu,
-                       double lambda, Mat3* stress, Mat9* dstress);
+                       double lambda, Mat3* stress, Mat9* dstress, Mat3* v_cache = nullptr);
 
 }  // namespace diffpd::internal

@@ -98,10 +98,12 @@ inline void SwapColumns(Mat3& B, Mat3& V, Vec3& norms, int i, int j) {
 
 }  // namespace
 
-Svd3 ComputeSvd3(const Mat3& F) {
+Svd3 ComputeSvd3(const Mat3& F) { return ComputeSvd3(F, Mat3::Identity()); }
+
+Svd3 ComputeSvd3(const Mat3& F, const Mat3& v_guess) {
   Svd3 svd;
   svd.U.setIdentity();
-  svd.V.setIdentity();
+  svd.V = v_guess;
   if (!F.allFinite()) {
     svd.sigma.setConstant(std::numeric_limits<double>::quiet_NaN());
     return svd;
@@ -113,7 +115,7 @@ Svd3 ComputeSvd3(const Mat3& F) {
   }
   // Exact power-of-two rescaling keeps squared norms clear of under/overflow.
   int exponent = 0;
-  Mat3 B = F;
+  Mat3 B = F * v_guess;
   if (max_abs < 1e-100 || max_abs > 1e100) {
     exponent = std::ilogb(max_abs);
     B *= std::ldexp(1.0, -exponent);

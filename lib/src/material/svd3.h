@@ -16,5 +16,10 @@ struct Svd3 {
 // Accurate to a few ulps in U, V orthogonality and in F reconstruction
 // (relative to |F|), including repeated and zero singular values.
 Svd3 ComputeSvd3(const Mat3& F);
+// The same, with the Jacobi sweeps started from a rotation v_guess (det +1)
+// instead of the identity: when v_guess is the V of a nearby F (the previous
+// solver iteration at the same sample) one sweep plus the check usually
+// suffices. The result does not depend on the guess beyond rounding.
+Svd3 ComputeSvd3(const Mat3& F, const Mat3& v_guess);
 
 }  // namespace diffpd::internal

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "diffpd/error.h"
+#include "forces/optional_terms_validation.h"
 
 namespace diffpd {
 
@@ -38,6 +39,7 @@ void Scene::Validate() const {
       throw InvalidInputError(msg.str());
     }
   }
+  internal::ValidateOptionalTerms(*this);
 }
 
 void FixNodeAxes(Scene* scene, const std::vector<int>& nodes, const std::vector<int>& axes) {

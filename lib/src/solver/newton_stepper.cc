@@ -60,6 +60,7 @@ VectorXd NewtonSolve(StepObjective& objective, const VectorXd& x0, StepReport* r
     if (Converged(sim.options, norm, initial)) return x;
     if (it >= sim.options.max_iterations) ThrowNotConverged(sim.options, it, norm, initial);
     sim.elastic.ElementHessians(x, sim.mu(), sim.lambda(), /*project_spd=*/true, &blocks, sim.threads());
+    sim.aux.AddElementHessians(x, sim.activation, /*project_spd=*/true, &blocks);
     sim.hessian_assembler().Assemble(blocks, objective.inertia_diagonal(), sim.fixed, &h);
     VectorXd rhs = -grad;
     VectorXd dx = SolveNewtonSystem(sim, h, rhs);

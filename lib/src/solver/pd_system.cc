@@ -46,6 +46,7 @@ bool PdSystem::Update(double h, double rho, double w) {
   const VectorXd diag = (rho / (h * h)) * fem_.unit_lumped_mass();
   for (Group& g : groups_) {
     g.matrix = w * laplacian_;
+    if (auxiliary_.size() > 0) g.matrix += auxiliary_;
     g.matrix.diagonal() += diag;
     double* values = g.matrix.valuePtr();
     const int* rows = g.matrix.innerIndexPtr();
@@ -64,20 +65,52 @@ bool PdSystem::Update(double h, double rho, double w) {
   h_ = h;
   rho_ = rho;
   w_ = w;
+  if (!erasures_.empty() || !active_nodes_.empty()) {  // the factor changed: rebuild the erasure on it
+    for (ActiveSetErasure& e : erasures_) e.Reset();
+    SetActiveNodes(std::vector<int>(active_nodes_), active_mode_);
+  }
   return true;
+}
+
+void PdSystem::SetAuxiliaryMatrix(const SparseMatrix& auxiliary) {
+  auxiliary_ = auxiliary;
+  h_ = -1;
+}
+
+void PdSystem::SetActiveNodes(const std::vector<int>& nodes, ContactLinearSolve mode) {
+  active_nodes_ = nodes;
+  active_mode_ = mode;
+  if (h_ < 0) return;  // not factorised yet: applied by Update
+  if (erasures_.size() != groups_.size()) erasures_.resize(groups_.size());
+  for (size_t gi = 0; gi < groups_.size(); ++gi)
+    erasures_[gi].Set(nodes, mode, groups_[gi].matrix, *groups_[gi].solver, groups_[gi].fixed_node);
+}
+
+int PdSystem::num_active_set_column_solves() const {
+  int total = 0;
+  for (const ActiveSetErasure& e : erasures_) total += e.num_column_solves();
+  return total;
+}
+
+int PdSystem::num_active_set_factorizations() const {
+  int total = 0;
+  for (const ActiveSetErasure& e : erasures_) total += e.num_factorizations();
+  return total;
 }
 
 MatrixXd PdSystem::Solve(const MatrixXd& r) const {
   const int n = fem_.num_nodes();
   const int cols = static_cast<int>(r.cols());
   MatrixXd out = MatrixXd::Zero(3 * n, cols);
-  for (const Group& g : groups_) {
+  for (size_t gi = 0; gi < groups_.size(); ++gi) {
+    const Group& g = groups_[gi];
     const int na = static_cast<int>(g.axes.size());
     MatrixXd rhs(n, na * cols);
     for (int c = 0; c < cols; ++c)
       for (int a = 0; a < na; ++a)
         for (int i = 0; i < n; ++i) rhs(i, c * na + a) = g.fixed_node[i] ? 0.0 : r(3 * i + g.axes[a], c);
-    const MatrixXd sol = g.solver->Solve(rhs);
+    const bool erased = gi < erasures_.size() && !erasures_[gi].empty();
+    const MatrixXd sol = erased ? erasures_[gi].Solve(*g.solver, std::move(rhs)) : g.solver->Solve(rhs);
     for (int c = 0; c < cols; ++c)
       for (int a = 0; a < na; ++a)
         for (int i = 0; i < n; ++i)
@@ -98,7 +131,9 @@ VectorXd PdSystem::Apply(const VectorXd& x) const {
     for (const int axis : g.axes) {
       VectorXd xa(n);
       for (int i = 0; i < n; ++i) xa(i) = g.fixed_node[i] ? 0.0 : x(3 * i + axis);
-      const VectorXd ya = g.matrix.selfadjointView<Eigen::Lower>() * xa;
+      for (const int i : active_nodes_) xa(i) = 0.0;
+      VectorXd ya = g.matrix.selfadjointView<Eigen::Lower>() * xa;
+      for (const int i : active_nodes_) ya(i) = 0.0;
       for (int i = 0; i < n; ++i)
         if (!g.fixed_node[i]) out(3 * i + axis) = ya(i);
     }

@@ -14,6 +14,8 @@
 #include <memory>
 #include <vector>
 
+#include "contact/active_set_erasure.h"
+#include "diffpd/contact.h"
 #include "diffpd/types.h"
 #include "fem/fem_model.h"
 #include "solver/cholmod_solver.h"
@@ -36,6 +38,18 @@ class PdSystem {
   // y = A x over the free DoFs (fixed rows and columns erased).
   VectorXd Apply(const VectorXd& x) const;
 
+  // A constant scalar n x n term (muscles, penalty contact: sum w G^T G, its
+  // pattern within the mesh's) added to A_s; refactorises on the next Update.
+  void SetAuxiliaryMatrix(const SparseMatrix& auxiliary);
+  // Contact active set: all three axes of `nodes` (sorted) are erased from
+  // Solve and Apply as extra fixed DoFs, without refactorising A (see
+  // contact/active_set_erasure.h). Empty clears it. Kept across Update.
+  void SetActiveNodes(const std::vector<int>& nodes, ContactLinearSolve mode);
+  const std::vector<int>& active_nodes() const { return active_nodes_; }
+  // Column solves and factorisations spent on active sets so far.
+  int num_active_set_column_solves() const;
+  int num_active_set_factorizations() const;
+
   int num_factorizations() const { return num_factorizations_; }
   int num_groups() const { return static_cast<int>(groups_.size()); }
 
@@ -52,6 +66,10 @@ class PdSystem {
   std::array<int, 3> group_of_axis_{};
   double h_ = -1, rho_ = -1, w_ = -1;
   int num_factorizations_ = 0;
+  SparseMatrix auxiliary_;                 // 0 x 0 when none
+  std::vector<int> active_nodes_;
+  ContactLinearSolve active_mode_ = ContactLinearSolve::kWoodbury;
+  std::vector<ActiveSetErasure> erasures_;  // per group, while active_nodes_ is set
 };
 
 }  // namespace diffpd::internal

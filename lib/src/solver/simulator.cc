@@ -3,9 +3,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 
+#include "contact/active_set_step.h"
 #include "diffpd/error.h"
+#include "forces/activation_scope.h"
 #include "solver/simulator_impl.h"
 
 namespace diffpd {
@@ -77,29 +80,45 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
   CheckVector(state.x, n, "state.x", false);
   CheckVector(state.v, n, "state.v", false);
   CheckVector(input.external_force, n, "external_force", true);
+  internal::CheckActivation(input.activation, sim.aux.num_muscles());
+  const internal::ActivationScope activation(sim, input.activation);
   const auto start = Clock::now();
   StepReport local;
   StepReport* rep = report ? report : &local;
   *rep = StepReport();
   const double h = sim.h();
-  const VectorXd f = sim.ExplicitForce(input);
+  VectorXd f = sim.ExplicitForce(input);
+  sim.state_forces.Add(state.x, state.v, sim.rho(), &f);
   State next;
   if (sim.options.method == Method::kSemiImplicit) {
+    if (!sim.scene.frictional_contacts.empty())
+      throw InvalidInputError("semi-implicit: frictional contact needs an implicit method (newton-cholesky, "
+                              "newton-pcg, pd, pd-lbfgs); use penalty contact instead");
     VectorXd grad;
     sim.elastic.EnergyAndGradient(state.x, sim.mu(), sim.lambda(), &grad, sim.threads());
+    sim.aux.AddEnergyAndGradient(state.x, sim.activation, &grad);
     next.v = state.v + h * ((f - grad).array() / sim.Mass().array()).matrix();
     next.x = state.x + h * next.v;
   } else {
-    VectorXd x0 = state.x + h * state.v;
-    for (int d = 0; d < n; ++d)
-      if (sim.fixed[d]) x0(d) = sim.fixed_values(d);
-    internal::StepObjective objective(sim, state.x + h * state.v, f);
-    switch (sim.options.method) {
-      case Method::kNewtonCholesky:
-      case Method::kNewtonPcg: next.x = internal::NewtonSolve(objective, x0, rep); break;
-      case Method::kPd: next.x = internal::PdSolve(objective, x0, rep); break;
-      case Method::kPdLbfgs: next.x = internal::PdLbfgsSolve(objective, x0, rep); break;
-      case Method::kSemiImplicit: break;
+    const internal::ImplicitSolver solve = [&sim](internal::StepObjective& objective, const VectorXd& x0,
+                                                  StepReport* r) -> VectorXd {
+      switch (sim.options.method) {
+        case Method::kNewtonCholesky:
+        case Method::kNewtonPcg: return internal::NewtonSolve(objective, x0, r);
+        case Method::kPd: return internal::PdSolve(objective, x0, r);
+        case Method::kPdLbfgs: return internal::PdLbfgsSolve(objective, x0, r);
+        case Method::kSemiImplicit: break;
+      }
+      return x0;
+    };
+    if (!sim.scene.frictional_contacts.empty()) {
+      next.x = internal::SolveWithActiveSet(sim, state, f, solve, rep);
+    } else {
+      VectorXd x0 = state.x + h * state.v;
+      for (int d = 0; d < n; ++d)
+        if (sim.fixed[d]) x0(d) = sim.fixed_values(d);
+      internal::StepObjective objective(sim, state.x + h * state.v, f);
+      next.x = solve(objective, x0, rep);
     }
   }
   for (int d = 0; d < n; ++d)
@@ -155,8 +174,12 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
   }
   const double h = sim.h();
   const VectorXd mass = sim.Mass();
+  const bool contact = !sim.scene.frictional_contacts.empty() && IsImplicit(sim.options.method);
+  if (contact && static_cast<int>(rollout.reports.size()) != steps)
+    throw InvalidInputError("Backward: a rollout with frictional contact needs its step reports (active sets)");
   RolloutGradient out;
   out.external_force.assign(steps, VectorXd());
+  out.activation.assign(steps, VectorXd());
   VectorXd gx = loss.dx[steps].size() ? loss.dx[steps] : VectorXd::Zero(n);
   VectorXd gv = loss.dv[steps].size() ? loss.dv[steps] : VectorXd::Zero(n);
   double dmu = 0, dlambda = 0, drho = 0;
@@ -168,9 +191,13 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
   for (int i = steps - 1; i >= 0; --i) {
     const State& s0 = rollout.states[i];
     const State& s1 = rollout.states[i + 1];
+    const internal::ActivationScope activation(sim, rollout.inputs[i].activation);
     VectorXd gx_prev, gv_prev;
     if (IsImplicit(sim.options.method)) {
       VectorXd b = gx + gv / h;
+      // With contact the step's active set is held fixed: its nodes are pinned.
+      std::optional<internal::ContactPinScope> pins;
+      if (contact) pins.emplace(sim, rollout.reports[i].contact_nodes, s1.x);
       internal::StepLinearization lin(sim, s1.x);
       const VectorXd z = lin.Solve(b, &out.report);  // zero at fixed DoFs
       sim.elastic.EnergyAndGradient(s1.x, 1.0, 0.0, &grad_mu, sim.threads());
@@ -181,8 +208,10 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
           sim.unit_mass.cwiseProduct(s1.x - s0.x - h * s0.v) / (h * h) - gravity_unit;
       drho -= z.dot(dgrad_drho);
       out.external_force[i] = z;
+      if (sim.aux.num_muscles() > 0) out.activation[i] = sim.aux.muscles().ActivationGradient(s1.x, sim.activation, z);
       gx_prev = mass.cwiseProduct(z) / (h * h) - gv / h;
       gv_prev = mass.cwiseProduct(z) / h;
+      if (contact) internal::AddPinGradient(sim, lin, s0, rollout.reports[i].contact_nodes, b, z, &gx_prev, &gv_prev);
     } else {
       // Semi-implicit: v1 = v0 + h M^-1 (f - grad E(x0)) on free DoFs, x1 = x0 + h v1.
       VectorXd gvt = gv + h * gx;  // total dL/dv1 through v1 and x1
@@ -192,6 +221,8 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
       sim.elastic.StressDifferentials(s0.x, sim.mu(), sim.lambda(), &dstress, sim.threads());
       VectorXd hw;
       sim.elastic.ApplyHessian(dstress, w, &hw, sim.threads());
+      sim.aux.AddHessianProduct(s0.x, sim.activation, w, &hw);
+      if (sim.aux.num_muscles() > 0) out.activation[i] = sim.aux.muscles().ActivationGradient(s0.x, sim.activation, w);
       VectorXd gx_free = gx;
       sim.ZeroFixed(&gx_free);
       gx_prev = gx_free - hw;
@@ -205,10 +236,15 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
       // M^-1 (f_user - grad E) scales as 1/rho; gravity's acceleration does not.
       VectorXd grad_e;
       sim.elastic.EnergyAndGradient(s0.x, sim.mu(), sim.lambda(), &grad_e, sim.threads());
+      sim.aux.AddEnergyAndGradient(s0.x, sim.activation, &grad_e);
       VectorXd user = rollout.inputs[i].external_force.size() ? rollout.inputs[i].external_force : VectorXd::Zero(n);
+      sim.state_forces.Add(s0.x, s0.v, sim.rho(), &user);  // M^-1 f scales as 1/rho for these too
       drho -= w.dot(user - grad_e) / sim.rho();
       out.external_force[i] = w;
     }
+    // Explicit state forces f(x_i, v_i): dL/df = out.external_force[i].
+    drho += sim.state_forces.AddVjp(s0.x, s0.v, sim.rho(), out.external_force[i], &gx_prev, &gv_prev,
+                                    &out.state_forces);
     if (loss.dx[i].size()) gx_prev += loss.dx[i];
     if (loss.dv[i].size()) gv_prev += loss.dv[i];
     gx = std::move(gx_prev);
@@ -230,6 +266,8 @@ VectorXd Simulator::SolveQuasiStatic(const VectorXd& initial_positions, const St
   const int n = sim.num_dofs();
   CheckVector(initial_positions, n, "initial_positions", false);
   CheckVector(input.external_force, n, "external_force", true);
+  internal::CheckActivation(input.activation, sim.aux.num_muscles());
+  const internal::ActivationScope activation(sim, input.activation);
   StepReport local;
   StepReport* rep = report ? report : &local;
   *rep = StepReport();

@@ -11,7 +11,9 @@ SimulatorImpl::SimulatorImpl(const Scene& scene_in, const SolverOptions& options
     : scene((scene_in.Validate(), scene_in)),
       options((options_in.Validate(), options_in)),
       fem(scene.mesh),
-      elastic(fem, scene.energies) {
+      elastic(fem, scene.energies),
+      aux(fem, scene),
+      state_forces(scene, fem.unit_lumped_mass()) {
   const int n = scene.mesh.num_dofs();
   fixed.assign(n, 0);
   fixed_values = VectorXd::Zero(n);
@@ -44,7 +46,10 @@ HessianAssembler& SimulatorImpl::hessian_assembler() {
 }
 
 PdSystem& SimulatorImpl::pd_system() {
-  if (!pd_) pd_ = std::make_unique<PdSystem>(fem, fixed);
+  if (!pd_) {
+    pd_ = std::make_unique<PdSystem>(fem, fixed);
+    if (!aux.empty()) pd_->SetAuxiliaryMatrix(aux.PdMatrix());
+  }
   pd_->Update(h(), rho(), elastic.PdWeight(mu(), lambda()));
   return *pd_;
 }
@@ -57,7 +62,7 @@ StepObjective::StepObjective(SimulatorImpl& sim, VectorXd xhat, VectorXd force, 
 double StepObjective::Evaluate(const VectorXd& x, VectorXd* grad) {
   const double e = sim_.elastic.EnergyAndGradient(x, sim_.mu(), sim_.lambda(), grad, sim_.threads());
   const VectorXd dx = x - xhat_;
-  double value = e;
+  double value = e + sim_.aux.AddEnergyAndGradient(x, sim_.activation, grad);
   for (int d = 0; d < x.size(); ++d) {
     if (sim_.fixed[d]) continue;
     value += 0.5 * inertia_(d) * dx(d) * dx(d) - force_(d) * x(d);

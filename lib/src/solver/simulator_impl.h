@@ -7,8 +7,10 @@
 #include "diffpd/rollout.h"
 #include "diffpd/scene.h"
 #include "diffpd/solver_options.h"
+#include "fem/auxiliary_energies.h"
 #include "fem/elastic_forces.h"
 #include "fem/fem_model.h"
+#include "forces/state_forces.h"
 #include "solver/cholmod_solver.h"
 #include "solver/hessian_assembler.h"
 #include "solver/pd_system.h"
@@ -23,7 +25,17 @@ class SimulatorImpl {
   SolverOptions options;
   FemModel fem;
   ElasticForces elastic;
-  std::vector<char> fixed;  // 3n flags
+  AuxiliaryEnergies aux;      // muscles, penalty contact (empty: no cost)
+  StateForces state_forces;   // damping, hydrodynamics, penalty friction
+  // Muscle activation of the step being solved or differentiated (empty:
+  // rest). Step, Backward and SolveQuasiStatic set it (ActivationScope in
+  // forces/activation_scope.h); anything else building a StepObjective or
+  // StepLinearization for a step must set it too.
+  VectorXd activation;
+  // 3n flags. During a step with frictional contact the active nodes are
+  // added (and their pins to fixed_values) by ContactPinScope
+  // (contact/contact_pin_scope.h), and removed after.
+  std::vector<char> fixed;
   VectorXd fixed_values;    // 3n, Dirichlet positions (zero at free DoFs)
   VectorXd unit_mass;       // 3n, lumped mass per DoF for unit density (m^3)
 
@@ -83,12 +95,22 @@ class StepLinearization {
   StepLinearization(SimulatorImpl& sim, const VectorXd& x, bool static_problem = false);
   // Solves H z = b (3n; fixed entries of b ignored, of z zero).
   VectorXd Solve(const VectorXd& b, BackwardReport* report);
+  // Solves H Z = B for the P columns of B (3n x P) together: PD methods
+  // iterate all columns in lockstep with one batched A^{-1} solve per
+  // iteration; Newton methods reuse one factorisation. Columns whose
+  // iteration fails fall back to the direct solve (counted per column).
+  MatrixXd SolveColumns(const MatrixXd& b, BackwardReport* report);
   // H z (3n, free rows only).
   VectorXd Apply(const VectorXd& z);
+  // H z with the fixed entries of z zeroed but every row kept: the fixed rows
+  // carry the coupling to the free DoFs (frictional contact's pin gradient).
+  VectorXd ApplyUnmasked(const VectorXd& z);
 
  private:
   bool DirectSolve(const VectorXd& b, VectorXd* z);
   bool IterativeSolve(const VectorXd& b, VectorXd* z, int* iterations);
+  // Lockstep IterativeSolve of several columns; ok[c] tells which converged.
+  void IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, std::vector<char>* ok, int* iterations);
   bool PcgSolve(const VectorXd& b, VectorXd* z, int* iterations);
 
   SimulatorImpl& sim_;

@@ -30,14 +30,20 @@ StepLinearization::StepLinearization(SimulatorImpl& sim, const VectorXd& x, bool
 }
 
 VectorXd StepLinearization::Apply(const VectorXd& z) {
+  VectorXd out = ApplyUnmasked(z);
+  sim_.ZeroFixed(&out);
+  return out;
+}
+
+VectorXd StepLinearization::ApplyUnmasked(const VectorXd& z) {
   VectorXd zf = z;
   sim_.ZeroFixed(&zf);
   VectorXd out;
   if (dstress_.empty())
     sim_.elastic.StressDifferentials(x_, sim_.mu(), sim_.lambda(), &dstress_, sim_.threads());
   sim_.elastic.ApplyHessian(dstress_, zf, &out, sim_.threads());
+  sim_.aux.AddHessianProduct(x_, sim_.activation, zf, &out);
   out.array() += inertia_.array() * zf.array();
-  sim_.ZeroFixed(&out);
   return out;
 }
 
@@ -45,6 +51,7 @@ bool StepLinearization::DirectSolve(const VectorXd& b, VectorXd* z) {
   if (!have_matrix_) {
     std::vector<double> blocks;
     sim_.elastic.ElementHessians(x_, sim_.mu(), sim_.lambda(), /*project_spd=*/false, &blocks, sim_.threads());
+    sim_.aux.AddElementHessians(x_, sim_.activation, /*project_spd=*/false, &blocks);
     sim_.hessian_assembler().Assemble(blocks, inertia_, sim_.fixed, &matrix_);
     have_matrix_ = true;
     llt_ = std::make_unique<CholmodSolver>();
@@ -140,6 +147,7 @@ bool StepLinearization::PcgSolve(const VectorXd& b, VectorXd* z, int* iterations
   if (!have_matrix_) {
     std::vector<double> blocks;
     sim_.elastic.ElementHessians(x_, sim_.mu(), sim_.lambda(), /*project_spd=*/false, &blocks, sim_.threads());
+    sim_.aux.AddElementHessians(x_, sim_.activation, /*project_spd=*/false, &blocks);
     sim_.hessian_assembler().Assemble(blocks, inertia_, sim_.fixed, &matrix_);
     have_matrix_ = true;
   }
@@ -180,6 +188,159 @@ VectorXd StepLinearization::Solve(const VectorXd& b, BackwardReport* report) {
   if (!DirectSolve(b, &z))
     throw SolverError(SolverStatus::kFactorizationFailed,
                       std::string(ToString(m)) + " backward: the step Hessian is singular; no gradient exists here");
+  return z;
+}
+
+}  // namespace diffpd::internal
+
+namespace diffpd::internal {
+
+// The single-column iterations above, run for all columns in lockstep so that
+// each iteration makes one A^{-1} solve with several right-hand sides.
+void StepLinearization::IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, std::vector<char>* ok,
+                                              int* iterations) {
+  PdSystem& pd = sim_.pd_system();
+  const SolverOptions& opt = sim_.options;
+  const int cols = static_cast<int>(b.cols());
+  MatrixXd rhs = b;
+  for (int c = 0; c < cols; ++c) {
+    VectorXd col = rhs.col(c);
+    sim_.ZeroFixed(&col);
+    rhs.col(c) = col;
+  }
+  *z = MatrixXd::Zero(rhs.rows(), cols);
+  ok->assign(cols, 0);
+  MatrixXd r = rhs;
+  std::vector<double> tol(cols), best(cols);
+  std::vector<int> stalled(cols, 0);
+  std::vector<int> active;
+  for (int c = 0; c < cols; ++c) {
+    const double bnorm = rhs.col(c).norm();
+    tol[c] = opt.backward_rel_tolerance * bnorm;
+    best[c] = bnorm;
+    if (bnorm == 0)
+      (*ok)[c] = 1;
+    else
+      active.push_back(c);
+  }
+  // Per-column L-BFGS memory.
+  std::vector<std::deque<VectorXd>> s_list(cols), y_list(cols);
+  std::vector<std::deque<double>> rho_list(cols);
+  std::vector<std::vector<double>> alpha(cols, std::vector<double>(opt.lbfgs_history));
+  const bool fixed_point = opt.pd_backward == PdBackwardMethod::kFixedPoint;
+  for (int it = 1; it <= opt.backward_max_iterations && !active.empty(); ++it) {
+    const int na = static_cast<int>(active.size());
+    MatrixXd q(rhs.rows(), na);
+    for (int j = 0; j < na; ++j) {
+      const int c = active[j];
+      if (fixed_point) {
+        q.col(j) = r.col(c);
+        continue;
+      }
+      VectorXd qc = -r.col(c);
+      for (int m = static_cast<int>(s_list[c].size()) - 1; m >= 0; --m) {
+        alpha[c][m] = rho_list[c][m] * s_list[c][m].dot(qc);
+        qc -= alpha[c][m] * y_list[c][m];
+      }
+      q.col(j) = qc;
+    }
+    const MatrixXd p_all = pd.Solve(q);
+    *iterations += na;
+    std::vector<int> still;
+    for (int j = 0; j < na; ++j) {
+      const int c = active[j];
+      bool converged = false, failed = false;
+      if (fixed_point) {
+        z->col(c) += p_all.col(j);
+        r.col(c) = rhs.col(c) - Apply(z->col(c));
+        const double rn = r.col(c).norm();
+        if (!std::isfinite(rn) || rn > 10 * best[c]) {
+          failed = true;
+        } else if (rn <= tol[c]) {
+          converged = true;
+        } else if (rn < 0.999 * best[c]) {
+          best[c] = rn;
+          stalled[c] = 0;
+        } else if (++stalled[c] >= 20) {
+          failed = true;
+        }
+      } else {
+        VectorXd p = p_all.col(j);
+        const int k = static_cast<int>(s_list[c].size());
+        for (int m = 0; m < k; ++m) p += (alpha[c][m] - rho_list[c][m] * y_list[c][m].dot(p)) * s_list[c][m];
+        p = -p;
+        sim_.ZeroFixed(&p);
+        const VectorXd hp = Apply(p);
+        const double curvature = p.dot(hp);
+        if (!(curvature > 0)) {
+          failed = true;
+        } else {
+          const double step = r.col(c).dot(p) / curvature;
+          z->col(c) += step * p;
+          r.col(c) -= step * hp;
+          const double rn = r.col(c).norm();
+          if (!std::isfinite(rn)) {
+            failed = true;
+          } else {
+            if (rn <= tol[c]) {
+              r.col(c) = rhs.col(c) - Apply(z->col(c));  // confirm with a true residual
+              if (r.col(c).norm() <= 10 * tol[c]) converged = true;
+            }
+            if (static_cast<int>(s_list[c].size()) == opt.lbfgs_history) {
+              s_list[c].pop_front();
+              y_list[c].pop_front();
+              rho_list[c].pop_front();
+            }
+            s_list[c].push_back(step * p);
+            y_list[c].push_back(step * hp);
+            rho_list[c].push_back(1.0 / (step * step * curvature));
+          }
+        }
+      }
+      if (converged)
+        (*ok)[c] = 1;
+      else if (!failed)
+        still.push_back(c);
+    }
+    active.swap(still);
+  }
+}
+
+MatrixXd StepLinearization::SolveColumns(const MatrixXd& b, BackwardReport* report) {
+  const Method m = sim_.options.method;
+  const int cols = static_cast<int>(b.cols());
+  MatrixXd z = MatrixXd::Zero(b.rows(), cols);
+  std::vector<char> ok(cols, 0);
+  int iterations = 0;
+  bool iterative = false;
+  if (m == Method::kPd || m == Method::kPdLbfgs) {
+    iterative = true;
+    IterativeSolveColumns(b, &z, &ok, &iterations);
+  } else if (m == Method::kNewtonPcg) {
+    iterative = true;
+    for (int c = 0; c < cols; ++c) {
+      VectorXd zc;
+      int it = 0;
+      ok[c] = PcgSolve(b.col(c), &zc, &it);
+      iterations += it;
+      if (ok[c]) z.col(c) = zc;
+    }
+  }
+  if (report) report->linear_iterations += iterations;
+  for (int c = 0; c < cols; ++c) {
+    if (ok[c]) continue;
+    if (iterative) {
+      if (report) ++report->fallbacks;
+      if (sim_.options.verbosity >= 1)
+        std::fprintf(stderr, "%s tangent: iterative solve of column %d failed; falling back to a direct solve\n",
+                     ToString(m), c);
+    }
+    VectorXd zc;
+    if (!DirectSolve(b.col(c), &zc))
+      throw SolverError(SolverStatus::kFactorizationFailed,
+                        std::string(ToString(m)) + " tangent: the step Hessian is singular; no derivative exists here");
+    z.col(c) = zc;
+  }
   return z;
 }
 

@@ -1,0 +1,127 @@
+// Contact with fixed collision surfaces: frictional (active set, DiffPD Sec.
+// 5.2) and penalty (a smooth PD vertex energy).
+//
+// Frictional contact. At every implicit step an active-set loop decides which
+// candidate nodes touch the surface; those become Dirichlet nodes for that
+// step only (all three axes: static friction, the node sticks where it
+// touches), pinned at
+//
+//   p(x_i, v_i) = the point where the segment x_i -> x_i + h v_i enters the
+//                 surface, if x_i is outside (gap > 1e-9 m) and x_i + h v_i
+//                 is inside (gap < 0);
+//               = Project(x_i) otherwise (a node resting on the surface stays
+//                 where it is; a node pulled in by the rest of the body drops
+//                 straight onto the surface),
+//
+// a smooth function of the previous state. The loop starts from the
+// candidates whose predicted position x_i + h v_i has gap <= 1e-9 m, solves the
+// step with them pinned, then releases every pinned node whose contact force
+// pulls it into the surface (n . f_c < 0, f_c = grad g at the node) and adds
+// every free candidate deeper than `penetration_tolerance`; it repeats until
+// the set no longer changes, at most `max_passes` solves per step, else
+// SolverError(kActiveSetNotConverged). A node released and re-added within one
+// step is not released again in that step (no cycling). Each step's active
+// set and contact forces are recorded in its StepReport.
+//
+// The PD matrix A is never refactorised when the active set changes: the
+// erased rows and columns are a low-rank change handled by the
+// Sherman-Morrison-Woodbury identity on the existing factor, in the forward
+// and the backward pass (kRefactorize instead factorises the erased matrix;
+// same solution, for comparison and benchmarks). Newton methods pin the same
+// nodes as extra fixed DoFs. Semi-implicit Euler does not support frictional
+// contact (Step throws InvalidInputError).
+//
+// Gradients: the backward pass holds each step's recorded active set fixed, so
+// the gradient is that of the smooth piece of the trajectory on which the
+// rollout lies (the active set is piecewise constant in the inputs; a
+// perturbation that changes it leaves that piece). Pins are differentiated
+// through p(x_i, v_i).
+//
+// Penalty contact. The half-space H = {x : n . x >= offset} repels candidate
+// nodes with the PD vertex energy
+//
+//   E(x) = (w/2) |x - Proj_H(x)|^2 = (w/2) min(0, n . x - offset)^2,
+//
+// w = stiffness (N/m); PD adds w to A's diagonal at every candidate node.
+// Optional Coulomb-like friction is an explicit state force evaluated at
+// (x_i, v_i) on every penetrating candidate:
+//
+//   f = -mu f_n v_t / sqrt(|v_t|^2 + eps^2),   f_n = w (offset - n . x_i),
+//   v_t = v_i - (n . v_i) n,  eps = friction_velocity,
+//
+// smooth in the state (explicit: keep mu f_n h / (eps m) < 2 for stability).
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include "diffpd/types.h"
+
+namespace diffpd {
+
+// A fixed collision surface. The body stays on the side where gap(x) >= 0.
+struct ContactSurface {
+  enum class Kind {
+    kPlane,       // n . x = offset; outside n . x > offset (n normalised)
+    kSphere,      // |x - center| = radius; the body stays outside the ball
+    kHeightField, // z = height(x, y); the body stays above (z > height)
+  };
+  Kind kind = Kind::kPlane;
+  Vec3 normal = Vec3(0, 0, 1);  // plane: outward normal, finite, non-zero
+  double offset = 0;            // plane: m
+  Vec3 center = Vec3::Zero();   // sphere: m
+  double radius = 1;            // sphere: m, finite and > 0
+  // Height field: height(x, y) in m and its gradient (dh/dx, dh/dy); both
+  // required, smooth where contact happens.
+  std::function<double(double, double)> height;
+  std::function<Eigen::Vector2d(double, double)> height_gradient;
+
+  static ContactSurface Plane(const Vec3& normal, double offset);
+  static ContactSurface Sphere(const Vec3& center, double radius);
+  static ContactSurface HeightField(std::function<double(double, double)> height,
+                                    std::function<Eigen::Vector2d(double, double)> height_gradient);
+
+  // Signed gap (m for plane and sphere; vertical distance for a height field):
+  // > 0 outside, < 0 penetrating.
+  double Gap(const Vec3& x) const;
+  // Gradient of Gap (unit outward normal for plane and sphere;
+  // (-dh/dx, -dh/dy, 1) for a height field).
+  Vec3 GapGradient(const Vec3& x) const;
+  // The point of the surface a node is pinned to from x: orthogonal projection
+  // for plane and sphere (x = center maps to the top of the sphere), vertical
+  // projection (x, y, height(x, y)) for a height field.
+  Vec3 Project(const Vec3& x) const;
+  // d Project / dx (3x3).
+  Mat3 ProjectJacobian(const Vec3& x) const;
+};
+
+// How PD solves with the active set erased from the prefactorised A.
+enum class ContactLinearSolve {
+  kWoodbury,    // low-rank (Sherman-Morrison-Woodbury) update of A's factor
+  kRefactorize, // factorise A with the active rows and columns erased
+};
+
+struct FrictionalContact {
+  ContactSurface surface;
+  // Candidate nodes (each at most once across all frictional contacts, none
+  // with a Dirichlet DoF).
+  std::vector<int> nodes;
+};
+
+// Settings of the active-set loop shared by all frictional contacts.
+struct FrictionalContactOptions {
+  int max_passes = 20;                  // solves per step, >= 1
+  double penetration_tolerance = 1e-6;  // m, >= 0: a free candidate deeper than this joins the set
+  ContactLinearSolve pd_linear_solve = ContactLinearSolve::kWoodbury;
+};
+
+struct PenaltyContact {
+  Vec3 normal = Vec3(0, 0, 1);   // outward normal of the allowed half-space, non-zero
+  double offset = 0;             // m: the half-space is n . x >= offset (n normalised)
+  std::vector<int> nodes;        // candidate nodes
+  double stiffness = 1e4;        // w, N/m, finite and > 0
+  double friction = 0;           // mu, finite and >= 0 (0: frictionless, no state force)
+  double friction_velocity = 1e-2;  // eps, m/s, finite and > 0
+};
+
+}  // namespace diffpd

@@ -1,0 +1,51 @@
+// Forward-mode derivatives (tangents) of a rollout: how every state x_k, v_k
+// changes along given directions in the space of the rollout's
+// differentiable inputs. Produced by Simulator::Tangents (simulator.h).
+//
+// With P directions the tangent pass costs one linear solve with the step's
+// exact Hessian per step for all P directions together (P right-hand sides
+// sharing one factorisation), so it pays when P is small and the outputs
+// are many (e.g. the Jacobian of many marker residuals w.r.t. a few material
+// parameters); with one scalar loss and many inputs use Backward instead.
+#pragma once
+
+#include <vector>
+
+#include "diffpd/rollout.h"
+#include "diffpd/types.h"
+
+namespace diffpd {
+
+// One direction d in the space of a rollout's differentiable inputs. The
+// tangent along d is the derivative of the rollout at epsilon = 0 when every
+// input theta is replaced by theta + epsilon d_theta. Empty vectors mean zero.
+struct InputDirection {
+  VectorXd x0;                          // 3n, m: initial positions
+  VectorXd v0;                          // 3n, m/s: initial velocities
+  std::vector<VectorXd> external_force; // empty, or one per step (each 3n or empty), N
+  double youngs_modulus = 0;            // Pa
+  double poissons_ratio = 0;            // dimensionless
+  double density = 0;                   // kg/m^3
+
+  // The unit direction of one material parameter.
+  static InputDirection YoungsModulus();
+  static InputDirection PoissonsRatio();
+  static InputDirection Density();
+};
+
+// Tangents of a rollout with K steps along P directions.
+struct TangentRollout {
+  // dx[k] and dv[k], k = 0..K, are 3n x P: column p holds d x_k / d epsilon
+  // (m per unit of direction p) and d v_k / d epsilon along direction p.
+  // Fixed (Dirichlet) DoFs have dx = 0 for k >= 1.
+  std::vector<MatrixXd> dx;
+  std::vector<MatrixXd> dv;
+  // Linear iterations of the iterative solves (all columns), fallbacks to a
+  // direct solve, and the wall-clock time of the whole pass.
+  BackwardReport report;
+
+  int num_steps() const { return static_cast<int>(dx.size()) - 1; }
+  int num_directions() const { return dx.empty() ? 0 : static_cast<int>(dx[0].cols()); }
+};
+
+}  // namespace diffpd

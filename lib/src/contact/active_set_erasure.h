@@ -1,0 +1,69 @@
+// Solves with a prefactorised SPD matrix whose rows and columns of a node set
+// S (the contact active set) are erased, without refactorising (internal).
+//
+// A is n x n (one PD axis group; its Dirichlet rows are already the
+// identity's). A_S is A with the rows and columns of S replaced by the
+// identity's. For R with R_S = 0 (entries of S are ignored) the solution of
+// A_S Y = R with Y_S = 0 is, by the Sherman-Morrison-Woodbury identity on the
+// bordered system [A P; P^T 0],
+//
+//   Y = A^-1 R - W C^-1 (A^-1 R)_S,   W = A^-1 P (n x s),  C = P^T A^-1 P = W_S,
+//
+// P the n x s selection of S. Cost: s solves with A's factor for the columns
+// of W (cached per node until the factor changes, so a node that stays in
+// contact over many steps costs one solve in all), a dense s x s Cholesky per
+// change of S, and per solve one solve with A plus O(n s). kRefactorize
+// instead factorises A_S (for comparison; same solution).
+#pragma once
+
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Cholesky>
+
+#include "diffpd/contact.h"
+#include "diffpd/types.h"
+#include "solver/cholmod_solver.h"
+
+namespace diffpd::internal {
+
+class ActiveSetErasure {
+ public:
+  ActiveSetErasure();
+  ~ActiveSetErasure();
+  ActiveSetErasure(ActiveSetErasure&&) noexcept;
+  ActiveSetErasure& operator=(ActiveSetErasure&&) noexcept;
+
+  // Erases `nodes` (sorted, unique); those already fixed in `base_fixed` (n
+  // flags) are skipped. `matrix` is A and `base` its current factor.
+  // Throws SolverError(kFactorizationFailed) if C or A_S is not positive definite.
+  void Set(const std::vector<int>& nodes, ContactLinearSolve mode, const SparseMatrix& matrix,
+           const CholmodSolver& base, const std::vector<char>& base_fixed);
+  // The base factor changed: drops the cached columns and the erased set
+  // (call Set again).
+  void Reset();
+  bool empty() const { return nodes_.empty(); }
+  const std::vector<int>& nodes() const { return nodes_; }
+
+  // Solves A_S Y = R (n x k): rows of R at S are ignored, rows of Y at S are
+  // zero. Rows of R at the base's fixed nodes must already be zero.
+  MatrixXd Solve(const CholmodSolver& base, MatrixXd rhs) const;
+  // Rows of S of x set to zero (the erasure of A_S x's columns and rows).
+  void ZeroErased(MatrixXd* x) const;
+
+  int num_column_solves() const { return num_column_solves_; }
+  int num_factorizations() const { return num_factorizations_; }
+
+ private:
+  std::vector<int> nodes_;
+  ContactLinearSolve mode_ = ContactLinearSolve::kWoodbury;
+  std::unordered_map<int, VectorXd> columns_;  // node -> A^-1 e_node
+  MatrixXd w_;                                  // n x s
+  Eigen::LLT<MatrixXd> capacitance_;            // of C = W_S
+  std::unique_ptr<CholmodSolver> erased_solver_;
+  int num_column_solves_ = 0;
+  int num_factorizations_ = 0;
+};
+
+}  // namespace diffpd::internal

@@ -1,0 +1,177 @@
+#include "contact/active_set_step.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "diffpd/error.h"
+
+namespace diffpd::internal {
+namespace {
+
+// A node with gap <= kTouch is on the surface (resting contact).
+constexpr double kTouch = 1e-9;  // m
+
+struct Candidate {
+  int node;
+  const ContactSurface* surface;
+};
+
+std::vector<Candidate> Candidates(const Scene& scene) {
+  std::vector<Candidate> out;
+  for (const FrictionalContact& c : scene.frictional_contacts)
+    for (const int i : c.nodes) out.push_back(Candidate{i, &c.surface});
+  return out;
+}
+
+// Root of Gap(x + t d) in (0, 1) given Gap(x) > 0 > Gap(x + d): Newton
+// steps safeguarded by bisection, to rounding.
+double EntryParameter(const ContactSurface& surface, const Vec3& x, const Vec3& d) {
+  double lo = 0, hi = 1;
+  const double g0 = surface.Gap(x), g1 = surface.Gap(x + d);
+  double t = g0 / (g0 - g1);  // exact for a plane
+  for (int it = 0; it < 100; ++it) {
+    const double g = surface.Gap(x + t * d);
+    if (g > 0) lo = t; else hi = t;
+    if (std::abs(g) <= 1e-15 * (std::abs(g0) + std::abs(g1)) || hi - lo <= 1e-16) break;
+    const double slope = surface.GapGradient(x + t * d).dot(d);
+    double next = slope != 0 ? t - g / slope : 0.5 * (lo + hi);
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    t = next;
+  }
+  return t;
+}
+
+}  // namespace
+
+ContactPin ComputeContactPin(const ContactSurface& surface, const Vec3& x, const Vec3& v, double h) {
+  ContactPin pin;
+  const Vec3 d = h * v;
+  if (surface.Gap(x) > kTouch && surface.Gap(x + d) < 0) {
+    const double t = EntryParameter(surface, x, d);
+    pin.position = x + t * d;
+    const Vec3 g = surface.GapGradient(pin.position);
+    const double gd = g.dot(d);
+    if (gd < 0) {
+      // Gap(x + t d) = 0: dt = -g . (dx + t h dv) / (g . d), so
+      // dpin = Q (dx + t h dv) with Q = I - d g^T / (g . d).
+      const Mat3 q = Mat3::Identity() - d * g.transpose() / gd;
+      pin.d_dx = q;
+      pin.d_dv = (t * h) * q;
+      return pin;
+    }
+  }
+  pin.position = surface.Project(x);
+  pin.d_dx = surface.ProjectJacobian(x);
+  pin.d_dv = Mat3::Zero();
+  return pin;
+}
+
+VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const VectorXd& force,
+                            const ImplicitSolver& solve, StepReport* report) {
+  const FrictionalContactOptions& opt = sim.scene.frictional_contact_options;
+  const double h = sim.h();
+  const int n = sim.num_dofs();
+  const VectorXd xhat = state.x + h * state.v;
+  const std::vector<Candidate> cand = Candidates(sim.scene);
+  const int nc = static_cast<int>(cand.size());
+  std::vector<char> active(nc, 0), released(nc, 0), locked(nc, 0);
+  std::vector<ContactPin> pins(nc);
+  std::vector<char> have_pin(nc, 0);
+  auto pin_of = [&](int c) -> const ContactPin& {
+    if (!have_pin[c]) {
+      const int i = cand[c].node;
+      pins[c] = ComputeContactPin(*cand[c].surface, state.x.segment<3>(3 * i), state.v.segment<3>(3 * i), h);
+      have_pin[c] = 1;
+    }
+    return pins[c];
+  };
+  for (int c = 0; c < nc; ++c) active[c] = cand[c].surface->Gap(xhat.segment<3>(3 * cand[c].node)) <= kTouch;
+
+  VectorXd x = xhat;
+  for (int pass = 1;; ++pass) {
+    // Active nodes in increasing order, with their pins.
+    std::vector<std::pair<int, int>> order;  // (node, candidate)
+    for (int c = 0; c < nc; ++c)
+      if (active[c]) order.emplace_back(cand[c].node, c);
+    std::sort(order.begin(), order.end());
+    std::vector<int> nodes;
+    VectorXd pinned = VectorXd::Zero(n);
+    for (const auto& [i, c] : order) {
+      nodes.push_back(i);
+      pinned.segment<3>(3 * i) = pin_of(c).position;
+    }
+    StepReport pass_report;
+    {
+      const ContactPinScope scope(sim, nodes, pinned);
+      VectorXd x0 = x;
+      for (int d = 0; d < n; ++d)
+        if (sim.fixed[d]) x0(d) = sim.fixed_values(d);
+      StepObjective objective(sim, xhat, force);
+      x = solve(objective, x0, &pass_report);
+    }
+    if (pass == 1) report->initial_residual = pass_report.initial_residual;
+    report->iterations += pass_report.iterations;
+    report->line_search_steps += pass_report.line_search_steps;
+    report->final_residual = pass_report.final_residual;
+    report->active_set_passes = pass;
+
+    // Contact forces f_c = grad g at the pinned nodes (the Dirichlet reaction).
+    VectorXd grad;
+    if (!nodes.empty()) {
+      StepObjective objective(sim, xhat, force);
+      objective.Evaluate(x, &grad);
+    }
+    bool changed = false;
+    for (int c = 0; c < nc; ++c) {
+      const int i = cand[c].node;
+      if (active[c]) {
+        const Vec3 normal = cand[c].surface->GapGradient(pin_of(c).position);
+        if (!locked[c] && normal.dot(grad.segment<3>(3 * i)) < 0) {
+          active[c] = 0;
+          released[c] = 1;
+          changed = true;
+        }
+      } else if (cand[c].surface->Gap(x.segment<3>(3 * i)) < -opt.penetration_tolerance) {
+        active[c] = 1;
+        if (released[c]) locked[c] = 1;
+        changed = true;
+      }
+    }
+    if (sim.options.verbosity >= 2)
+      std::fprintf(stderr, "  contact pass %d: %zu pinned nodes%s\n", pass, nodes.size(), changed ? ", set changed" : "");
+    if (!changed) {
+      report->contact_nodes = nodes;
+      report->contact_forces.resize(3, static_cast<Eigen::Index>(nodes.size()));
+      for (size_t k = 0; k < nodes.size(); ++k)
+        report->contact_forces.col(static_cast<Eigen::Index>(k)) = grad.segment<3>(3 * nodes[k]);
+      return x;
+    }
+    if (pass >= opt.max_passes) {
+      std::ostringstream msg;
+      msg << "frictional contact: the active set did not settle in " << opt.max_passes
+          << " passes (frictional_contact_options.max_passes; " << nodes.size() << " nodes pinned in the last pass)";
+      throw SolverError(SolverStatus::kActiveSetNotConverged, msg.str());
+    }
+  }
+}
+
+void AddPinGradient(SimulatorImpl& sim, StepLinearization& lin, const State& previous, const std::vector<int>& nodes,
+                    const VectorXd& b, const VectorXd& z, VectorXd* gx, VectorXd* gv) {
+  if (nodes.empty()) return;
+  const VectorXd hz = lin.ApplyUnmasked(z);
+  std::vector<const ContactSurface*> surface_of(sim.fem.num_nodes(), nullptr);
+  for (const FrictionalContact& c : sim.scene.frictional_contacts)
+    for (const int i : c.nodes) surface_of[i] = &c.surface;
+  for (const int i : nodes) {
+    DIFFPD_CHECK(surface_of[i] != nullptr, "pinned node " << i << " is not a frictional contact candidate");
+    const ContactPin pin = ComputeContactPin(*surface_of[i], previous.x.segment<3>(3 * i),
+                                             previous.v.segment<3>(3 * i), sim.h());
+    const Vec3 dl_dpin = b.segment<3>(3 * i) - hz.segment<3>(3 * i);
+    gx->segment<3>(3 * i) += pin.d_dx.transpose() * dl_dpin;
+    gv->segment<3>(3 * i) += pin.d_dv.transpose() * dl_dpin;
+  }
+}
+
+}  // namespace diffpd::internal

@@ -1,0 +1,112 @@
+#include "forces/state_forces.h"
+
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+#include "forces/hydrodynamic_force.h"
+
+namespace diffpd::internal {
+namespace {
+
+Vec3 AreaVector(const VectorXd& x, int a, int b, int c) {
+  const Vec3 xa = x.segment<3>(3 * a);
+  return 0.5 * (x.segment<3>(3 * b) - xa).cross(x.segment<3>(3 * c) - xa);
+}
+
+Vec3 MeanVelocity(const VectorXd& v, int a, int b, int c) {
+  return (v.segment<3>(3 * a) + v.segment<3>(3 * b) + v.segment<3>(3 * c)) / 3.0;
+}
+
+}  // namespace
+
+StateForces::StateForces(const Scene& scene, const VectorXd& unit_node_mass)
+    : damping_(scene.linear_damping), hydro_(scene.hydrodynamics),
+      num_penalty_contacts_(static_cast<int>(scene.penalty_contacts.size())) {
+  for (size_t c = 0; c < scene.penalty_contacts.size(); ++c) {
+    const PenaltyContact& pc = scene.penalty_contacts[c];
+    if (pc.friction == 0) continue;
+    for (const int i : pc.nodes)
+      friction_.push_back(FrictionNode{static_cast<int>(c), i, pc.normal.normalized(), pc.offset, pc.stiffness,
+                                       pc.friction, pc.friction_velocity});
+  }
+  if (damping_) {
+    unit_mass_.resize(3 * unit_node_mass.size());
+    for (Eigen::Index i = 0; i < unit_node_mass.size(); ++i) unit_mass_.segment<3>(3 * i).setConstant(unit_node_mass(i));
+  }
+}
+
+void StateForces::Add(const VectorXd& x, const VectorXd& v, double rho, VectorXd* f) const {
+  if (empty()) return;
+  if (damping_) f->array() -= (*damping_ * rho) * unit_mass_.array() * v.array();
+  if (hydro_) {
+    const Eigen::Matrix3Xi& tri = hydro_->triangles;
+    for (int t = 0; t < tri.cols(); ++t) {
+      const int a = tri(0, t), b = tri(1, t), c = tri(2, t);
+      const Vec3 u = MeanVelocity(v, a, b, c) - hydro_->flow_velocity;
+      const Vec3 share = HydrodynamicForce(*hydro_, AreaVector(x, a, b, c), u) / 3.0;
+      f->segment<3>(3 * a) += share;
+      f->segment<3>(3 * b) += share;
+      f->segment<3>(3 * c) += share;
+    }
+  }
+  for (const FrictionNode& fn : friction_) {
+    const double gap = fn.normal.dot(x.segment<3>(3 * fn.node)) - fn.offset;
+    if (gap >= 0) continue;
+    const Vec3 vi = v.segment<3>(3 * fn.node);
+    const Vec3 vt = vi - fn.normal.dot(vi) * fn.normal;
+    const double s = std::sqrt(vt.squaredNorm() + fn.eps * fn.eps);
+    f->segment<3>(3 * fn.node) += (fn.mu * fn.stiffness * gap / s) * vt;  // -mu f_n vt / s, f_n = -w gap
+  }
+}
+
+double StateForces::AddVjp(const VectorXd& x, const VectorXd& v, double rho, const VectorXd& w, VectorXd* gx,
+                           VectorXd* gv, StateForceGradient* grad) const {
+  if (empty()) return 0.0;
+  double drho = 0;
+  if (damping_) {
+    const VectorXd mw = unit_mass_.cwiseProduct(w);
+    gv->noalias() -= (*damping_ * rho) * mw;
+    grad->linear_damping -= rho * mw.dot(v);
+    drho -= *damping_ * mw.dot(v);
+  }
+  if (hydro_) {
+    const Eigen::Matrix3Xi& tri = hydro_->triangles;
+    for (int t = 0; t < tri.cols(); ++t) {
+      const int a = tri(0, t), b = tri(1, t), c = tri(2, t);
+      const Vec3 wt = (w.segment<3>(3 * a) + w.segment<3>(3 * b) + w.segment<3>(3 * c)) / 3.0;
+      const Vec3 u = MeanVelocity(v, a, b, c) - hydro_->flow_velocity;
+      const Vec3 xa = x.segment<3>(3 * a);
+      const Vec3 e1 = x.segment<3>(3 * b) - xa, e2 = x.segment<3>(3 * c) - xa;
+      Vec3 g_area, g_u;
+      HydrodynamicForceVjp(*hydro_, 0.5 * e1.cross(e2), u, wt, &g_area, &g_u, grad);
+      // N = e1 x e2 / 2: g . dN = de1 . (e2 x g) / 2 + de2 . (g x e1) / 2.
+      const Vec3 gb = 0.5 * e2.cross(g_area), gc = 0.5 * g_area.cross(e1);
+      gx->segment<3>(3 * a) -= gb + gc;
+      gx->segment<3>(3 * b) += gb;
+      gx->segment<3>(3 * c) += gc;
+      for (const int i : {a, b, c}) gv->segment<3>(3 * i) += g_u / 3.0;
+      grad->flow_velocity -= g_u;
+    }
+  }
+  if (!friction_.empty() && static_cast<int>(grad->penalty_friction.size()) != num_penalty_contacts_)
+    grad->penalty_friction.assign(num_penalty_contacts_, 0.0);
+  for (const FrictionNode& fn : friction_) {
+    const double gap = fn.normal.dot(x.segment<3>(3 * fn.node)) - fn.offset;
+    if (gap >= 0) continue;
+    const Vec3 wi = w.segment<3>(3 * fn.node);
+    const Vec3 vi = v.segment<3>(3 * fn.node);
+    const Vec3 vt = vi - fn.normal.dot(vi) * fn.normal;
+    const double s = std::sqrt(vt.squaredNorm() + fn.eps * fn.eps);
+    const double wvt = wi.dot(vt);
+    const double fn_mag = -fn.stiffness * gap;  // f_n
+    // f = -mu f_n vt / s.
+    gx->segment<3>(3 * fn.node) += (fn.mu * fn.stiffness * wvt / s) * fn.normal;
+    const Vec3 pw = wi - fn.normal.dot(wi) * fn.normal;
+    gv->segment<3>(3 * fn.node) -= fn.mu * fn_mag * (pw / s - (wvt / (s * s * s)) * vt);
+    grad->penalty_friction[fn.contact] -= fn_mag * wvt / s;
+  }
+  return drho;
+}
+
+}  // namespace diffpd::internal

@@ -1,0 +1,105 @@
+// `diffpd stress`: the command-line edge of stress.h.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "bench.h"
+#include "commands.h"
+#include "stress.h"
+
+namespace diffpd::problems {
+namespace {
+
+constexpr const char* kStressFooter = R"(
+Runs every (problem, method, E, nu, dt) case for --steps steps and
+classifies it:
+ ok        : finite states; total energy (kinetic + elastic + gravitational
+             potential) never above its start by more than --energy-tol
+             relative; finite gradients from the backward pass of the whole
+             rollout; on the first --gradcheck-steps steps the gradient matches
+             central finite differences (solves at rel_tolerance 1e-10) within
+             --gradcheck-tol (all inputs: x0, v0, forces, E, nu, rho);
+ failed    : a SolverError stopped the case: its status and message;
+ violation : a non-finite result without an error, energy growth, a gradient
+             mismatch or an unexpected error - a library bug.
+Exit code 4 when any case is a violation. JSON: a list of {problem, method,
+youngs_modulus, poissons_ratio, time_step, outcome, message, steps_completed,
+max_energy_excess, gradcheck_error, seconds}.
+Meshes: --refine doublings of each problem's cells (-6: cantilever 8x2x2,
+falling cube 2x2x2; -9: cantilever 4x1x1, cube 1 cell).)";
+
+struct StressArgs {
+  std::vector<std::string> problems = {"cantilever", "falling-cube"};
+  std::vector<std::string> methods = {"pd", "pd-lbfgs", "newton-pcg", "newton-cholesky"};
+  int refine = -6;
+  StressOptions options;
+  bool json = false;
+};
+
+int RunStressArgs(const StressArgs& args) {
+  StressOptions options = args.options;
+  options.methods = ParseMethods(args.methods);
+  options.problems.clear();
+  for (const auto& p : args.problems) options.problems.push_back({p, args.refine});
+  const auto cases = RunStress(options, &std::cerr);
+  int counts[3] = {0, 0, 0};
+  for (const auto& c : cases) ++counts[c.outcome == "ok" ? 0 : c.outcome == "failed" ? 1 : 2];
+  if (args.json) {
+    std::printf("%s\n", StressToJson(cases).dump(2).c_str());
+  } else {
+    std::printf("%-13s %-16s %8s %6s %8s %-10s %7s %11s %11s %9s  %s\n", "problem", "method", "E", "nu", "dt",
+                "outcome", "steps", "energy_exc", "gradcheck", "seconds", "message");
+    for (const auto& c : cases)
+      std::printf("%-13s %-16s %8.0e %6.3g %8.0e %-10s %7d %11.2e %11.2e %9.3f  %s\n", c.problem.c_str(),
+                  c.method.c_str(), c.youngs_modulus, c.poissons_ratio, c.time_step, c.outcome.c_str(),
+                  c.steps_completed, c.max_energy_excess, c.gradcheck_error, c.seconds, c.message.c_str());
+    std::printf("# %zu cases: %d ok, %d failed with a solver error, %d violations\n", cases.size(), counts[0],
+                counts[1], counts[2]);
+  }
+  if (counts[2] > 0) {
+    std::fprintf(stderr, "diffpd stress: %d case(s) violated the stability contract (see the table)\n", counts[2]);
+    return 4;
+  }
+  return 0;
+}
+
+}  // namespace
+
+Subcommand AddStressCommand(CLI::App* parent) {
+  auto args = std::make_shared<StressArgs>();
+  CLI::App* cmd = parent->add_subcommand(
+      "stress", "stability at the extremes of E, nu and dt: each case ok or a clear solver error, never NaN");
+  cmd->footer(kStressFooter);
+  StressOptions& o = args->options;
+  cmd->add_option("--problems", args->problems, "comma-separated problems: cantilever, falling-cube")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--methods", args->methods,
+                  "comma-separated methods: semi-implicit, newton-cholesky, newton-pcg, pd, pd-lbfgs")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--refine", args->refine, "cell doublings of every problem's mesh")->capture_default_str();
+  cmd->add_option("--E", o.youngs_moduli, "comma-separated Young's moduli (Pa)")->delimiter(',')->capture_default_str();
+  cmd->add_option("--nu", o.poissons_ratios, "comma-separated Poisson's ratios")->delimiter(',')->capture_default_str();
+  cmd->add_option("--dt", o.time_steps, "comma-separated time steps (s)")->delimiter(',')->capture_default_str();
+  cmd->add_option("--steps", o.steps, "steps per case")->capture_default_str();
+  cmd->add_option("--rtol", o.rel_tolerance, "relative tolerance of each step's solve")->capture_default_str();
+  cmd->add_option("--max-iterations", o.max_iterations, "iteration limit of each step's solve")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--threads", o.threads, "threads for element loops (0: OpenMP default)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--energy-tol", o.energy_tolerance, "allowed relative rise of the total energy")
+      ->capture_default_str();
+  cmd->add_option("--gradcheck-steps", o.gradcheck_steps, "steps of the finite-difference check (0: skip)")
+      ->capture_default_str();
+  cmd->add_option("--gradcheck-tol", o.gradcheck_tolerance, "allowed relative error of the gradient check")
+      ->capture_default_str();
+  cmd->add_option("--seed", o.seed, "seed of the loss and check directions")->capture_default_str();
+  cmd->add_flag("--json", args->json, "print one JSON document (a list) on stdout");
+  return {cmd, [args] { return RunStressArgs(*args); }};
+}
+
+}  // namespace diffpd::problems

@@ -1,0 +1,183 @@
+// Explicit state forces (linear damping, hydrodynamic drag and thrust,
+// penalty friction): vector-Jacobian products vs finite differences, boundary
+// triangles, physical behaviour, and rollout gradients w.r.t. the state and
+// the force parameters for PD and Newton.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "diffpd/simulator.h"
+#include "diffpd/state_forces.h"
+#include "forces/state_forces.h"
+#include "gradcheck.h"
+#include "test_scenes.h"
+
+namespace diffpd {
+namespace {
+
+VectorXd Random(int n, std::mt19937_64* rng, double scale = 1.0) {
+  std::normal_distribution<double> normal(0.0, scale);
+  VectorXd v(n);
+  for (int i = 0; i < n; ++i) v(i) = normal(*rng);
+  return v;
+}
+
+// A free 2x2x2 box swimming in a current, damped, sliding on a penalty floor.
+Scene SwimmerScene(bool tets = false) {
+  Scene scene;
+  scene.mesh = tets ? testing::BoxTetMesh(2, 2, 1, 0.1, 0.1, 0.05) : testing::BoxHexMesh(2, 2, 1, 0.1, 0.1, 0.05);
+  scene.material.youngs_modulus = 1e5;
+  scene.material.poissons_ratio = 0.4;
+  scene.material.density = 800;
+  scene.gravity = Vec3(0, 0, -9.81);
+  Hydrodynamics hydro;
+  hydro.triangles = BoundaryTriangles(scene.mesh);
+  hydro.thrust = 0.6;
+  hydro.flow_velocity = Vec3(0.1, -0.05, 0.02);
+  scene.hydrodynamics = hydro;
+  scene.linear_damping = 0.5;
+  PenaltyContact floor;
+  floor.offset = 0.002;  // the bottom nodes start 2 mm inside
+  floor.stiffness = 200;
+  floor.friction = 0.4;
+  floor.friction_velocity = 0.05;
+  for (int i = 0; i < scene.mesh.num_vertices(); ++i)
+    if (scene.mesh.vertices(2, i) < 1e-9) floor.nodes.push_back(i);
+  scene.penalty_contacts = {floor};
+  return scene;
+}
+
+TEST(BoundaryTrianglesTest, CoverTheBoundaryOnceAndPointOutward) {
+  for (const bool tets : {false, true}) {
+    const Mesh mesh = tets ? testing::BoxTetMesh(2, 3, 1, 0.2, 0.3, 0.1) : testing::BoxHexMesh(2, 3, 1, 0.2, 0.3, 0.1);
+    const Eigen::Matrix3Xi tri = BoundaryTriangles(mesh);
+    // 2 (2*3 + 2*1 + 3*1) quads, each 2 triangles.
+    EXPECT_EQ(tri.cols(), 2 * 2 * (6 + 2 + 3));
+    double volume = 0, area = 0;
+    Vec3 total = Vec3::Zero();
+    for (int t = 0; t < tri.cols(); ++t) {
+      const Vec3 a = mesh.vertices.col(tri(0, t)), b = mesh.vertices.col(tri(1, t)), c = mesh.vertices.col(tri(2, t));
+      volume += a.dot(b.cross(c)) / 6.0;  // divergence theorem: positive iff outward
+      total += 0.5 * (b - a).cross(c - a);
+      area += 0.5 * (b - a).cross(c - a).norm();
+    }
+    EXPECT_NEAR(volume, 0.2 * 0.3 * 0.1, 1e-12);
+    EXPECT_NEAR(area, 2 * (0.2 * 0.3 + 0.2 * 0.1 + 0.3 * 0.1), 1e-12);
+    EXPECT_LT(total.norm(), 1e-12);
+    EXPECT_EQ(BoundaryNodes(mesh).size(), 3u * 4u * 2u);  // every node of a 2x3x1 grid is on the boundary
+  }
+  EXPECT_EQ(BoundaryNodes(testing::BoxHexMesh(3, 3, 3, 1, 1, 1)).size(), 64u - 8u);
+}
+
+TEST(StateForcesTest, VectorJacobianProductsMatchFiniteDifferences) {
+  const Scene scene = SwimmerScene();
+  internal::FemModel fem(scene.mesh);
+  internal::StateForces forces(scene, fem.unit_lumped_mass());
+  const int n = scene.mesh.num_dofs();
+  std::mt19937_64 rng(4);
+  const double rho = scene.material.density;
+  for (int trial = 0; trial < 3; ++trial) {
+    VectorXd x = Eigen::Map<const VectorXd>(scene.mesh.vertices.data(), n) + Random(n, &rng, 0.003);
+    const VectorXd v = Random(n, &rng, 0.2);
+    const VectorXd w = Random(n, &rng);
+    VectorXd gx = VectorXd::Zero(n), gv = VectorXd::Zero(n);
+    StateForceGradient grad;
+    const double drho = forces.AddVjp(x, v, rho, w, &gx, &gv, &grad);
+    auto wf = [&](const VectorXd& xx, const VectorXd& vv, double r) {
+      VectorXd f = VectorXd::Zero(n);
+      forces.Add(xx, vv, r, &f);
+      return w.dot(f);
+    };
+    const VectorXd dx = Random(n, &rng), dv = Random(n, &rng);
+    const double eps = 1e-7;
+    const double fd_x = (wf(x + eps * dx, v, rho) - wf(x - eps * dx, v, rho)) / (2 * eps);
+    const double fd_v = (wf(x, v + eps * dv, rho) - wf(x, v - eps * dv, rho)) / (2 * eps);
+    const double fd_r = (wf(x, v, rho + 1e-3) - wf(x, v, rho - 1e-3)) / 2e-3;
+    EXPECT_NEAR(fd_x, gx.dot(dx), 1e-6 * std::abs(fd_x) + 1e-10);
+    EXPECT_NEAR(fd_v, gv.dot(dv), 1e-6 * std::abs(fd_v) + 1e-10);
+    EXPECT_NEAR(fd_r, drho, 1e-6 * std::abs(fd_r) + 1e-12);
+    // Parameters: perturb the scene.
+    auto param_fd = [&](const std::function<void(Scene*, double)>& perturb) {
+      Scene p = scene, m = scene;
+      perturb(&p, 1e-6);
+      perturb(&m, -1e-6);
+      VectorXd fp = VectorXd::Zero(n), fm = VectorXd::Zero(n);
+      internal::StateForces(p, fem.unit_lumped_mass()).Add(x, v, rho, &fp);
+      internal::StateForces(m, fem.unit_lumped_mass()).Add(x, v, rho, &fm);
+      return w.dot(fp - fm) / 2e-6;
+    };
+    auto near = [](double fd, double an) { EXPECT_NEAR(fd, an, 1e-6 * std::abs(an) + 1e-10); };
+    near(param_fd([](Scene* s, double e) { *s->linear_damping += e; }), grad.linear_damping);
+    near(param_fd([](Scene* s, double e) { s->hydrodynamics->fluid_density += e; }), grad.fluid_density);
+    near(param_fd([](Scene* s, double e) { s->hydrodynamics->drag_normal += e; }), grad.drag_normal);
+    near(param_fd([](Scene* s, double e) { s->hydrodynamics->drag_tangential += e; }), grad.drag_tangential);
+    near(param_fd([](Scene* s, double e) { s->hydrodynamics->thrust += e; }), grad.thrust);
+    near(param_fd([](Scene* s, double e) { s->hydrodynamics->flow_velocity(1) += e; }), grad.flow_velocity(1));
+    near(param_fd([](Scene* s, double e) { s->penalty_contacts[0].friction += e; }), grad.penalty_friction[0]);
+  }
+}
+
+TEST(StateForcesTest, LinearDampingDecaysTheVelocityOfAFreeBodyAtItsRate) {
+  Scene scene;
+  scene.mesh = testing::BoxHexMesh(2, 2, 2, 0.1, 0.1, 0.1);
+  scene.linear_damping = 2.0;
+  SolverOptions options;
+  options.method = Method::kPd;
+  options.time_step = 0.01;
+  options.rel_tolerance = 1e-10;
+  Simulator sim(scene, options);
+  State s = sim.RestState();
+  s.v = VectorXd::Constant(sim.num_dofs(), 0.3);
+  // Rigid translation: v_{i+1} = v_i + h (-c v_i) (explicit damping force).
+  for (int k = 1; k <= 10; ++k) {
+    s = sim.Step(s, StepInput());
+    EXPECT_NEAR(s.v(0), 0.3 * std::pow(1 - 0.01 * 2.0, k), 1e-9);
+  }
+}
+
+TEST(StateForcesTest, SceneWithoutStateForcesIsUnchangedByTheMachinery) {
+  const Scene plain = testing::SmallBeamScene();
+  Scene zero = plain;
+  zero.linear_damping = 0.0;
+  SolverOptions options;
+  options.method = Method::kNewtonCholesky;
+  Simulator a(plain, options), b(zero, options);
+  const Rollout ra = a.Simulate(a.RestState(), std::vector<StepInput>(3));
+  const Rollout rb = b.Simulate(b.RestState(), std::vector<StepInput>(3));
+  EXPECT_EQ((ra.states.back().x - rb.states.back().x).norm(), 0.0);
+}
+
+class StateForceGradientTest : public ::testing::TestWithParam<Method> {};
+
+TEST_P(StateForceGradientTest, RolloutGradientsWithRespectToStateAndForceParametersMatchFiniteDifferences) {
+  const Scene scene = SwimmerScene();
+  SolverOptions options;
+  options.method = GetParam();
+  options.time_step = 0.004;
+  options.rel_tolerance = 1e-12;
+  options.abs_tolerance = 1e-11;
+  options.backward_rel_tolerance = 1e-13;
+  options.max_iterations = 20000;
+  options.num_threads = 1;
+  Simulator sim(scene, options);
+  State initial = sim.RestState();
+  std::mt19937_64 rng(8);
+  initial.v = Random(sim.num_dofs(), &rng, 0.1);
+  const problems::GradCheckResult result = problems::CheckRolloutGradient(scene, options, initial, 3);
+  int parameters = 0;
+  for (const auto& entry : result.inputs) {
+    EXPECT_LT(entry.max_rel_error, 1e-5) << ToString(GetParam()) << " input " << entry.input;
+    for (const char* name : {"linear_damping", "fluid_density", "drag_tangential", "drag_normal", "thrust",
+                             "penalty_friction"})
+      if (entry.input == name) ++parameters;
+  }
+  EXPECT_EQ(parameters, 6);
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, StateForceGradientTest, ::testing::Values(Method::kPd, Method::kNewtonCholesky),
+                         [](const ::testing::TestParamInfo<Method>& info) {
+                           return info.param == Method::kPd ? std::string("pd") : std::string("newton_cholesky");
+                         });
+
+}  // namespace
+}  // namespace diffpd

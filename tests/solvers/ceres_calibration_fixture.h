@@ -1,0 +1,72 @@
+// A small synthetic calibration shared by the Ceres adapter tests: a clamped
+// beam swinging under gravity with an initial sideways velocity, captured
+// markers (three vertices and one element point) sampled at frames that do
+// not align with the simulation steps.
+#pragma once
+
+#include <vector>
+
+#include "diffpd/captured_motion.h"
+#include "diffpd/simulator.h"
+#include "diffpd/solvers/calibration_model.h"
+#include "test_scenes.h"
+
+namespace diffpd::testing {
+
+// The true material of the synthetic captures.
+inline MaterialParameters TrueMaterial() { return MaterialParameters{2e5, 0.4, 1e3}; }
+
+inline SolverOptions CalibrationSolverOptions(Method method) {
+  SolverOptions options;
+  options.method = method;
+  options.time_step = 0.01;
+  options.rel_tolerance = 1e-12;
+  options.abs_tolerance = 1e-11;
+  options.backward_rel_tolerance = 1e-12;
+  options.max_iterations = 20000;
+  options.num_threads = 1;
+  return options;
+}
+
+// Initial state: rest, with a sideways velocity growing along the beam.
+inline State SwingStart(const Simulator& sim) {
+  State s = sim.RestState();
+  for (int i = 0; i < s.x.size() / 3; ++i) s.v(3 * i + 1) = 2.0 * s.x(3 * i);
+  return s;
+}
+
+// Setup with motion synthesised from TrueMaterial() over `steps` steps of
+// 0.01 s, frames every 0.015 s, noise-free unless `noise` (m) > 0, and the
+// scene's material set to `start`.
+inline solvers::CalibrationSetup SyntheticSetup(Method method, bool tets, const MaterialParameters& start,
+                                                int steps = 8, double noise = 0) {
+  Scene scene = SmallBeamScene(tets);
+  scene.material = TrueMaterial();
+  const SolverOptions options = CalibrationSolverOptions(method);
+  Simulator truth(scene, options);
+  const State start_state = SwingStart(truth);
+  const Rollout rollout = truth.Simulate(start_state, std::vector<StepInput>(steps));
+  std::vector<Marker> markers;
+  int far = 0;
+  for (int v = 0; v < scene.mesh.num_vertices(); ++v)
+    if (scene.mesh.vertices(0, v) > scene.mesh.vertices(0, far) + 1e-9) far = v;
+  markers.push_back(Marker{0, far, -1, Vec3::Zero(), 0});
+  markers.push_back(Marker{1, far - 1, -1, Vec3::Zero(), 0});
+  markers.push_back(Marker{5, scene.mesh.num_vertices() / 2, -1, Vec3::Zero(), 0});
+  markers.push_back(Marker{7, -1, scene.mesh.num_elements() - 1,
+                           tets ? Vec3(0.2, 0.3, 0.1) : Vec3(0.5, -0.25, 0.75), 0});
+  std::vector<double> times;
+  for (double t = 0.015; t <= steps * 0.01 + 1e-12; t += 0.015) times.push_back(t);
+  solvers::CalibrationSetup setup;
+  setup.motion = SampleMarkers(scene.mesh, rollout.states, options.time_step, markers, times, noise, 2021);
+  // Per-axis weights: mm-scale residuals, the y axis (the swing) counted twice.
+  for (MarkerSample& s : setup.motion.samples) s.weight = Vec3(1e3, 2e3, 1e3);
+  scene.material = start;
+  setup.scene = scene;
+  setup.solver = options;
+  setup.initial = start_state;
+  setup.num_steps = steps;
+  return setup;
+}
+
+}  // namespace diffpd::testing

@@ -1,0 +1,313 @@
+// Tests of the Ipopt TNLP over a rollout (rollout_nlp.h), called directly,
+// without running Ipopt.
+#include "diffpd/solvers/rollout_nlp.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "diffpd/error.h"
+#include "ipopt_test_problems.h"
+
+namespace diffpd::testing {
+namespace {
+
+using solvers::RolloutNlp;
+
+// Central difference of a scalar function of x along variable j.
+template <typename Fn>
+double CentralDifference(Fn&& fn, VectorXd x, int j, double eps) {
+  const double x0 = x(j);
+  x(j) = x0 + eps;
+  const double plus = fn(x);
+  x(j) = x0 - eps;
+  const double minus = fn(x);
+  return (plus - minus) / (2 * eps);
+}
+
+// A step per variable that suits its units (forces ~0.05 N, velocities
+// ~0.05 m/s, positions ~1e-3 m, scaled material ~1).
+VectorXd StepSizes(const BeamNlp& p) {
+  VectorXd eps = VectorXd::Constant(p.nlp->num_variables(), 1e-5);
+  eps.segment(p.position_offset, 6).setConstant(1e-6);
+  return eps;
+}
+
+int ExpectedNonzeros(const BeamNlp& p) {
+  const int n = p.nlp->num_variables();
+  // Path constraint at state 2: per-step forces of steps 0 and 1, knots 0 and 1
+  // of the piecewise-linear signal (knot 2 starts at step 3), and every
+  // variable of the other blocks.
+  const int path = 2 + 2 + (n - 8);
+  return path + n + n + 2;
+}
+
+TEST(RolloutNlpTest, NlpInfoCountsVariablesConstraintsAndDeclaredNonzeros) {
+  BeamNlp p(TightNewton());
+  Ipopt::Index n, m, nnz_jac, nnz_h;
+  Ipopt::TNLP::IndexStyleEnum style;
+  ASSERT_TRUE(p.nlp->get_nlp_info(n, m, nnz_jac, nnz_h, style));
+  EXPECT_EQ(n, 11 + 3 + 6 + 2);
+  EXPECT_EQ(m, 4);
+  EXPECT_EQ(nnz_jac, ExpectedNonzeros(p));
+  EXPECT_EQ(nnz_h, 0);
+  EXPECT_EQ(style, Ipopt::TNLP::C_STYLE);
+}
+
+TEST(RolloutNlpTest, BoundsAndStartingPointComeFromTheBlocksAndConstraints) {
+  BeamNlp p(TightNewton());
+  const int n = p.nlp->num_variables(), m = p.nlp->num_constraints();
+  std::vector<double> xl(n), xu(n), gl(m), gu(m), x(n);
+  ASSERT_TRUE(p.nlp->get_bounds_info(n, xl.data(), xu.data(), m, gl.data(), gu.data()));
+  EXPECT_EQ(xl[p.force_offset], -0.5);
+  EXPECT_EQ(xu[p.force_offset + 9], 0.5);
+  EXPECT_EQ(xu[p.force_offset + 10], M_PI);  // the sinusoid's phase
+  EXPECT_LE(xl[p.velocity_offset], -1e19);  // unbounded: beyond Ipopt's infinity
+  EXPECT_GE(xu[p.velocity_offset], 1e19);
+  EXPECT_EQ(xl[p.material_offset], 0.5);
+  EXPECT_EQ(xu[p.material_offset + 1], 5.0);
+  EXPECT_EQ(gl[0], -1.0);
+  EXPECT_EQ(gu[2], 0.1);
+  EXPECT_LE(gl[3], -1e19);
+  EXPECT_EQ(gu[3], 1.0);
+  ASSERT_TRUE(p.nlp->get_starting_point(n, true, x.data(), false, nullptr, nullptr, m, false, nullptr));
+  EXPECT_EQ(x[p.force_offset + 10], 0.7);
+  EXPECT_EQ(x[p.velocity_offset + 2], 0.05);
+  EXPECT_EQ(x[p.material_offset], 2.0);  // E = 2e5 Pa at scale 1e5
+  EXPECT_EQ(x[p.material_offset + 1], 1.0);
+  // Multipliers cannot be warm-started.
+  EXPECT_FALSE(p.nlp->get_starting_point(n, true, x.data(), true, x.data(), x.data(), m, false, nullptr));
+  std::vector<Ipopt::TNLP::LinearityType> kinds(m);
+  ASSERT_TRUE(p.nlp->get_constraints_linearity(m, kinds.data()));
+  EXPECT_EQ(kinds[0], Ipopt::TNLP::NON_LINEAR);
+  EXPECT_EQ(kinds[3], Ipopt::TNLP::LINEAR);
+}
+
+TEST(RolloutNlpTest, JacobianStructureListsRowsInOrderAndOmitsLaterPerStepControlsOfPathConstraints) {
+  BeamNlp p(TightNewton());
+  Ipopt::Index n, m, nnz, nnz_h;
+  Ipopt::TNLP::IndexStyleEnum style;
+  ASSERT_TRUE(p.nlp->get_nlp_info(n, m, nnz, nnz_h, style));
+  std::vector<Ipopt::Index> rows(nnz), cols(nnz);
+  ASSERT_TRUE(p.nlp->eval_jac_g(n, nullptr, true, m, nnz, rows.data(), cols.data(), nullptr));
+  std::vector<std::vector<int>> per_row(m);
+  for (int k = 0; k < nnz; ++k) {
+    ASSERT_GE(rows[k], 0);
+    ASSERT_LT(rows[k], m);
+    if (k > 0) {
+      ASSERT_GE(rows[k], rows[k - 1]);
+    }
+    per_row[rows[k]].push_back(cols[k]);
+  }
+  // Path row: per-step forces 0, 1 (not 2..4), knots 0, 1 (not 2).
+  auto has = [&](int r, int c) { return std::find(per_row[r].begin(), per_row[r].end(), c) != per_row[r].end(); };
+  EXPECT_TRUE(has(0, p.force_offset + 0));
+  EXPECT_TRUE(has(0, p.force_offset + 1));
+  for (int s = 2; s < 5; ++s) EXPECT_FALSE(has(0, p.force_offset + s)) << "step " << s;
+  EXPECT_TRUE(has(0, p.force_offset + 6));
+  EXPECT_FALSE(has(0, p.force_offset + 7));
+  EXPECT_EQ(per_row[1].size(), size_t(n));
+  EXPECT_EQ(per_row[3], (std::vector<int>{p.force_offset + 0, p.force_offset + 6}));
+  // A wrong element count is refused.
+  EXPECT_FALSE(p.nlp->eval_jac_g(n, nullptr, true, m, nnz + 1, rows.data(), cols.data(), nullptr));
+}
+
+TEST(RolloutNlpTest, ObjectiveGradientMatchesCentralDifferencesNewton) {
+  BeamNlp p(TightNewton());
+  const VectorXd x = p.nlp->starting_point();
+  const int n = p.nlp->num_variables();
+  std::vector<double> grad(n);
+  ASSERT_TRUE(p.nlp->eval_grad_f(n, x.data(), true, grad.data()));
+  const VectorXd eps = StepSizes(p);
+  auto f = [&](const VectorXd& y) {
+    double v = 0;
+    EXPECT_TRUE(p.nlp->eval_f(n, y.data(), true, v));
+    return v;
+  };
+  const double scale = Eigen::Map<VectorXd>(grad.data(), n).cwiseAbs().maxCoeff();
+  ASSERT_GT(scale, 0);
+  for (int j = 0; j < n; ++j) {
+    const double fd = CentralDifference(f, x, j, eps(j));
+    EXPECT_NEAR(grad[j], fd, 1e-6 * std::max(std::abs(fd), 1e-2 * scale)) << "variable " << j;
+  }
+}
+
+TEST(RolloutNlpTest, ConstraintJacobianMatchesCentralDifferencesNewton) {
+  BeamNlp p(TightNewton());
+  const VectorXd x = p.nlp->starting_point();
+  const int n = p.nlp->num_variables(), m = p.nlp->num_constraints();
+  MatrixXd jac;
+  ASSERT_TRUE(p.nlp->ConstraintJacobian(x, &jac));
+  const VectorXd eps = StepSizes(p);
+  MatrixXd fd(m, n);
+  for (int j = 0; j < n; ++j) {
+    VectorXd plus = x, minus = x, g_plus, g_minus;
+    plus(j) += eps(j);
+    minus(j) -= eps(j);
+    ASSERT_TRUE(p.nlp->Constraints(plus, &g_plus));
+    ASSERT_TRUE(p.nlp->Constraints(minus, &g_minus));
+    fd.col(j) = (g_plus - g_minus) / (2 * eps(j));
+  }
+  for (int r = 0; r < m; ++r) {
+    const double scale = jac.row(r).cwiseAbs().maxCoeff();
+    ASSERT_GT(scale, 0) << "row " << r;
+    for (int j = 0; j < n; ++j)
+      EXPECT_NEAR(jac(r, j), fd(r, j), 1e-6 * std::max(std::abs(fd(r, j)), 1e-2 * scale))
+          << "row " << r << " variable " << j;
+  }
+  // Declared zeros are true zeros: the path constraint at state 2 does not
+  // move when the forces of steps 2..4 do (up to the last bits of the
+  // solves), while it does move with the force of step 1.
+  const double live = std::abs(fd(0, p.force_offset + 1));
+  ASSERT_GT(live, 1e-3);
+  for (int s = 2; s < 5; ++s) EXPECT_LE(std::abs(fd(0, p.force_offset + s)), 1e-9 * live) << "step " << s;
+}
+
+TEST(RolloutNlpTest, ValuesCallOfEvalJacGFillsTheDeclaredEntries) {
+  BeamNlp p(TightNewton());
+  const VectorXd x = p.nlp->starting_point();
+  Ipopt::Index n, m, nnz, nnz_h;
+  Ipopt::TNLP::IndexStyleEnum style;
+  ASSERT_TRUE(p.nlp->get_nlp_info(n, m, nnz, nnz_h, style));
+  std::vector<Ipopt::Index> rows(nnz), cols(nnz);
+  std::vector<double> values(nnz);
+  ASSERT_TRUE(p.nlp->eval_jac_g(n, nullptr, true, m, nnz, rows.data(), cols.data(), nullptr));
+  ASSERT_TRUE(p.nlp->eval_jac_g(n, x.data(), true, m, nnz, nullptr, nullptr, values.data()));
+  MatrixXd dense;
+  ASSERT_TRUE(p.nlp->ConstraintJacobian(x, &dense));
+  for (int k = 0; k < nnz; ++k) EXPECT_EQ(values[k], dense(rows[k], cols[k]));
+  EXPECT_EQ(values[nnz - 2], 1.0);  // the linear row's coefficients
+  EXPECT_EQ(values[nnz - 1], -2.0);
+}
+
+TEST(RolloutNlpTest, ObjectiveGradientMatchesADirectionalCentralDifferencePd) {
+  SolverOptions options = TightPd();
+  options.abs_tolerance = 1e-10;
+  BeamNlp p(options);
+  const VectorXd x = p.nlp->starting_point();
+  VectorXd grad;
+  ASSERT_TRUE(p.nlp->ObjectiveGradient(x, &grad));
+  // A fixed direction mixing every block, scaled to each variable's units.
+  VectorXd d = StepSizes(p) * 1e5;
+  for (int j = 0; j < d.size(); ++j) d(j) *= (j % 3 == 0 ? 1.0 : j % 3 == 1 ? -0.5 : 0.25);
+  const double eps = 1e-5;
+  double plus, minus;
+  ASSERT_TRUE(p.nlp->Objective(x + eps * d, &plus));
+  ASSERT_TRUE(p.nlp->Objective(x - eps * d, &minus));
+  const double fd = (plus - minus) / (2 * eps);
+  EXPECT_NEAR(grad.dot(d), fd, 1e-6 * std::abs(fd));
+}
+
+TEST(RolloutNlpTest, OneRolloutPerEvaluationPoint) {
+  BeamNlp p(TightNewton());
+  VectorXd x = p.nlp->starting_point();
+  const int n = p.nlp->num_variables(), m = p.nlp->num_constraints();
+  Ipopt::Index nnz, nnz_h;
+  Ipopt::TNLP::IndexStyleEnum style;
+  Ipopt::Index nn, mm;
+  ASSERT_TRUE(p.nlp->get_nlp_info(nn, mm, nnz, nnz_h, style));
+  double f;
+  std::vector<double> grad(n), g(m), jac(nnz);
+  ASSERT_TRUE(p.nlp->eval_f(n, x.data(), true, f));
+  ASSERT_TRUE(p.nlp->eval_grad_f(n, x.data(), false, grad.data()));
+  ASSERT_TRUE(p.nlp->eval_g(n, x.data(), false, m, g.data()));
+  ASSERT_TRUE(p.nlp->eval_jac_g(n, x.data(), false, m, nnz, nullptr, nullptr, jac.data()));
+  EXPECT_EQ(p.nlp->statistics().rollouts, 1);
+  // 1 adjoint for the objective, 1 per trajectory constraint.
+  EXPECT_EQ(p.nlp->statistics().backward_passes, 1 + 3);
+  // Repeating an evaluation at the same point costs nothing.
+  ASSERT_TRUE(p.nlp->eval_grad_f(n, x.data(), false, grad.data()));
+  ASSERT_TRUE(p.nlp->eval_f(n, x.data(), true, f));
+  EXPECT_EQ(p.nlp->statistics().rollouts, 1);
+  EXPECT_EQ(p.nlp->statistics().backward_passes, 4);
+  // A new point simulates once more, whatever new_x says.
+  x(0) += 1e-3;
+  ASSERT_TRUE(p.nlp->eval_g(n, x.data(), false, m, g.data()));
+  ASSERT_TRUE(p.nlp->eval_f(n, x.data(), false, f));
+  EXPECT_EQ(p.nlp->statistics().rollouts, 2);
+  EXPECT_GT(p.nlp->statistics().forward_seconds, 0);
+  EXPECT_GT(p.nlp->statistics().backward_seconds, 0);
+}
+
+TEST(RolloutNlpTest, FailedRolloutMakesEveryEvaluationReturnFalseAndRecovers) {
+  // PD with at most 3 iterations per step: the rest state converges at once
+  // (zero residual, no gravity), a large tip force does not.
+  Scene scene = SmallBeamScene();
+  scene.gravity.reset();
+  SolverOptions options = TightPd();
+  options.max_iterations = 3;
+  Simulator sim(scene, options);
+  const std::vector<int> tip = NodesAtXMax(scene.mesh);
+  RolloutNlp nlp(&sim, RestSetup(sim, 3));
+  std::vector<solvers::ExternalForceControl::Channel> channels(1);
+  channels[0] = {tip, Vec3::UnitZ(), std::make_unique<solvers::PerStepSignal>(3)};
+  nlp.AddVariables(std::make_unique<solvers::ExternalForceControl>(std::move(channels)));
+  const int n3 = sim.num_dofs() / 3;
+  nlp.AddObjective(std::make_unique<solvers::PointCoordinate>(solvers::Marker(n3, tip[0]), solvers::kFinalState, Vec3::UnitZ()));
+  nlp.AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(n3, tip[0]), 1, Vec3::UnitZ()), -1, 1);
+  const int n = nlp.num_variables(), m = nlp.num_constraints();
+  Ipopt::Index nn, mm, nnz, nnz_h;
+  Ipopt::TNLP::IndexStyleEnum style;
+  ASSERT_TRUE(nlp.get_nlp_info(nn, mm, nnz, nnz_h, style));
+  double f;
+  std::vector<double> grad(n), g(m), jac(nnz);
+  const VectorXd bad = VectorXd::Constant(n, 5.0);  // 5 N per node
+  EXPECT_FALSE(nlp.eval_f(n, bad.data(), true, f));
+  EXPECT_FALSE(nlp.eval_grad_f(n, bad.data(), false, grad.data()));
+  EXPECT_FALSE(nlp.eval_g(n, bad.data(), false, m, g.data()));
+  EXPECT_FALSE(nlp.eval_jac_g(n, bad.data(), false, m, nnz, nullptr, nullptr, jac.data()));
+  EXPECT_EQ(nlp.statistics().rollouts, 1);
+  EXPECT_EQ(nlp.statistics().failed_rollouts, 1);
+  EXPECT_NE(nlp.last_error().find("rollout: solver failed (maximum number of iterations reached)"), std::string::npos) << nlp.last_error();
+  EXPECT_TRUE(std::isinf(nlp.ConstraintViolation(bad)));
+  const VectorXd good = VectorXd::Zero(n);
+  EXPECT_TRUE(nlp.eval_f(n, good.data(), true, f));
+  EXPECT_TRUE(nlp.eval_jac_g(n, good.data(), false, m, nnz, nullptr, nullptr, jac.data()));
+}
+
+TEST(RolloutNlpTest, ConstraintViolationIsTheLargestBoundOrConstraintExcess) {
+  BeamNlp p(TightNewton());
+  VectorXd x = p.nlp->starting_point();
+  VectorXd g;
+  ASSERT_TRUE(p.nlp->Constraints(x, &g));
+  EXPECT_EQ(p.nlp->ConstraintViolation(x), std::max(0.0, std::abs(g(2)) - 0.1));
+  x(p.force_offset + 3) = 0.75;  // bound 0.5
+  ASSERT_TRUE(p.nlp->Constraints(x, &g));
+  EXPECT_NEAR(p.nlp->ConstraintViolation(x), std::max(0.25, std::abs(g(2)) - 0.1), 1e-15);
+}
+
+TEST(RolloutNlpTest, BadInputIsRefusedWithAMessage) {
+  Simulator sim(SmallBeamScene(), TightNewton());
+  solvers::RolloutSetup setup = RestSetup(sim, 0);
+  try {
+    RolloutNlp nlp(&sim, setup);
+    FAIL() << "no throw";
+  } catch (const InvalidInputError& e) {
+    EXPECT_STREQ(e.what(), "RolloutNlp: the base setup has no step (need K >= 1 inputs)");
+  }
+  RolloutNlp nlp(&sim, RestSetup(sim, 4));
+  try {
+    nlp.AddVariables(std::make_unique<solvers::InitialStateVariables>(solvers::InitialStateVariables::kVelocity,
+                                                                      std::vector<int>{1000}));
+    FAIL() << "no throw";
+  } catch (const InvalidInputError& e) {
+    EXPECT_STREQ(e.what(), "initial_velocity: node 1000 is out of range: the mesh has 45 nodes");
+  }
+  try {
+    nlp.AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(45, 0), 7, Vec3::UnitZ(), "late"),
+                      0, 1);
+    FAIL() << "no throw";
+  } catch (const InvalidInputError& e) {
+    EXPECT_STREQ(e.what(), "RolloutNlp: constraint 'late' reads state 7, outside the rollout's states [0, 4]");
+  }
+  try {
+    nlp.AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(45, 0), 1, Vec3::UnitZ(), "c"), 1, 0);
+    FAIL() << "no throw";
+  } catch (const InvalidInputError& e) {
+    EXPECT_STREQ(e.what(), "RolloutNlp: constraint 'c' bounds [1, 0] are invalid: need lower <= upper, no NaN");
+  }
+}
+
+}  // namespace
+}  // namespace diffpd::testing
