@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "diffpd/solver_options.h"
 
@@ -24,6 +25,12 @@ struct CommandArgs {
   double rel_tolerance = -1;  // -1: the command's default
   std::string out_dir;   // "" : no files
   bool json = false;
+  // Optimisation problems (Problem::Run): the reduced instance, whether to
+  // repeat the solve with newton-cholesky for the time ratio, and Ipopt
+  // options as "name=value" (int, number or string, passed unchanged).
+  bool small = false;
+  bool compare_newton = true;
+  std::vector<std::string> ipopt_options;
 };
 
 int ListCommand(bool json);

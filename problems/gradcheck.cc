@@ -99,7 +99,9 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
              analytic_a, check.relative_step);
     }
   }
-  // State-force parameters: a fresh simulator per perturbed scene.
+  // State-force parameters: a fresh simulator per perturbed scene. Forces are
+  // linear in them and act almost linearly: a larger step beats rounding.
+  const double force_step = 100 * check.relative_step;
   auto scene_loss = [&](const Scene& perturbed) {
     Simulator s(perturbed, options);
     return loss(s, initial, inputs);
@@ -116,17 +118,17 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   };
   if (scene.linear_damping)
     record_scene("linear_damping", [](Scene* p, double e) { *p->linear_damping += e; },
-                 grad.state_forces.linear_damping, check.relative_step * std::max(1.0, *scene.linear_damping));
+                 grad.state_forces.linear_damping, force_step * std::max(1.0, *scene.linear_damping));
   if (scene.hydrodynamics) {
     const Hydrodynamics& hy = *scene.hydrodynamics;
     record_scene("fluid_density", [](Scene* p, double e) { p->hydrodynamics->fluid_density += e; },
-                 grad.state_forces.fluid_density, check.relative_step * std::max(1.0, hy.fluid_density));
+                 grad.state_forces.fluid_density, force_step * std::max(1.0, hy.fluid_density));
     record_scene("drag_tangential", [](Scene* p, double e) { p->hydrodynamics->drag_tangential += e; },
-                 grad.state_forces.drag_tangential, check.relative_step);
+                 grad.state_forces.drag_tangential, force_step);
     record_scene("drag_normal", [](Scene* p, double e) { p->hydrodynamics->drag_normal += e; },
-                 grad.state_forces.drag_normal, check.relative_step);
+                 grad.state_forces.drag_normal, force_step);
     record_scene("thrust", [](Scene* p, double e) { p->hydrodynamics->thrust += e; }, grad.state_forces.thrust,
-                 check.relative_step);
+                 force_step);
   }
   bool any_friction = false;
   for (const auto& c : scene.penalty_contacts) any_friction = any_friction || c.friction > 0;
@@ -139,7 +141,7 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
                    for (auto& c : p->penalty_contacts)
                      if (c.friction > 0) c.friction += e;
                  },
-                 analytic, check.relative_step);
+                 analytic, force_step);
   }
   const MaterialParameters base = scene.material;
   auto material_loss = [&](MaterialParameters m) {

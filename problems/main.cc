@@ -6,6 +6,7 @@
 #include <string>
 
 #include "commands.h"
+#include "problem_registry.h"
 #include "diffpd/error.h"
 
 namespace {
@@ -39,6 +40,10 @@ int main(int argc, char** argv) {
   CLI::App* run = app.add_subcommand("run", "simulate a problem, print a per-step table and write results");
   AddCommonOptions(run, &run_args, &run_method);
   run->add_option("--out", run_args.out_dir, "directory for VTK frames (.vtu + .pvd) and summary.json");
+  run->add_flag("--small", run_args.small, "optimisation problems: the reduced instance (under a minute)");
+  run->add_flag("!--no-compare", run_args.compare_newton,
+                "optimisation problems: skip the repeat with newton-cholesky");
+  run->add_option("--ipopt", run_args.ipopt_options, "optimisation problems: Ipopt option name=value (repeatable)");
 
   CLI::App* grad = app.add_subcommand("gradcheck", "compare rollout gradients with central finite differences");
   AddCommonOptions(grad, &grad_args, &grad_method);
@@ -55,6 +60,8 @@ int main(int argc, char** argv) {
     if (*list) return diffpd::problems::ListCommand(list_json);
     if (*run) {
       run_args.method = diffpd::ParseMethod(run_method);
+      const int own = diffpd::problems::MakeProblem(run_args.problem)->Run(run_args);
+      if (own >= 0) return own;
       return diffpd::problems::RunCommand(run_args);
     }
     if (*grad) {

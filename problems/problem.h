@@ -12,6 +12,8 @@
 
 namespace diffpd::problems {
 
+struct CommandArgs;  // commands.h
+
 class Problem {
  public:
   virtual ~Problem() = default;
@@ -26,6 +28,10 @@ class Problem {
   virtual std::vector<StepInput> Inputs(const Simulator& sim, int steps) const {
     return std::vector<StepInput>(steps);
   }
+  // `diffpd run <problem>`: a problem that is more than a forward simulation
+  // (an optimisation) runs itself and returns the exit code; -1 (the
+  // default) means "simulate forward as usual".
+  virtual int Run(const CommandArgs& args) const { return -1; }
 };
 
 }  // namespace diffpd::problems

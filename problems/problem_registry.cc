@@ -1,7 +1,13 @@
 #include "problem_registry.h"
 
+#include "bouncing_ball.h"
+#include "bunny.h"
 #include "cantilever.h"
+#include "routing_tendon_opt.h"
+#include "cantilever_plane.h"
 #include "diffpd/error.h"
+#include "rolling_sphere.h"
+#include "routing_tendon.h"
 
 namespace diffpd::problems {
 
@@ -9,6 +15,12 @@ std::vector<std::unique_ptr<Problem>> AllProblems() {
   std::vector<std::unique_ptr<Problem>> all;
   all.push_back(std::make_unique<Cantilever>());
   all.push_back(std::make_unique<FallingCube>());
+  all.push_back(std::make_unique<CantileverWithPlane>());
+  all.push_back(std::make_unique<RollingSphere>());
+  all.push_back(std::make_unique<BouncingBall>());
+  // RoutingTendon's forward scene; `diffpd run routing-tendon` optimises its activations.
+  all.push_back(std::make_unique<RoutingTendonOpt>());
+  all.push_back(std::make_unique<Bunny>());
   return all;
 }
 

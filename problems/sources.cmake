@@ -12,3 +12,18 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/tradeoff_command.cc
   ${CMAKE_CURRENT_LIST_DIR}/stress.cc
   ${CMAKE_CURRENT_LIST_DIR}/stress_command.cc)
+# Trajectory and control optimisation with Ipopt (issue 6).
+list(APPEND DIFFPD_PROBLEMS_SOURCES
+  ${CMAKE_CURRENT_LIST_DIR}/shared_data.cc
+  ${CMAKE_CURRENT_LIST_DIR}/trajectory_optimization.cc
+  ${CMAKE_CURRENT_LIST_DIR}/bunny.cc
+  ${CMAKE_CURRENT_LIST_DIR}/routing_tendon_opt.cc)
+get_filename_component(DIFFPD_DEFAULT_SHARED_DATA_DIR "${CMAKE_CURRENT_LIST_DIR}/../../shared/data" ABSOLUTE)
+set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/shared_data.cc PROPERTIES
+  COMPILE_DEFINITIONS "DIFFPD_SHARED_DATA_DIR=\"${DIFFPD_DEFAULT_SHARED_DATA_DIR}\"")
+# Contact, muscles and state forces: problems and the contact benchmark scene.
+list(APPEND DIFFPD_PROBLEMS_SOURCES
+  ${CMAKE_CURRENT_LIST_DIR}/rolling_sphere.cc
+  ${CMAKE_CURRENT_LIST_DIR}/bouncing_ball.cc
+  ${CMAKE_CURRENT_LIST_DIR}/routing_tendon.cc
+  ${CMAKE_CURRENT_LIST_DIR}/cantilever_plane.cc)

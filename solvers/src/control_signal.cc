@@ -49,6 +49,10 @@ void PerStepSignal::Evaluate(const Eigen::Ref<const VectorXd>& c, VectorXd* valu
   if (jacobian) *jacobian = MatrixXd::Identity(num_steps(), num_steps());
 }
 
+VectorXd PerStepSignal::ConstantCoefficients(double value) const {
+  return VectorXd::Constant(num_steps(), value);
+}
+
 PiecewiseLinearSignal::PiecewiseLinearSignal(int num_steps, int knots) : ControlSignal(num_steps), knots_(knots) {
   RequireSteps(num_steps, 2);
   if (knots < 2 || knots > num_steps) {
@@ -79,6 +83,10 @@ int PiecewiseLinearSignal::FirstStep(int j) const {
   return num_steps();
 }
 
+VectorXd PiecewiseLinearSignal::ConstantCoefficients(double value) const {
+  return VectorXd::Constant(knots_, value);
+}
+
 FourierSignal::FourierSignal(int num_steps, double time_step, double period, int harmonics)
     : ControlSignal(num_steps) {
   RequirePositiveFinite(time_step, "time_step");
@@ -104,6 +112,12 @@ void FourierSignal::Evaluate(const Eigen::Ref<const VectorXd>& c, VectorXd* valu
   Linear(basis_, c, values, jacobian);
 }
 
+VectorXd FourierSignal::ConstantCoefficients(double value) const {
+  VectorXd c = VectorXd::Zero(num_coefficients());
+  c(0) = value;
+  return c;
+}
+
 SinusoidSignal::SinusoidSignal(int num_steps, double time_step, double period) : ControlSignal(num_steps) {
   RequirePositiveFinite(time_step, "time_step");
   RequirePositiveFinite(period, "period");
@@ -122,5 +136,7 @@ void SinusoidSignal::Evaluate(const Eigen::Ref<const VectorXd>& c, VectorXd* val
     jacobian->col(2) = (c(1) * angle.cos()).matrix();
   }
 }
+
+VectorXd SinusoidSignal::ConstantCoefficients(double value) const { return Eigen::Vector3d(value, 0, 0); }
 
 }  // namespace diffpd::solvers

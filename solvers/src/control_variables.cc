@@ -93,7 +93,9 @@ std::string InitialStateVariables::name() const {
   return quantity_ == kPosition ? "initial_position" : "initial_velocity";
 }
 
-void InitialStateVariables::CheckFits(int num_nodes, int num_steps) const { CheckNodesFit(nodes_, num_nodes, name()); }
+void InitialStateVariables::CheckFits(const Scene& scene, int num_steps) const {
+  CheckNodesFit(nodes_, scene.mesh.num_vertices(), name());
+}
 
 void InitialStateVariables::Apply(const Eigen::Ref<const VectorXd>& values, RolloutSetup* setup) const {
   VectorXd& target = quantity_ == kPosition ? setup->initial.x : setup->initial.v;
@@ -107,6 +109,18 @@ void InitialStateVariables::PullBack(const Eigen::Ref<const VectorXd>& values, c
   out.setZero();
   for (size_t i = 0; i < nodes_.size(); ++i)
     out.segment<3>(sharing_ == kShared ? 0 : 3 * i) += g.segment<3>(3 * nodes_[i]);
+}
+
+bool InitialStateVariables::AddDirection(const Eigen::Ref<const VectorXd>& values, int j, int num_steps,
+                                         InputDirection* direction) const {
+  VectorXd& target = quantity_ == kPosition ? direction->x0 : direction->v0;
+  const int axis = j % 3;
+  if (sharing_ == kShared) {
+    for (int node : nodes_) target(3 * node + axis) += 1;
+  } else {
+    target(3 * nodes_[j / 3] + axis) += 1;
+  }
+  return true;
 }
 
 // ---- ExternalForceControl ---------------------------------------------------
@@ -132,10 +146,10 @@ ExternalForceControl::ExternalForceControl(std::vector<Channel> channels)
   }
 }
 
-void ExternalForceControl::CheckFits(int num_nodes, int num_steps) const {
+void ExternalForceControl::CheckFits(const Scene& scene, int num_steps) const {
   for (size_t c = 0; c < channels_.size(); ++c) {
     const std::string what = "external_force channel " + std::to_string(c);
-    CheckNodesFit(channels_[c].nodes, num_nodes, what);
+    CheckNodesFit(channels_[c].nodes, scene.mesh.num_vertices(), what);
     if (channels_[c].signal->num_steps() != num_steps) {
       std::ostringstream msg;
       msg << what << ": its signal has " << channels_[c].signal->num_steps() << " steps, the rollout has "
@@ -181,6 +195,24 @@ int ExternalForceControl::FirstAffectedState(int j) const {
   return channels_[c].signal->FirstStep(j - offsets_[c]) + 1;
 }
 
+bool ExternalForceControl::AddDirection(const Eigen::Ref<const VectorXd>& values, int j, int num_steps,
+                                        InputDirection* direction) const {
+  int c = 0;
+  while (offsets_[c + 1] <= j) ++c;
+  const Channel& ch = channels_[c];
+  MatrixXd jacobian;
+  ch.signal->Evaluate(values.segment(offsets_[c], offsets_[c + 1] - offsets_[c]), nullptr, &jacobian);
+  const Eigen::Index n = direction->x0.size();
+  for (int k = 0; k < num_steps; ++k) {
+    const double ds = jacobian(k, j - offsets_[c]);
+    if (ds == 0) continue;
+    VectorXd& f = direction->external_force[k];
+    if (f.size() == 0) f = VectorXd::Zero(n);
+    for (int node : ch.nodes) f.segment<3>(3 * node) += ds * ch.direction;
+  }
+  return true;
+}
+
 // ---- MaterialVariables ------------------------------------------------------
 
 MaterialVariables::MaterialVariables(std::vector<Entry> entries, const MaterialParameters& start)
@@ -222,6 +254,110 @@ void MaterialVariables::PullBack(const Eigen::Ref<const VectorXd>& values, const
                                                            : grad.density;
     out(i) = g * entries_[i].scale;
   }
+}
+
+bool MaterialVariables::AddDirection(const Eigen::Ref<const VectorXd>& values, int j, int num_steps,
+                                     InputDirection* direction) const {
+  const double scale = entries_[j].scale;
+  switch (entries_[j].field) {
+    case kYoungsModulus: direction->youngs_modulus += scale; break;
+    case kPoissonsRatio: direction->poissons_ratio += scale; break;
+    case kDensity: direction->density += scale; break;
+  }
+  return true;
+}
+
+// ---- ActivationControl ------------------------------------------------------
+
+ActivationControl::ActivationControl(std::vector<Channel> channels)
+    : ControlVariables(0), channels_(std::move(channels)) {
+  if (channels_.empty()) throw InvalidInputError("activation: no channel");
+  offsets_.push_back(0);
+  VectorXd initial;
+  for (size_t c = 0; c < channels_.size(); ++c) {
+    const std::string what = "activation channel " + std::to_string(c);
+    if (channels_[c].muscle < 0) {
+      std::ostringstream msg;
+      msg << what << ": muscle " << channels_[c].muscle << " is invalid: must be >= 0";
+      throw InvalidInputError(msg.str());
+    }
+    for (size_t d = 0; d < c; ++d)
+      if (channels_[d].muscle == channels_[c].muscle) {
+        std::ostringstream msg;
+        msg << what << ": muscle " << channels_[c].muscle << " is already driven by channel " << d;
+        throw InvalidInputError(msg.str());
+      }
+    if (!channels_[c].signal) throw InvalidInputError(what + ": no signal");
+    if (channels_[c].signal->num_steps() != channels_[0].signal->num_steps()) {
+      std::ostringstream msg;
+      msg << what << ": its signal has " << channels_[c].signal->num_steps() << " steps, channel 0's has "
+          << channels_[0].signal->num_steps();
+      throw InvalidInputError(msg.str());
+    }
+    const int p = channels_[c].signal->num_coefficients();
+    Append(p);
+    offsets_.push_back(offsets_.back() + p);
+    initial.conservativeResize(offsets_.back());
+    initial.tail(p) = channels_[c].signal->ConstantCoefficients(1.0);
+  }
+  SetInitial(initial);
+}
+
+void ActivationControl::CheckFits(const Scene& scene, int num_steps) const {
+  for (size_t c = 0; c < channels_.size(); ++c) {
+    const std::string what = "activation channel " + std::to_string(c);
+    if (channels_[c].muscle >= static_cast<int>(scene.muscles.size())) {
+      std::ostringstream msg;
+      msg << what << ": muscle " << channels_[c].muscle << " is out of range: the scene has " << scene.muscles.size()
+          << " muscles";
+      throw InvalidInputError(msg.str());
+    }
+    if (channels_[c].signal->num_steps() != num_steps) {
+      std::ostringstream msg;
+      msg << what << ": its signal has " << channels_[c].signal->num_steps() << " steps, the rollout has "
+          << num_steps;
+      throw InvalidInputError(msg.str());
+    }
+  }
+}
+
+void ActivationControl::Apply(const Eigen::Ref<const VectorXd>& values, RolloutSetup* setup) const {
+  VectorXd s;
+  for (size_t c = 0; c < channels_.size(); ++c) {
+    const Channel& ch = channels_[c];
+    ch.signal->Evaluate(values.segment(offsets_[c], offsets_[c + 1] - offsets_[c]), &s, nullptr);
+    for (Eigen::Index k = 0; k < s.size(); ++k) {
+      VectorXd& a = setup->inputs[k].activation;
+      if (a.size() <= ch.muscle) {
+        const Eigen::Index old = a.size();
+        a.conservativeResize(ch.muscle + 1);
+        a.tail(a.size() - old).setOnes();
+      }
+      a(ch.muscle) = s(k);
+    }
+  }
+}
+
+void ActivationControl::PullBack(const Eigen::Ref<const VectorXd>& values, const RolloutGradient& grad,
+                                 Eigen::Ref<VectorXd> out) const {
+  VectorXd ds;
+  MatrixXd jacobian;
+  for (size_t c = 0; c < channels_.size(); ++c) {
+    const Channel& ch = channels_[c];
+    const int p = offsets_[c + 1] - offsets_[c];
+    ch.signal->Evaluate(values.segment(offsets_[c], p), nullptr, &jacobian);
+    ds = VectorXd::Zero(ch.signal->num_steps());
+    const Eigen::Index known = std::min<Eigen::Index>(ds.size(), grad.activation.size());
+    for (Eigen::Index k = 0; k < known; ++k)
+      if (grad.activation[k].size() > ch.muscle) ds(k) = grad.activation[k](ch.muscle);
+    out.segment(offsets_[c], p) = jacobian.transpose() * ds;
+  }
+}
+
+int ActivationControl::FirstAffectedState(int j) const {
+  int c = 0;
+  while (offsets_[c + 1] <= j) ++c;
+  return channels_[c].signal->FirstStep(j - offsets_[c]) + 1;
 }
 
 }  // namespace diffpd::solvers

@@ -62,6 +62,12 @@ RolloutNlp::RolloutNlp(Simulator* simulator, RolloutSetup base)
     throw InvalidInputError(msg.str());
   }
   base_.material.Validate();
+  // Muscles at rest where the base says nothing, so activation blocks can
+  // set single entries.
+  const Eigen::Index muscles = static_cast<Eigen::Index>(sim_->scene().muscles.size());
+  if (muscles > 0)
+    for (StepInput& in : base_.inputs)
+      if (in.activation.size() == 0) in.activation = VectorXd::Ones(muscles);
 }
 
 RolloutNlp::~RolloutNlp() = default;
@@ -74,7 +80,7 @@ const VectorXd& RolloutNlp::starting_point() const {
 
 int RolloutNlp::AddVariables(std::unique_ptr<ControlVariables> block) {
   if (!block) throw InvalidInputError("RolloutNlp: the variable block is null");
-  block->CheckFits(sim_->num_dofs() / 3, static_cast<int>(base_.inputs.size()));
+  block->CheckFits(sim_->scene(), static_cast<int>(base_.inputs.size()));
   const int offset = num_variables();
   const int size = block->size();
   lower_.conservativeResize(offset + size);
@@ -285,23 +291,111 @@ bool RolloutNlp::ComputeJacobian() {
   if (cache_->has_jac) return true;
   BuildStructure();
   return Guarded("constraint Jacobian", [&] {
-    const int K = cache_->rollout.num_steps();
     std::vector<double> values;
     values.reserve(nnz_jac_);
-    VectorXd row(num_variables());
-    for (size_t r = 0; r < constraints_.size(); ++r) {
-      LossGradient loss(K);
-      constraints_[r].g->AddGradient(cache_->rollout, 1.0, &loss);
-      row.setZero();
-      PullBackLoss(loss, constraints_[r].g->LastState(K), row);
-      for (int j : row_columns_[r]) values.push_back(row(j));
+    if (!constraints_.empty()) {
+      if (ResolvedJacobianMode() == JacobianMode::kForward) {
+        if (!ForwardModeAvailable()) {
+          last_error_ = "constraint Jacobian: forward mode does not cover this problem (muscle activations, contact, "
+                        "muscles or state forces); use JacobianMode::kReverse or kAuto";
+          return false;
+        }
+        JacobianForward(&values);
+      } else {
+        JacobianReverse(&values);
+      }
     }
-    for (const LinearConstraint& l : linear_)
-      values.insert(values.end(), l.coefficients.begin(), l.coefficients.end());
+    for (const LinearConstraint& l : linear_) values.insert(values.end(), l.coefficients.begin(), l.coefficients.end());
     cache_->jac = std::move(values);
     cache_->has_jac = true;
     return true;
   });
+}
+
+void RolloutNlp::JacobianReverse(std::vector<double>* values) {
+  const int K = cache_->rollout.num_steps();
+  VectorXd row(num_variables());
+  for (size_t r = 0; r < constraints_.size(); ++r) {
+    LossGradient loss(K);
+    constraints_[r].g->AddGradient(cache_->rollout, 1.0, &loss);
+    row.setZero();
+    PullBackLoss(loss, constraints_[r].g->LastState(K), row);
+    for (int j : row_columns_[r]) values->push_back(row(j));
+  }
+}
+
+void RolloutNlp::JacobianForward(std::vector<double>* values) {
+  const Rollout& rollout = cache_->rollout;
+  const int K = rollout.num_steps();
+  const int n = sim_->num_dofs();
+  std::vector<InputDirection> directions(num_variables());
+  for (const Block& b : blocks_)
+    for (int j = 0; j < b.block->size(); ++j) {
+      InputDirection& d = directions[b.offset + j];
+      d.x0 = VectorXd::Zero(n);
+      d.v0 = VectorXd::Zero(n);
+      d.external_force.assign(K, VectorXd());
+      const bool ok = b.block->AddDirection(cache_->x.segment(b.offset, b.block->size()), j, K, &d);
+      DIFFPD_CHECK(ok, "block " << b.block->name() << " lost its forward mode");
+    }
+  if (!SameMaterial(rollout.material, sim_->scene().material)) sim_->SetMaterial(rollout.material);
+  const auto start = Clock::now();
+  TangentRollout tangents;
+  try {
+    tangents = sim_->Tangents(rollout, directions);
+  } catch (...) {
+    stats_.backward_seconds += Seconds(start);
+    ++stats_.backward_passes;
+    ++stats_.tangent_passes;
+    throw;
+  }
+  stats_.backward_seconds += Seconds(start);
+  ++stats_.backward_passes;
+  ++stats_.tangent_passes;
+  VectorXd row(num_variables());
+  for (size_t r = 0; r < constraints_.size(); ++r) {
+    LossGradient loss(K);
+    constraints_[r].g->AddGradient(rollout, 1.0, &loss);
+    row.setZero();
+    for (int k = 0; k <= K; ++k) {
+      if (loss.dx[k].size()) row.noalias() += tangents.dx[k].transpose() * loss.dx[k];
+      if (loss.dv[k].size()) row.noalias() += tangents.dv[k].transpose() * loss.dv[k];
+    }
+    for (int j : row_columns_[r]) values->push_back(row(j));
+  }
+}
+
+bool RolloutNlp::ForwardModeAvailable() const {
+  const Scene& scene = sim_->scene();
+  if (!scene.muscles.empty() || !scene.frictional_contacts.empty() || !scene.penalty_contacts.empty() ||
+      scene.hydrodynamics || scene.linear_damping)
+    return false;
+  const int K = static_cast<int>(base_.inputs.size());
+  const int n = sim_->num_dofs();
+  for (const Block& b : blocks_) {
+    if (b.block->size() == 0) continue;
+    InputDirection probe;
+    probe.x0 = VectorXd::Zero(n);
+    probe.v0 = VectorXd::Zero(n);
+    probe.external_force.assign(K, VectorXd());
+    if (!b.block->AddDirection(b.block->initial(), 0, K, &probe)) return false;
+  }
+  return true;
+}
+
+JacobianMode RolloutNlp::ResolvedJacobianMode() const {
+  if (jacobian_mode_ != JacobianMode::kAuto) return jacobian_mode_;
+  return ForwardModeAvailable() && num_variables() < static_cast<int>(constraints_.size()) ? JacobianMode::kForward
+                                                                                           : JacobianMode::kReverse;
+}
+
+const char* ToString(JacobianMode mode) {
+  switch (mode) {
+    case JacobianMode::kAuto: return "auto";
+    case JacobianMode::kReverse: return "reverse";
+    case JacobianMode::kForward: return "forward";
+  }
+  return "unknown";
 }
 
 void RolloutNlp::BuildStructure() {

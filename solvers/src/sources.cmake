@@ -12,4 +12,4 @@ list(APPEND DIFFPD_SOLVERS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/calibration_model.cc
   ${CMAKE_CURRENT_LIST_DIR}/marker_cost_function.cc
   ${CMAKE_CURRENT_LIST_DIR}/rollout_loss_function.cc
-  ${CMAKE_CURRENT_LIST_DIR}/log_manifold.cc)
+  ${CMAKE_CURRENT_LIST_DIR}/coordinate_manifold.cc)

@@ -136,20 +136,28 @@ void PointTravel::AddGradient(const Rollout& rollout, double weight, LossGradien
 
 // ---- PointDistanceSquared -----------------------------------------------------
 
-PointDistanceSquared::PointDistanceSquared(TrackedPoint point, int step, Vec3 target, std::string name)
-    : point_(std::move(point)), step_(step), target_(CheckedFinite(target, name, "target")), name_(std::move(name)) {
+PointDistanceSquared::PointDistanceSquared(TrackedPoint point, int step, Vec3 target, std::string name,
+                                           Vec3 axis_weights)
+    : point_(std::move(point)),
+      step_(step),
+      target_(CheckedFinite(target, name, "target")),
+      name_(std::move(name)),
+      weights_(axis_weights) {
   CheckStep(step, name_);
+  if (!weights_.allFinite() || (weights_.array() < 0).any())
+    throw InvalidInputError(name_ + ": the axis weights must be finite and >= 0");
 }
 
 int PointDistanceSquared::LastState(int num_steps) const { return Resolve(step_, num_steps); }
 
 double PointDistanceSquared::Value(const Rollout& rollout) const {
-  return (point_.At(PositionsAt(rollout, step_, name_)) - target_).squaredNorm();
+  const Vec3 r = point_.At(PositionsAt(rollout, step_, name_)) - target_;
+  return r.cwiseProduct(r).dot(weights_);
 }
 
 void PointDistanceSquared::AddGradient(const Rollout& rollout, double weight, LossGradient* loss) const {
   const Vec3 r = point_.At(PositionsAt(rollout, step_, name_)) - target_;
-  AddPointGradient(rollout, step_, point_, 2 * r, weight, loss);
+  AddPointGradient(rollout, step_, point_, 2 * weights_.cwiseProduct(r), weight, loss);
 }
 
 // ---- AxisAlignment ------------------------------------------------------------

@@ -1,1 +1,2 @@
 diffpd_add_test(muscle_forces_test ${CMAKE_CURRENT_LIST_DIR}/muscle_forces_test.cc LIBS diffpd_problems)
+diffpd_add_test(penalty_contact_energy_test ${CMAKE_CURRENT_LIST_DIR}/penalty_contact_energy_test.cc)

@@ -8,6 +8,7 @@
 
 #include "diffpd/simulator.h"
 #include "diffpd/state_forces.h"
+#include "fem/fem_model.h"
 #include "forces/state_forces.h"
 #include "gradcheck.h"
 #include "test_scenes.h"
@@ -162,7 +163,7 @@ TEST_P(StateForceGradientTest, RolloutGradientsWithRespectToStateAndForceParamet
   Simulator sim(scene, options);
   State initial = sim.RestState();
   std::mt19937_64 rng(8);
-  initial.v = Random(sim.num_dofs(), &rng, 0.1);
+  initial.v = Random(sim.num_dofs(), &rng, 0.5);
   const problems::GradCheckResult result = problems::CheckRolloutGradient(scene, options, initial, 3);
   int parameters = 0;
   for (const auto& entry : result.inputs) {

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "diffpd/error.h"
+#include "diffpd/state_forces.h"
 #include "diffpd/simulator.h"
 #include "test_scenes.h"
 
@@ -203,7 +204,9 @@ TEST(TangentRolloutTest, PdReusesTheForwardFactorForEveryColumn) {
     loss.dx[3] = VectorXd::Ones(sim.num_dofs());
     const RolloutGradient g = sim.Backward(rollout, loss);
     EXPECT_EQ(t.report.fallbacks, static_cast<int>(dirs.size()) * g.report.fallbacks);
-    if (backward == PdBackwardMethod::kLbfgs) EXPECT_EQ(t.report.fallbacks, 0);
+    if (backward == PdBackwardMethod::kLbfgs) {
+      EXPECT_EQ(t.report.fallbacks, 0);
+    }
     last.push_back(t.dx.back());
   }
   EXPECT_LT((last[0] - last[1]).norm(), 1e-8 * last[0].norm());
@@ -260,6 +263,123 @@ TEST(TangentRolloutTest, RejectsBadDirectionsWithMessages) {
   EXPECT_EQ(message({InputDirection::Density()}),
             "Tangents: the rollout was made with another material, time step or method than the simulator's "
             "current ones");
+}
+
+// A small box (2 x 2 x 2 hexes, 4 cm) dropped onto the plane z = 0 with a
+// sideways velocity: its bottom nodes touch during the rollout.
+Scene DroppedBoxScene() {
+  Scene scene;
+  scene.mesh = MakeBoxHexMesh(Eigen::Vector3i(2, 2, 2), Vec3(0.04, 0.04, 0.04), Vec3(0, 0, 0.002));
+  scene.material = MaterialParameters{1e5, 0.4, 1e3};
+  scene.gravity = Vec3(0, 0, -9.81);
+  FrictionalContact contact;
+  contact.surface = ContactSurface::Plane(Vec3(0, 0, 1), 0.0);
+  contact.nodes = BoundaryNodes(scene.mesh);
+  scene.frictional_contacts = {contact};
+  return scene;
+}
+
+// Tangents through frictional contact (active set held fixed, pins
+// differentiated) vs reverse mode and central differences; the differences
+// stay on the same piece of the trajectory (same active sets).
+TEST(TangentRolloutTest, FrictionalContactTangentsMatchReverseModeAndFiniteDifferences) {
+  const Scene scene = DroppedBoxScene();
+  for (Method method : {Method::kNewtonCholesky, Method::kPd}) {
+    SolverOptions options = TightOptions(method);
+    options.time_step = 0.005;
+    Simulator sim(scene, options);
+    State start = sim.RestState();
+    for (int i = 0; i < start.v.size() / 3; ++i) start.v.segment<3>(3 * i) = Vec3(0.3, 0.1, -0.5);
+    const int steps = 6;
+    const Rollout rollout = sim.Simulate(start, std::vector<StepInput>(steps));
+    int contact_steps = 0;
+    for (const StepReport& r : rollout.reports) contact_steps += !r.contact_nodes.empty();
+    ASSERT_GE(contact_steps, 3) << ToString(method);
+    InputDirection e = InputDirection::YoungsModulus();
+    e.youngs_modulus = scene.material.youngs_modulus;
+    InputDirection v0;
+    v0.v0 = VectorXd::Zero(sim.num_dofs());
+    for (int i = 0; i < sim.num_dofs() / 3; ++i) v0.v0.segment<3>(3 * i) = Vec3(0.1, -0.2, 0.05);
+    InputDirection x0;
+    x0.x0 = 0.1 * v0.v0;
+    const std::vector<InputDirection> dirs = {e, v0, x0};
+    const TangentRollout t = sim.Tangents(rollout, dirs);
+    LossGradient loss(steps);
+    std::mt19937_64 rng(5);
+    loss.dx[steps] = RandomVector(sim.num_dofs(), &rng, 1.0);
+    loss.dv[steps - 2] = RandomVector(sim.num_dofs(), &rng, 0.01);
+    const RolloutGradient g = sim.Backward(rollout, loss);
+    const double reverse[3] = {g.youngs_modulus * e.youngs_modulus, g.v0.dot(v0.v0), g.x0.dot(x0.x0)};
+    for (int p = 0; p < 3; ++p) {
+      const double forward = loss.dx[steps].dot(t.dx[steps].col(p)) + loss.dv[steps - 2].dot(t.dv[steps - 2].col(p));
+      EXPECT_NEAR(forward, reverse[p], 1e-8 * std::abs(reverse[p])) << ToString(method) << " direction " << p;
+      const double eps = 1e-6;
+      const Rollout plus = Perturbed(scene, options, start, steps, dirs[p], eps);
+      const Rollout minus = Perturbed(scene, options, start, steps, dirs[p], -eps);
+      for (int k = 0; k < steps; ++k) ASSERT_EQ(plus.reports[k].contact_nodes, rollout.reports[k].contact_nodes);
+      const VectorXd fd = (plus.states[steps].x - minus.states[steps].x) / (2 * eps);
+      EXPECT_LT((t.dx[steps].col(p) - fd).norm(), 1e-6 * fd.norm()) << ToString(method) << " direction " << p;
+    }
+  }
+}
+
+// Tangents along per-step muscle activations vs central differences.
+TEST(TangentRolloutTest, ActivationTangentsMatchFiniteDifferences) {
+  Scene scene = testing::SmallBeamScene();
+  Muscle muscle;
+  for (int e = 0; e < scene.mesh.num_elements(); e += 2) muscle.elements.push_back(e);
+  muscle.fibers = {Vec3(1, 0, 0)};
+  muscle.stiffness = 3e5;
+  scene.muscles = {muscle};
+  const int steps = 4;
+  for (Method method : {Method::kNewtonCholesky, Method::kSemiImplicit}) {
+    SolverOptions options = TightOptions(method);
+    const int k_steps = method == Method::kSemiImplicit ? 20 : steps;
+    Simulator sim(scene, options);
+    std::vector<StepInput> inputs(k_steps);
+    for (int k = 0; k < k_steps; ++k) inputs[k].activation = VectorXd::Constant(1, 0.9 - 0.01 * k);
+    const Rollout rollout = sim.Simulate(MovingStart(sim), inputs);
+    InputDirection d;
+    for (int k = 0; k < k_steps; ++k) d.activation.push_back(k == 1 ? VectorXd() : VectorXd::Constant(1, 0.5 + 0.1 * k));
+    const TangentRollout t = sim.Tangents(rollout, {d, InputDirection::PoissonsRatio()});
+    const double eps = 1e-6;
+    std::vector<StepInput> plus = inputs, minus = inputs;
+    for (int k = 0; k < k_steps; ++k)
+      if (d.activation[k].size()) {
+        plus[k].activation += eps * d.activation[k];
+        minus[k].activation -= eps * d.activation[k];
+      }
+    const VectorXd fd =
+        (sim.Simulate(MovingStart(sim), plus).states.back().x - sim.Simulate(MovingStart(sim), minus).states.back().x) /
+        (2 * eps);
+    EXPECT_GT(fd.norm(), 0.0);
+    EXPECT_LT((t.dx.back().col(0) - fd).norm(), 1e-6 * fd.norm()) << ToString(method);
+  }
+  Simulator sim(scene, TightOptions(Method::kPd));
+  const Rollout rollout = sim.Simulate(sim.RestState(), std::vector<StepInput>(2));
+  InputDirection bad;
+  bad.activation = {VectorXd::Ones(2), VectorXd()};
+  try {
+    sim.Tangents(rollout, {bad});
+    FAIL();
+  } catch (const InvalidInputError& e) {
+    EXPECT_STREQ(e.what(), "Tangents: direction 0 has an activation with 2 entries, expected 1 (one per muscle)");
+  }
+}
+
+TEST(TangentRolloutTest, StateForcesAreRejectedUntilSupported) {
+  Scene scene = testing::SmallBeamScene();
+  scene.linear_damping = 0.5;
+  Simulator sim(scene, TightOptions(Method::kNewtonCholesky));
+  const Rollout rollout = sim.Simulate(sim.RestState(), std::vector<StepInput>(2));
+  try {
+    sim.Tangents(rollout, {InputDirection::Density()});
+    FAIL();
+  } catch (const InvalidInputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "Tangents: explicit state forces (linear damping, hydrodynamics, penalty friction) are not "
+                 "differentiated in forward mode yet; use Backward");
+  }
 }
 
 }  // namespace

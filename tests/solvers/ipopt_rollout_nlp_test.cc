@@ -277,6 +277,126 @@ TEST(RolloutNlpTest, ConstraintViolationIsTheLargestBoundOrConstraintExcess) {
   EXPECT_NEAR(p.nlp->ConstraintViolation(x), std::max(0.25, std::abs(g(2)) - 0.1), 1e-15);
 }
 
+TEST(RolloutNlpTest, ForwardModeJacobianEqualsReverseMode) {
+  BeamNlp p(TightNewton());
+  const VectorXd x = p.nlp->starting_point();
+  ASSERT_TRUE(p.nlp->ForwardModeAvailable());
+  EXPECT_EQ(p.nlp->ResolvedJacobianMode(), solvers::JacobianMode::kReverse);  // 22 variables, 3 constraints
+  MatrixXd reverse, forward;
+  p.nlp->SetJacobianMode(solvers::JacobianMode::kReverse);
+  ASSERT_TRUE(p.nlp->ConstraintJacobian(x, &reverse));
+  EXPECT_EQ(p.nlp->statistics().tangent_passes, 0);
+  // A fresh NLP, so that nothing is cached.
+  BeamNlp q(TightNewton());
+  q.nlp->SetJacobianMode(solvers::JacobianMode::kForward);
+  ASSERT_TRUE(q.nlp->ConstraintJacobian(x, &forward)) << q.nlp->last_error();
+  EXPECT_EQ(q.nlp->statistics().tangent_passes, 1);
+  EXPECT_EQ(q.nlp->statistics().backward_passes, 1);
+  for (int r = 0; r < reverse.rows(); ++r)
+    for (int j = 0; j < reverse.cols(); ++j)
+      EXPECT_NEAR(forward(r, j), reverse(r, j), 1e-9 * reverse.row(r).cwiseAbs().maxCoeff()) << r << ", " << j;
+}
+
+TEST(RolloutNlpTest, AutoModeChoosesForwardForFewVariablesAndManyConstraints) {
+  // 3 variables (the tip's initial velocity), 4 path constraints.
+  auto make = [](Simulator* sim) {
+    const std::vector<int> tip = NodesAtXMax(sim->scene().mesh);
+    auto nlp = std::make_unique<RolloutNlp>(sim, RestSetup(*sim, 4));
+    nlp->AddVariables(std::make_unique<solvers::InitialStateVariables>(solvers::InitialStateVariables::kVelocity, tip));
+    const int n = sim->scene().mesh.num_vertices();
+    for (int k = 1; k <= 4; ++k)
+      nlp->AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(n, tip[0]), k, Vec3::UnitZ()), -1, 1);
+    return nlp;
+  };
+  Simulator sim_a(SmallBeamScene(), TightNewton()), sim_b(SmallBeamScene(), TightNewton());
+  auto automatic = make(&sim_a), reverse = make(&sim_b);
+  reverse->SetJacobianMode(solvers::JacobianMode::kReverse);
+  EXPECT_EQ(automatic->ResolvedJacobianMode(), solvers::JacobianMode::kForward);
+  const VectorXd x = VectorXd::Constant(3, 0.01);
+  MatrixXd jac_auto, jac_reverse;
+  ASSERT_TRUE(automatic->ConstraintJacobian(x, &jac_auto));
+  ASSERT_TRUE(reverse->ConstraintJacobian(x, &jac_reverse));
+  EXPECT_EQ(automatic->statistics().tangent_passes, 1);
+  EXPECT_EQ(automatic->statistics().backward_passes, 1);
+  EXPECT_EQ(reverse->statistics().backward_passes, 4);
+  EXPECT_LE((jac_auto - jac_reverse).cwiseAbs().maxCoeff(), 1e-10 * jac_reverse.cwiseAbs().maxCoeff());
+  EXPECT_GT(jac_auto(3, 2), jac_auto(0, 2));  // a z velocity lifts the tip more the longer it acts
+}
+
+// The beam with two muscles (upper and lower half of the elements, fibres
+// along x) driven by activations: one per-step channel, one Fourier channel.
+struct MuscleBeam {
+  static constexpr int kSteps = 4;
+  std::unique_ptr<Simulator> sim;
+  Ipopt::SmartPtr<RolloutNlp> nlp;
+
+  MuscleBeam() {
+    Scene scene = SmallBeamScene();
+    Muscle upper, lower;
+    for (int e = 0; e < scene.mesh.num_elements(); ++e) {
+      double z = 0;
+      for (int a = 0; a < 8; ++a) z += scene.mesh.vertices(2, scene.mesh.elements(a, e)) / 8;
+      (z > 0.02 ? upper : lower).elements.push_back(e);
+    }
+    upper.fibers = lower.fibers = {Vec3::UnitX()};
+    upper.stiffness = lower.stiffness = 1e5;
+    scene.muscles = {upper, lower};
+    sim = std::make_unique<Simulator>(scene, TightNewton());
+    nlp = new RolloutNlp(sim.get(), RestSetup(*sim, kSteps));
+    std::vector<solvers::ActivationControl::Channel> channels(2);
+    channels[0] = {0, std::make_unique<solvers::PerStepSignal>(kSteps)};
+    channels[1] = {1, std::make_unique<solvers::FourierSignal>(kSteps, 0.01, 0.04, 1)};
+    auto activation = std::make_unique<solvers::ActivationControl>(std::move(channels));
+    VectorXd a0(7);
+    a0 << 0.9, 0.95, 1.0, 0.85, 1.0, 0.05, -0.03;
+    activation->SetInitial(a0);
+    nlp->AddVariables(std::move(activation));
+    const std::vector<int> tip = NodesAtXMax(scene.mesh);
+    const int n = scene.mesh.num_vertices();
+    nlp->AddObjective(std::make_unique<solvers::PointDistanceSquared>(
+        solvers::MeanOf(n, tip), solvers::kFinalState, solvers::MeanOf(n, tip).At(sim->RestState().x) - Vec3(0.01, 0, 0.01)));
+    nlp->AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(n, tip[0]), 2, Vec3::UnitX()), -1, 1);
+  }
+};
+
+TEST(RolloutNlpTest, ActivationGradientAndJacobianMatchCentralDifferences) {
+  MuscleBeam p;
+  EXPECT_FALSE(p.nlp->ForwardModeAvailable());
+  EXPECT_EQ(p.nlp->ResolvedJacobianMode(), solvers::JacobianMode::kReverse);
+  // A block with activations starts at rest (a = 1) by default.
+  {
+    std::vector<solvers::ActivationControl::Channel> channels(1);
+    channels[0] = {1, std::make_unique<solvers::FourierSignal>(4, 0.01, 0.04, 1)};
+    solvers::ActivationControl rest(std::move(channels));
+    EXPECT_EQ(rest.initial(), (VectorXd(3) << 1.0, 0.0, 0.0).finished());
+  }
+  const VectorXd x = p.nlp->starting_point();
+  VectorXd grad;
+  MatrixXd jac;
+  ASSERT_TRUE(p.nlp->ObjectiveGradient(x, &grad)) << p.nlp->last_error();
+  ASSERT_TRUE(p.nlp->ConstraintJacobian(x, &jac));
+  ASSERT_GT(grad.cwiseAbs().maxCoeff(), 0);
+  const double eps = 1e-5;
+  for (int j = 0; j < x.size(); ++j) {
+    VectorXd plus = x, minus = x;
+    plus(j) += eps;
+    minus(j) -= eps;
+    double fp, fm;
+    VectorXd gp, gm;
+    ASSERT_TRUE(p.nlp->Objective(plus, &fp));
+    ASSERT_TRUE(p.nlp->Constraints(plus, &gp));
+    ASSERT_TRUE(p.nlp->Objective(minus, &fm));
+    ASSERT_TRUE(p.nlp->Constraints(minus, &gm));
+    const double fd = (fp - fm) / (2 * eps), fd_g = (gp(0) - gm(0)) / (2 * eps);
+    EXPECT_NEAR(grad(j), fd, 1e-6 * std::max(std::abs(fd), 1e-2 * grad.cwiseAbs().maxCoeff())) << "variable " << j;
+    EXPECT_NEAR(jac(0, j), fd_g, 1e-6 * std::max(std::abs(fd_g), 1e-2 * jac.cwiseAbs().maxCoeff())) << "variable " << j;
+  }
+  // The path constraint at state 2 has no entry for the per-step activations
+  // of steps 2 and 3.
+  EXPECT_EQ(jac(0, 2), 0.0);
+  EXPECT_EQ(jac(0, 3), 0.0);
+}
+
 TEST(RolloutNlpTest, BadInputIsRefusedWithAMessage) {
   Simulator sim(SmallBeamScene(), TightNewton());
   solvers::RolloutSetup setup = RestSetup(sim, 0);

@@ -23,6 +23,7 @@ struct InputDirection {
   VectorXd x0;                          // 3n, m: initial positions
   VectorXd v0;                          // 3n, m/s: initial velocities
   std::vector<VectorXd> external_force; // empty, or one per step (each 3n or empty), N
+  std::vector<VectorXd> activation;     // empty, or one per step (each one per muscle or empty)
   double youngs_modulus = 0;            // Pa
   double poissons_ratio = 0;            // dimensionless
   double density = 0;                   // kg/m^3

@@ -13,6 +13,8 @@ ActiveSetErasure& ActiveSetErasure::operator=(ActiveSetErasure&&) noexcept = def
 
 void ActiveSetErasure::Reset() {
   nodes_.clear();
+  prepared_ = false;
+  active_ = false;
   columns_.clear();
   w_.resize(0, 0);
 }
@@ -22,12 +24,13 @@ void ActiveSetErasure::Set(const std::vector<int>& nodes, ContactLinearSolve mod
   std::vector<int> erased;
   for (const int i : nodes)
     if (!base_fixed[i]) erased.push_back(i);
-  if (erased == nodes_ && mode == mode_) return;
+  active_ = !erased.empty();
+  if (!active_ || (prepared_ && erased == nodes_ && mode == mode_)) return;
+  prepared_ = false;
   nodes_ = std::move(erased);
   mode_ = mode;
   const int n = static_cast<int>(matrix.rows());
   const int s = static_cast<int>(nodes_.size());
-  if (s == 0) return;
   if (mode == ContactLinearSolve::kRefactorize) {
     std::vector<char> drop(n, 0);
     for (const int i : nodes_) drop[i] = 1;
@@ -39,9 +42,12 @@ void ActiveSetErasure::Set(const std::vector<int>& nodes, ContactLinearSolve mod
         if (drop[col] || drop[rows[t]]) values[t] = rows[t] == col ? 1.0 : 0.0;
     if (!erased_solver_) erased_solver_ = std::make_unique<CholmodSolver>();
     ++num_factorizations_;
-    if (!erased_solver_->Factorize(a))
+    if (!erased_solver_->Factorize(a)) {
+      active_ = false;
       throw SolverError(SolverStatus::kFactorizationFailed,
                         "frictional contact: the PD matrix with the active set erased is not positive definite");
+    }
+    prepared_ = true;
     return;
   }
   // Woodbury: the missing columns of W in one multi-RHS solve.
@@ -61,10 +67,12 @@ void ActiveSetErasure::Set(const std::vector<int>& nodes, ContactLinearSolve mod
   for (int r = 0; r < s; ++r) cap.row(r) = w_.row(nodes_[r]);
   capacitance_.compute(0.5 * (cap + cap.transpose()));
   if (capacitance_.info() != Eigen::Success) {
+    active_ = false;
     std::ostringstream msg;
     msg << "frictional contact: the Woodbury capacitance matrix of " << s << " active nodes is not positive definite";
     throw SolverError(SolverStatus::kFactorizationFailed, msg.str());
   }
+  prepared_ = true;
 }
 
 void ActiveSetErasure::ZeroErased(MatrixXd* x) const {

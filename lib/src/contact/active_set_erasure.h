@@ -13,7 +13,9 @@
 // of W (cached per node until the factor changes, so a node that stays in
 // contact over many steps costs one solve in all), a dense s x s Cholesky per
 // change of S, and per solve one solve with A plus O(n s). kRefactorize
-// instead factorises A_S (for comparison; same solution).
+// instead factorises A_S (for comparison; same solution). Either way the
+// prepared set is kept while erasure is switched off (empty Set), so setting
+// the same S again (the next step of a resting contact) costs nothing.
 #pragma once
 
 #include <memory>
@@ -43,8 +45,7 @@ class ActiveSetErasure {
   // The base factor changed: drops the cached columns and the erased set
   // (call Set again).
   void Reset();
-  bool empty() const { return nodes_.empty(); }
-  const std::vector<int>& nodes() const { return nodes_; }
+  bool empty() const { return !active_; }
 
   // Solves A_S Y = R (n x k): rows of R at S are ignored, rows of Y at S are
   // zero. Rows of R at the base's fixed nodes must already be zero.
@@ -56,7 +57,9 @@ class ActiveSetErasure {
   int num_factorizations() const { return num_factorizations_; }
 
  private:
-  std::vector<int> nodes_;
+  std::vector<int> nodes_;  // the prepared set
+  bool prepared_ = false;   // nodes_ is prepared for the current factor
+  bool active_ = false;     // erasure on (a non-empty set is set)
   ContactLinearSolve mode_ = ContactLinearSolve::kWoodbury;
   std::unordered_map<int, VectorXd> columns_;  // node -> A^-1 e_node
   MatrixXd w_;                                  // n x s

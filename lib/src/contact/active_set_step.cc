@@ -43,6 +43,25 @@ double EntryParameter(const ContactSurface& surface, const Vec3& x, const Vec3& 
   return t;
 }
 
+// Replaces the step tolerance by an absolute one (target > 0) for its lifetime.
+class ToleranceScope {
+ public:
+  ToleranceScope(SimulatorImpl& sim, double target)
+      : sim_(sim), abs_(sim.options.abs_tolerance), rel_(sim.options.rel_tolerance) {
+    if (target <= 0) return;
+    sim.options.abs_tolerance = target;
+    sim.options.rel_tolerance = 0;
+  }
+  ~ToleranceScope() {
+    sim_.options.abs_tolerance = abs_;
+    sim_.options.rel_tolerance = rel_;
+  }
+
+ private:
+  SimulatorImpl& sim_;
+  double abs_, rel_;
+};
+
 }  // namespace
 
 ContactPin ComputeContactPin(const ContactSurface& surface, const Vec3& x, const Vec3& v, double h) {
@@ -90,6 +109,7 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
   for (int c = 0; c < nc; ++c) active[c] = cand[c].surface->Gap(xhat.segment<3>(3 * cand[c].node)) <= kTouch;
 
   VectorXd x = xhat;
+  double first_target = 0;
   for (int pass = 1;; ++pass) {
     // Active nodes in increasing order, with their pins.
     std::vector<std::pair<int, int>> order;  // (node, candidate)
@@ -109,8 +129,13 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
       for (int d = 0; d < n; ++d)
         if (sim.fixed[d]) x0(d) = sim.fixed_values(d);
       StepObjective objective(sim, xhat, force);
+      // Later passes start from the previous solution; they must meet the
+      // first pass's tolerance, not one relative to their smaller residual.
+      const ToleranceScope tolerance(sim, pass == 1 ? -1.0 : first_target);
       x = solve(objective, x0, &pass_report);
     }
+    if (pass == 1)
+      first_target = sim.options.abs_tolerance + sim.options.rel_tolerance * pass_report.initial_residual;
     if (pass == 1) report->initial_residual = pass_report.initial_residual;
     report->iterations += pass_report.iterations;
     report->line_search_steps += pass_report.line_search_steps;

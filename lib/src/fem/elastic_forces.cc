@@ -214,24 +214,4 @@ void ElasticForces::ElementHessians(const VectorXd& x, double mu, double lambda,
   else ElementHessiansImpl<8>(x, mu, lambda, project_spd, blocks, threads);
 }
 
-template <int K>
-void ElasticForces::GatherImpl(const std::vector<double>& stress, VectorXd* out, int threads) {
-  const int q_per = fem_.samples_per_element();
-  ParallelForElements(fem_.num_elements(), threads, [&](int e) {
-    Eigen::Matrix<double, 3, K> fe = Eigen::Matrix<double, 3, K>::Zero();
-    for (int q = 0; q < q_per; ++q) {
-      const int s = e * q_per + q;
-      const Eigen::Map<const Mat3> S(stress.data() + 9 * static_cast<size_t>(s));
-      fe.noalias() += (fem_.sample_volume(s) * S) * Eigen::Map<const Eigen::Matrix<double, K, 3>>(fem_.grad(s)).transpose();
-    }
-    Eigen::Map<Eigen::Matrix<double, 3, K>>(element_buffer_.data() + static_cast<size_t>(e) * 3 * K) = fe;
-  });
-  GatherElementBuffer(out, threads);
-}
-
-void ElasticForces::GatherSampleStresses(const std::vector<double>& stress, VectorXd* out, int threads) {
-  if (fem_.nodes_per_element() == 4) GatherImpl<4>(stress, out, threads);
-  else GatherImpl<8>(stress, out, threads);
-}
-
 }  // namespace diffpd::internal

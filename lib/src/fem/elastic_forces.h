@@ -46,10 +46,6 @@ class ElasticForces {
   void ElementHessians(const VectorXd& x, double mu, double lambda, bool project_spd,
                        std::vector<double>* blocks, int threads);
 
-  // out = sum_s vol_s G_s^T S_s where S_s (3x3 per sample) are given stresses;
-  // i.e. the generic "G^T" gather used by every force. `stress` holds 9 doubles
-  // per sample (column-major).
-  void GatherSampleStresses(const std::vector<double>& stress, VectorXd* out, int threads);
 
  private:
   template <int K>
@@ -61,8 +57,6 @@ class ElasticForces {
   template <int K>
   void ElementHessiansImpl(const VectorXd& x, double mu, double lambda, bool project_spd,
                            std::vector<double>* blocks, int threads);
-  template <int K>
-  void GatherImpl(const std::vector<double>& stress, VectorXd* out, int threads);
   // Sums the per-element 3 x K buffer into a 3n vector, in parallel over nodes.
   void GatherElementBuffer(VectorXd* out, int threads) const;
 

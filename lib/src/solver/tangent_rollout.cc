@@ -13,13 +13,22 @@
 //              - drho (h / rho) M^{-1} (f_user - grad E).
 // Both: x_{i+1} is the prescribed value at fixed DoFs (zero tangent there) and
 // v_{i+1} = (x_{i+1} - x_i) / h everywhere.
+// Muscles: grad E is affine in the activations (E = k/2 vol (|F m| - a)^2), so
+// d(grad E)/da . da = grad E(a + da) - grad E(a) exactly. Frictional contact:
+// the step's recorded active set is held fixed (as in Backward); a pinned node
+// moves with its pin, dx = dpin/dx_i dx_i + dpin/dv_i dv_i, and the free DoFs
+// solve H_ff dx_f = b_f - H_fp dx_p. Explicit state forces (damping,
+// hydrodynamics, penalty friction) are not differentiated in forward mode yet.
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
 #include "diffpd/tangent_rollout.h"
+#include "contact/active_set_step.h"
+#include "forces/activation_scope.h"
 #include "solver/simulator_impl.h"
 
 namespace diffpd {
@@ -61,7 +70,7 @@ void CheckDirectionVector(const VectorXd& v, int n, int p, const char* name) {
   }
 }
 
-void CheckDirections(const std::vector<InputDirection>& dirs, int n, int steps) {
+void CheckDirections(const std::vector<InputDirection>& dirs, int n, int steps, int num_muscles) {
   if (dirs.empty()) throw InvalidInputError("Tangents: no direction given (need at least one)");
   for (size_t p = 0; p < dirs.size(); ++p) {
     const InputDirection& d = dirs[p];
@@ -75,6 +84,25 @@ void CheckDirections(const std::vector<InputDirection>& dirs, int n, int steps) 
       throw InvalidInputError(msg.str());
     }
     for (const VectorXd& f : d.external_force) CheckDirectionVector(f, n, ip, "external_force");
+    if (!d.activation.empty() && static_cast<int>(d.activation.size()) != steps) {
+      std::ostringstream msg;
+      msg << "Tangents: direction " << p << " has activation for " << d.activation.size()
+          << " steps, expected 0 or " << steps;
+      throw InvalidInputError(msg.str());
+    }
+    for (const VectorXd& a : d.activation) {
+      if (a.size() != 0 && a.size() != num_muscles) {
+        std::ostringstream msg;
+        msg << "Tangents: direction " << p << " has an activation with " << a.size() << " entries, expected "
+            << num_muscles << " (one per muscle)";
+        throw InvalidInputError(msg.str());
+      }
+      if (!a.allFinite()) {
+        std::ostringstream msg;
+        msg << "Tangents: direction " << p << " has a non-finite entry in activation";
+        throw InvalidInputError(msg.str());
+      }
+    }
     if (!std::isfinite(d.youngs_modulus) || !std::isfinite(d.poissons_ratio) || !std::isfinite(d.density)) {
       std::ostringstream msg;
       msg << "Tangents: direction " << p << " has a non-finite material component";
@@ -101,7 +129,17 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
       rollout.options.method != sim.options.method)
     throw InvalidInputError(
         "Tangents: the rollout was made with another material, time step or method than the simulator's current ones");
-  CheckDirections(directions, n, steps);
+  CheckDirections(directions, n, steps, sim.aux.num_muscles());
+  if (!sim.state_forces.empty())
+    throw InvalidInputError(
+        "Tangents: explicit state forces (linear damping, hydrodynamics, penalty friction) are not differentiated in "
+        "forward mode yet; use Backward");
+  const bool contact = !sim.scene.frictional_contacts.empty() && sim.options.method != Method::kSemiImplicit;
+  if (contact && static_cast<int>(rollout.reports.size()) != steps)
+    throw InvalidInputError("Tangents: a rollout with frictional contact needs its step reports (active sets)");
+  std::vector<const ContactSurface*> surface_of(n / 3, nullptr);
+  for (const FrictionalContact& c : sim.scene.frictional_contacts)
+    for (const int node : c.nodes) surface_of[node] = &c.surface;
 
   const int num_dirs = static_cast<int>(directions.size());
   const double h = sim.h();
@@ -133,11 +171,33 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
 
   VectorXd grad_mu, grad_lambda;
   const bool implicit = sim.options.method != Method::kSemiImplicit;
+  // d(grad E)/da . da at x for every direction with an activation at step i
+  // (muscle gradients are affine in the activations), subtracted from *b.
+  auto subtract_activation_terms = [&](int i, const VectorXd& x, MatrixXd* b) {
+    const int muscles = sim.aux.num_muscles();
+    if (muscles == 0) return;
+    VectorXd base_activation = sim.activation.size() ? sim.activation : VectorXd::Ones(muscles);
+    VectorXd g0 = VectorXd::Zero(n);
+    bool have_g0 = false;
+    for (int p = 0; p < num_dirs; ++p) {
+      const InputDirection& d = directions[p];
+      if (d.activation.empty() || d.activation[i].size() == 0) continue;
+      if (!have_g0) {
+        sim.aux.muscles().AddEnergyAndGradient(x, base_activation, &g0);
+        have_g0 = true;
+      }
+      VectorXd g1 = VectorXd::Zero(n);
+      sim.aux.muscles().AddEnergyAndGradient(x, base_activation + d.activation[i], &g1);
+      b->col(p) -= g1 - g0;
+    }
+  };
+
   for (int i = 0; i < steps; ++i) {
     const State& s0 = rollout.states[i];
     const State& s1 = rollout.states[i + 1];
     const MatrixXd& dx0 = out.dx[i];
     const MatrixXd& dv0 = out.dv[i];
+    const internal::ActivationScope activation(sim, rollout.inputs[i].activation);
     MatrixXd dx1;
     if (implicit) {
       // Right-hand sides: inertia through xhat, force directions, parameters.
@@ -154,8 +214,25 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
       for (int p = 0; p < num_dirs; ++p)
         if (!directions[p].external_force.empty() && directions[p].external_force[i].size())
           b.col(p) += directions[p].external_force[i];
+      subtract_activation_terms(i, s1.x, &b);
+      const std::vector<int> no_pins;
+      const std::vector<int>& pinned = contact ? rollout.reports[i].contact_nodes : no_pins;
+      MatrixXd dpin = MatrixXd::Zero(n, num_dirs);
+      if (!pinned.empty()) {
+        // Pinned nodes follow their pins; move their coupling to the right.
+        for (const int node : pinned) {
+          DIFFPD_CHECK(surface_of[node] != nullptr, "pinned node " << node << " is not a frictional contact candidate");
+          const internal::ContactPin pin = internal::ComputeContactPin(
+              *surface_of[node], s0.x.segment<3>(3 * node), s0.v.segment<3>(3 * node), h);
+          dpin.middleRows<3>(3 * node) = pin.d_dx * dx0.middleRows<3>(3 * node) + pin.d_dv * dv0.middleRows<3>(3 * node);
+        }
+        internal::StepLinearization coupling(sim, s1.x);  // pinned nodes still free here
+        for (int p = 0; p < num_dirs; ++p) b.col(p) -= coupling.ApplyUnmasked(dpin.col(p));
+      }
+      std::optional<internal::ContactPinScope> pins;
+      if (!pinned.empty()) pins.emplace(sim, pinned, s1.x);
       internal::StepLinearization lin(sim, s1.x);
-      dx1 = lin.SolveColumns(b, &out.report);  // zero at fixed DoFs
+      dx1 = lin.SolveColumns(b, &out.report) + dpin;  // zero at fixed DoFs but the pins
     } else {
       // Acceleration tangent on free DoFs, then symplectic update.
       std::vector<Mat9> dstress;
@@ -164,6 +241,7 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
       for (int p = 0; p < num_dirs; ++p) {
         VectorXd hdx;
         sim.elastic.ApplyHessian(dstress, dx0.col(p), &hdx, sim.threads());
+        sim.aux.AddHessianProduct(s0.x, sim.activation, dx0.col(p), &hdx);
         force.col(p) = -hdx;
         if (!directions[p].external_force.empty() && directions[p].external_force[i].size())
           force.col(p) += directions[p].external_force[i];
@@ -173,10 +251,12 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
         sim.elastic.EnergyAndGradient(s0.x, 0.0, 1.0, &grad_lambda, sim.threads());
         force -= grad_mu * dmu.transpose() + grad_lambda * dlambda.transpose();
       }
+      subtract_activation_terms(i, s0.x, &force);
       MatrixXd dv1 = dv0 + h * mass.cwiseInverse().asDiagonal() * force;
       if (drho.any()) {
         VectorXd grad_e;
         sim.elastic.EnergyAndGradient(s0.x, sim.mu(), sim.lambda(), &grad_e, sim.threads());
+        sim.aux.AddEnergyAndGradient(s0.x, sim.activation, &grad_e);
         const VectorXd& user = rollout.inputs[i].external_force;
         const VectorXd net = (user.size() ? user : VectorXd::Zero(n)) - grad_e;
         dv1 -= (h / rho) * net.cwiseQuotient(mass) * drho.transpose();

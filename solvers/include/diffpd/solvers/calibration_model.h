@@ -11,8 +11,9 @@
 // Parameter blocks, in this order (a block is present only if non-empty):
 //  - the material block: the values of `setup.fitted` in physical units
 //    (Pa, 1, kg/m^3), e.g. {E, nu}; the parameters not listed stay at
-//    setup.scene.material. Positivity and log-space steps: LogManifold
-//    (log_manifold.h); ranges: ceres::Problem::SetParameterLower/UpperBound.
+//    setup.scene.material. Positivity and log-space steps, intervals:
+//    CoordinateManifold (coordinate_manifold.h); ranges also by
+//    ceres::Problem::SetParameterLower/UpperBound.
 //  - the input block: `setup.input_parameters` (initial state, forces), e.g.
 //    LinearInputParameters below.
 // Residuals: for each captured sample s (in file order) and axis d,

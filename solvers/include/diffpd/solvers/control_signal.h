@@ -23,6 +23,9 @@ class ControlSignal {
   // The first step k whose value can depend on coefficient j (for any c);
   // K if none. Used to declare sparsity.
   virtual int FirstStep(int j) const { return 0; }
+  // Coefficients whose signal is `value` at every step (e.g. a rest
+  // activation of 1).
+  virtual VectorXd ConstantCoefficients(double value) const = 0;
 
  protected:
   explicit ControlSignal(int num_steps);
@@ -41,6 +44,7 @@ class PerStepSignal : public ControlSignal {
   bool is_linear() const override { return true; }
   void Evaluate(const Eigen::Ref<const VectorXd>& c, VectorXd* values, MatrixXd* jacobian) const override;
   int FirstStep(int j) const override { return j; }
+  VectorXd ConstantCoefficients(double value) const override;
 };
 
 // Piecewise-linear interpolation of p >= 2 knot values placed uniformly
@@ -55,6 +59,7 @@ class PiecewiseLinearSignal : public ControlSignal {
   bool is_linear() const override { return true; }
   void Evaluate(const Eigen::Ref<const VectorXd>& c, VectorXd* values, MatrixXd* jacobian) const override;
   int FirstStep(int j) const override;
+  VectorXd ConstantCoefficients(double value) const override;
 
  private:
   int knots_;
@@ -73,6 +78,7 @@ class FourierSignal : public ControlSignal {
   int num_coefficients() const override { return static_cast<int>(basis_.cols()); }
   bool is_linear() const override { return true; }
   void Evaluate(const Eigen::Ref<const VectorXd>& c, VectorXd* values, MatrixXd* jacobian) const override;
+  VectorXd ConstantCoefficients(double value) const override;
   // The K x p matrix B with s = B c.
   const MatrixXd& basis() const { return basis_; }
 
@@ -90,6 +96,7 @@ class SinusoidSignal : public ControlSignal {
   int num_coefficients() const override { return 3; }
   bool is_linear() const override { return false; }
   void Evaluate(const Eigen::Ref<const VectorXd>& c, VectorXd* values, MatrixXd* jacobian) const override;
+  VectorXd ConstantCoefficients(double value) const override;
 
  private:
   VectorXd phase_;  // 2 pi t_k / T

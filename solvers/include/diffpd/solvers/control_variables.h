@@ -13,6 +13,8 @@
 
 #include "diffpd/material.h"
 #include "diffpd/rollout.h"
+#include "diffpd/scene.h"
+#include "diffpd/tangent_rollout.h"
 #include "diffpd/solvers/control_signal.h"
 #include "diffpd/types.h"
 
@@ -42,10 +44,10 @@ class ControlVariables {
   const VectorXd& upper() const { return upper_; }
   const VectorXd& initial() const { return initial_; }
 
-  // Throws InvalidInputError if the block does not fit a rollout of
-  // `num_nodes` nodes and `num_steps` steps (node out of range, signal of
-  // another length).
-  virtual void CheckFits(int num_nodes, int num_steps) const = 0;
+  // Throws InvalidInputError if the block does not fit a rollout of `scene`
+  // with `num_steps` steps (node or muscle out of range, signal of another
+  // length).
+  virtual void CheckFits(const Scene& scene, int num_steps) const = 0;
   // Writes the effect of `values` (size()) into `setup`.
   virtual void Apply(const Eigen::Ref<const VectorXd>& values, RolloutSetup* setup) const = 0;
   // out (size()) = dL/d(values), given the gradient of L w.r.t. the rollout
@@ -57,6 +59,15 @@ class ControlVariables {
   // The earliest state index k (0..K) that variable j can influence: 0 for
   // the initial state, i + 1 for an input of step i, K + 1 for none.
   virtual int FirstAffectedState(int j) const = 0;
+  // Forward mode: adds d(setup)/d(values_j) into `direction` (the
+  // simulator's InputDirection, per-step lists sized for K steps) and
+  // returns true; returns false if the block drives an input that forward
+  // mode cannot represent (muscle activations), and then the NLP uses
+  // reverse mode.
+  virtual bool AddDirection(const Eigen::Ref<const VectorXd>& values, int j, int num_steps,
+                            InputDirection* direction) const {
+    return false;
+  }
 
  protected:
   explicit ControlVariables(int size);
@@ -78,11 +89,13 @@ class InitialStateVariables : public ControlVariables {
   // Throws InvalidInputError if nodes is empty or has a negative index.
   InitialStateVariables(Quantity quantity, std::vector<int> nodes, Sharing sharing = kShared);
   std::string name() const override;
-  void CheckFits(int num_nodes, int num_steps) const override;
+  void CheckFits(const Scene& scene, int num_steps) const override;
   void Apply(const Eigen::Ref<const VectorXd>& values, RolloutSetup* setup) const override;
   void PullBack(const Eigen::Ref<const VectorXd>& values, const RolloutGradient& grad,
                 Eigen::Ref<VectorXd> out) const override;
   int FirstAffectedState(int j) const override { return 0; }
+  bool AddDirection(const Eigen::Ref<const VectorXd>& values, int j, int num_steps,
+                    InputDirection* direction) const override;
 
  private:
   Quantity quantity_;
@@ -111,11 +124,13 @@ class ExternalForceControl : public ControlVariables {
   // First variable of channel c.
   int channel_offset(int c) const { return offsets_[c]; }
   const Channel& channel(int c) const { return channels_[c]; }
-  void CheckFits(int num_nodes, int num_steps) const override;
+  void CheckFits(const Scene& scene, int num_steps) const override;
   void Apply(const Eigen::Ref<const VectorXd>& values, RolloutSetup* setup) const override;
   void PullBack(const Eigen::Ref<const VectorXd>& values, const RolloutGradient& grad,
                 Eigen::Ref<VectorXd> out) const override;
   int FirstAffectedState(int j) const override;
+  bool AddDirection(const Eigen::Ref<const VectorXd>& values, int j, int num_steps,
+                    InputDirection* direction) const override;
 
  private:
   std::vector<Channel> channels_;
@@ -137,14 +152,48 @@ class MaterialVariables : public ControlVariables {
   // scale is not finite and > 0.
   MaterialVariables(std::vector<Entry> entries, const MaterialParameters& start);
   std::string name() const override { return "material"; }
-  void CheckFits(int num_nodes, int num_steps) const override {}
+  void CheckFits(const Scene& scene, int num_steps) const override {}
   void Apply(const Eigen::Ref<const VectorXd>& values, RolloutSetup* setup) const override;
   void PullBack(const Eigen::Ref<const VectorXd>& values, const RolloutGradient& grad,
                 Eigen::Ref<VectorXd> out) const override;
   int FirstAffectedState(int j) const override { return 1; }
+  bool AddDirection(const Eigen::Ref<const VectorXd>& values, int j, int num_steps,
+                    InputDirection* direction) const override;
 
  private:
   std::vector<Entry> entries_;
+};
+
+// Muscle activations (muscle.h) driven by control signals: channel c sets
+// the activation of Scene::muscles[muscle] to s_k during step k (1 = rest,
+// < 1 contracts). Muscles without a channel keep the base setup's
+// activation (RolloutNlp fills a base without activations with 1). The variables are the channels'
+// coefficients, channel after channel; starting values: a constant signal
+// of 1 (rest). Forward mode does not cover activations: an NLP with this
+// block uses reverse mode.
+class ActivationControl : public ControlVariables {
+ public:
+  struct Channel {
+    int muscle = 0;
+    std::unique_ptr<ControlSignal> signal;
+  };
+  // Throws InvalidInputError if there is no channel, a channel has a
+  // negative muscle or no signal, two channels drive the same muscle, or the
+  // signals have different numbers of steps.
+  explicit ActivationControl(std::vector<Channel> channels);
+  std::string name() const override { return "activation"; }
+  int num_channels() const { return static_cast<int>(channels_.size()); }
+  int channel_offset(int c) const { return offsets_[c]; }
+  const Channel& channel(int c) const { return channels_[c]; }
+  void CheckFits(const Scene& scene, int num_steps) const override;
+  void Apply(const Eigen::Ref<const VectorXd>& values, RolloutSetup* setup) const override;
+  void PullBack(const Eigen::Ref<const VectorXd>& values, const RolloutGradient& grad,
+                Eigen::Ref<VectorXd> out) const override;
+  int FirstAffectedState(int j) const override;
+
+ private:
+  std::vector<Channel> channels_;
+  std::vector<int> offsets_;  // num_channels + 1
 };
 
 }  // namespace diffpd::solvers

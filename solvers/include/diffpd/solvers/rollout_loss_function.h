@@ -10,6 +10,10 @@
 // The parameter vector is the concatenation of the model's parameter blocks
 // (material block, then input block). The gradient comes from one adjoint
 // (Simulator::Backward) whatever the model's JacobianMode.
+// Ceres' line searches try a first step as long as the (tangent-space)
+// gradient: scale the loss to O(1) or less (e.g. residuals in metres, weights
+// near 1) and use a CoordinateManifold so that the tangent coordinates are
+// comparable (log E, logit nu).
 #pragma once
 
 #include <ceres/first_order_function.h>

@@ -12,11 +12,16 @@
 //
 // Derivatives, all exact to the simulator's tolerances:
 //  - objective gradient: one reverse-mode pass (Simulator::Backward) per point;
-//  - constraint Jacobian: reverse mode, one Backward per trajectory
-//    constraint, each over the rollout truncated after the constraint's last
-//    state (a constraint at step k costs k adjoint steps). Forward-mode
-//    tangents do not exist in the simulator yet; reverse mode is used for
-//    every problem size.
+//  - constraint Jacobian, chosen by size (JacobianMode::kAuto):
+//    reverse mode, one Backward per trajectory constraint, each over the
+//    rollout truncated after the constraint's last state (a constraint at
+//    step k costs k adjoint steps); or forward mode, one Simulator::Tangents
+//    pass with one direction per variable (all directions share each step's
+//    linearisation), used when the variables are fewer than the trajectory
+//    constraints and forward mode covers the problem: every block supports
+//    it (not muscle activations) and the scene has no term the tangent pass
+//    leaves out (frictional or penalty contact, muscles, hydrodynamics,
+//    damping). ResolvedJacobianMode() says which mode is used.
 //  - Hessian: none; run Ipopt with hessian_approximation = limited-memory
 //    (ipopt_solve.h sets it).
 // Jacobian sparsity is declared honestly: a trajectory constraint whose last
@@ -55,10 +60,19 @@ namespace diffpd::solvers {
 struct RolloutNlpStatistics {
   long rollouts = 0;            // forward simulations (one per evaluation point)
   long failed_rollouts = 0;     // those that threw (eval_* returned false)
-  long backward_passes = 0;     // reverse-mode passes (objective + constraints)
+  long backward_passes = 0;     // derivative passes: adjoints (objective, constraints) and tangent passes
+  long tangent_passes = 0;      // of which forward-mode tangent passes
   double forward_seconds = 0;   // wall time in Simulator::Simulate
-  double backward_seconds = 0;  // wall time in Simulator::Backward
+  double backward_seconds = 0;  // wall time in Simulator::Backward and Simulator::Tangents
 };
+
+// How the constraint Jacobian is computed (see the file comment).
+enum class JacobianMode {
+  kAuto,     // forward if available and num_variables < trajectory constraints, else reverse
+  kReverse,  // one adjoint pass per trajectory constraint
+  kForward,  // one tangent pass; evaluation fails (returns false) where unavailable
+};
+const char* ToString(JacobianMode mode);
 
 // One Ipopt iteration as reported to intermediate_callback.
 struct IterationRecord {
@@ -90,6 +104,12 @@ class RolloutNlp : public Ipopt::TNLP {
   // which it also becomes again when a block is added afterwards).
   // Throws InvalidInputError on a size mismatch or a non-finite entry.
   void SetStartingPoint(const VectorXd& x);
+
+  void SetJacobianMode(JacobianMode mode) { jacobian_mode_ = mode; }
+  // True if forward mode covers this problem (see the file comment).
+  bool ForwardModeAvailable() const;
+  // kForward or kReverse: what kAuto resolves to, or the mode set.
+  JacobianMode ResolvedJacobianMode() const;
 
   int num_variables() const { return static_cast<int>(lower_.size()); }
   int num_constraints() const;
@@ -170,6 +190,8 @@ class RolloutNlp : public Ipopt::TNLP {
   bool ComputeGradient();
   bool ComputeConstraints();
   bool ComputeJacobian();
+  void JacobianReverse(std::vector<double>* values);
+  void JacobianForward(std::vector<double>* values);
   // Gradient of `terms` weighted over the rollout truncated after state
   // `last`, pulled back onto every variable (added into out).
   void PullBackLoss(const LossGradient& loss, int last, Eigen::Ref<VectorXd> out);
@@ -191,6 +213,7 @@ class RolloutNlp : public Ipopt::TNLP {
   std::vector<LinearConstraint> linear_;
   std::vector<std::vector<int>> row_columns_;  // per constraint row
   int nnz_jac_ = -1;
+  JacobianMode jacobian_mode_ = JacobianMode::kAuto;
 
   std::unique_ptr<Cache> cache_;
   RolloutNlpStatistics stats_;

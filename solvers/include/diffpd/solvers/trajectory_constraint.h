@@ -85,10 +85,14 @@ class PointTravel : public TrajectoryFunction {
   std::string name_;
 };
 
-// |p(x_k) - target|^2 (m^2).
+// sum_a w_a (p_a(x_k) - target_a)^2 (m^2), axis weights w (default 1, 1, 1:
+// the squared distance; e.g. (1, 1, 0) ignores height).
 class PointDistanceSquared : public TrajectoryFunction {
  public:
-  PointDistanceSquared(TrackedPoint point, int step, Vec3 target, std::string name = "distance_squared");
+  // Throws InvalidInputError if step < -1, target is not finite or a weight
+  // is not finite and >= 0.
+  PointDistanceSquared(TrackedPoint point, int step, Vec3 target, std::string name = "distance_squared",
+                       Vec3 axis_weights = Vec3::Ones());
   std::string name() const override { return name_; }
   int LastState(int num_steps) const override;
   double Value(const Rollout& rollout) const override;
@@ -99,6 +103,7 @@ class PointDistanceSquared : public TrajectoryFunction {
   int step_;
   Vec3 target_;
   std::string name_;
+  Vec3 weights_;
 };
 
 // The cosine of the angle between the body axis a -> b at state k and a
