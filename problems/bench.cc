@@ -10,6 +10,7 @@
 
 #include "cantilever.h"
 #include "diffpd/error.h"
+#include "problem_registry.h"
 
 namespace diffpd::problems {
 namespace {
@@ -90,6 +91,7 @@ nlohmann::json NumberOrNull(bool ok, double v) { return ok ? nlohmann::json(v) :
 }  // namespace
 
 std::unique_ptr<Problem> MakeRefinedProblem(const std::string& name, int doublings) {
+  if (doublings == 0) return MakeProblem(name);
   if (name == "cantilever") {
     int cells[3] = {32, 8, 8};
     for (int i = 0; i < std::abs(doublings); ++i) {
@@ -237,9 +239,13 @@ BenchResult RunBench(const std::string& problem, const BenchOptions& options, st
 
   for (Method method : options.methods) {
     Progress(progress, std::string("[bench] ") + ToString(method) + " ...");
-    const RolloutMeasurement m =
-        MeasureRollout(s.scene, MethodOptions(method, options, s.time_step), s.initial, s.inputs, s.loss,
-                       options.repeat);
+    RolloutMeasurement m;
+    try {
+      m = MeasureRollout(s.scene, MethodOptions(method, options, s.time_step), s.initial, s.inputs, s.loss,
+                         options.repeat);
+    } catch (const InvalidInputError& e) {  // e.g. PD on an energy that is not projective
+      m.failure = std::string("invalid input: ") + e.what();
+    }
     Progress(progress, std::string("[bench] ") + ToString(method) + ": " + Describe(m));
     BenchRow row;
     row.method = ToString(method);

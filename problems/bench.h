@@ -45,8 +45,9 @@ inline constexpr double kReferenceBackwardRelTolerance = 1e-12;
 // `doublings` = 3 is 8x the elements and -3 an eighth. Cantilever: the default
 // 32 x 8 x 8 cells; -9 gives 4 x 1 x 1. Falling cube: 8^3 cells, scaled to
 // round(8 * 2^(doublings / 3)) cells per axis (exact for multiples of 3).
-// Throws InvalidInputError for other problems, or when a halving would leave
-// no cells along an axis.
+// With 0 doublings, any registered problem (MakeProblem). Throws
+// InvalidInputError for an unknown problem, for other problems with
+// doublings != 0, or when a halving would leave no cells along an axis.
 std::unique_ptr<Problem> MakeRefinedProblem(const std::string& name, int doublings);
 
 // Methods from their names (ParseMethod each); throws InvalidInputError.
@@ -128,8 +129,10 @@ struct BenchResult {
 };
 
 // Measures every method and the reference. Progress lines go to `progress`
-// (nullptr: silent). Throws InvalidInputError on bad options or problem, and
-// SolverError when the reference itself fails.
+// (nullptr: silent). A method that fails (SolverError, or InvalidInputError
+// such as PD on a non-projective energy) gets a row with `failure`. Throws
+// InvalidInputError on bad options or problem, and SolverError when the
+// reference itself fails.
 BenchResult RunBench(const std::string& problem, const BenchOptions& options, std::ostream* progress = nullptr);
 
 // The rows as the JSON list the command prints: objects with method,

@@ -31,6 +31,17 @@ struct CommandArgs {
   bool small = false;
   bool compare_newton = true;
   std::vector<std::string> ipopt_options;
+  // Calibration problems (calibrate-*): the captured-motion file (default:
+  // the problem's file in data/), the methods to fit with and compare
+  // (default: the problem's), a cap on Ceres iterations (-1: the problem's);
+  // calibrate-starfish: the recording to fit, those to predict, and the
+  // seconds of each recording to evaluate (-1: the problem's default).
+  std::string data_file;
+  std::vector<std::string> methods;
+  int max_iterations = -1;
+  std::string calibrate_file;
+  std::vector<std::string> predict_files;
+  double seconds = -1;
 };
 
 int ListCommand(bool json);
@@ -46,6 +57,7 @@ struct Subcommand {
 Subcommand AddBenchCommand(CLI::App* parent);     // bench_command.cc
 Subcommand AddTradeoffCommand(CLI::App* parent);  // tradeoff_command.cc
 Subcommand AddStressCommand(CLI::App* parent);    // stress_command.cc
+Subcommand AddSynthCommand(CLI::App* parent);     // synth_command.cc
 
 // Solver options for a problem from the shared arguments.
 SolverOptions OptionsFromArgs(const CommandArgs& args, double default_dt, double default_rel_tolerance);

@@ -44,12 +44,20 @@ int main(int argc, char** argv) {
   run->add_flag("!--no-compare", run_args.compare_newton,
                 "optimisation problems: skip the repeat with newton-cholesky");
   run->add_option("--ipopt", run_args.ipopt_options, "optimisation problems: Ipopt option name=value (repeatable)");
+  run->add_option("--data", run_args.data_file, "calibration problems: captured-motion CSV (default: the problem's in data/)");
+  run->add_option("--methods", run_args.methods, "calibration problems: methods to fit with, compared (comma-separated)")
+      ->delimiter(',');
+  run->add_option("--max-iterations", run_args.max_iterations, "calibration problems: Ceres iterations per fit");
+  run->add_option("--calibrate", run_args.calibrate_file, "calibrate-starfish: the recording to fit");
+  run->add_option("--predict", run_args.predict_files, "calibrate-starfish: recordings to predict (repeatable)");
+  run->add_option("--seconds", run_args.seconds, "calibrate-starfish: seconds of each recording to evaluate");
 
   CLI::App* grad = app.add_subcommand("gradcheck", "compare rollout gradients with central finite differences");
   AddCommonOptions(grad, &grad_args, &grad_method);
   const auto bench = diffpd::problems::AddBenchCommand(&app);
   const auto tradeoff = diffpd::problems::AddTradeoffCommand(&app);
   const auto stress = diffpd::problems::AddStressCommand(&app);
+  const auto synth = diffpd::problems::AddSynthCommand(&app);
 
   try {
     app.parse(argc, argv);
@@ -71,6 +79,7 @@ int main(int argc, char** argv) {
     if (*bench.app) return bench.run();
     if (*tradeoff.app) return tradeoff.run();
     if (*stress.app) return stress.run();
+    if (*synth.app) return synth.run();
   } catch (const diffpd::InvalidInputError& e) {
     std::fprintf(stderr, "diffpd: invalid input: %s\n", e.what());
     return 2;

@@ -1,11 +1,13 @@
 #include "problem_registry.h"
 
 #include "bouncing_ball.h"
+#include "calibrate_plant.h"
 #include "bunny.h"
 #include "cantilever.h"
 #include "routing_tendon_opt.h"
 #include "cantilever_plane.h"
 #include "diffpd/error.h"
+#include "locomotion.h"
 #include "rolling_sphere.h"
 #include "routing_tendon.h"
 
@@ -21,6 +23,10 @@ std::vector<std::unique_ptr<Problem>> AllProblems() {
   // RoutingTendon's forward scene; `diffpd run routing-tendon` optimises its activations.
   all.push_back(std::make_unique<RoutingTendonOpt>());
   all.push_back(std::make_unique<Bunny>());
+  all.push_back(std::make_unique<Locomotion>(Locomotion::Body::kTorus));
+  all.push_back(std::make_unique<Locomotion>(Locomotion::Body::kQuadruped));
+  all.push_back(std::make_unique<Locomotion>(Locomotion::Body::kCow));
+  all.push_back(std::make_unique<PlantCalibration>());
   return all;
 }
 

@@ -17,7 +17,8 @@ list(APPEND DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/shared_data.cc
   ${CMAKE_CURRENT_LIST_DIR}/trajectory_optimization.cc
   ${CMAKE_CURRENT_LIST_DIR}/bunny.cc
-  ${CMAKE_CURRENT_LIST_DIR}/routing_tendon_opt.cc)
+  ${CMAKE_CURRENT_LIST_DIR}/routing_tendon_opt.cc
+  ${CMAKE_CURRENT_LIST_DIR}/locomotion.cc)
 get_filename_component(DIFFPD_DEFAULT_SHARED_DATA_DIR "${CMAKE_CURRENT_LIST_DIR}/../../shared/data" ABSOLUTE)
 set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/shared_data.cc PROPERTIES
   COMPILE_DEFINITIONS "DIFFPD_SHARED_DATA_DIR=\"${DIFFPD_DEFAULT_SHARED_DATA_DIR}\"")
@@ -27,3 +28,11 @@ list(APPEND DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/bouncing_ball.cc
   ${CMAKE_CURRENT_LIST_DIR}/routing_tendon.cc
   ${CMAKE_CURRENT_LIST_DIR}/cantilever_plane.cc)
+# System identification with Ceres (issue 5): calibration problems and the
+# generator of their captured motion in data/.
+list(APPEND DIFFPD_PROBLEMS_SOURCES
+  ${CMAKE_CURRENT_LIST_DIR}/calibrate_problem.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibrate_plant.cc
+  ${CMAKE_CURRENT_LIST_DIR}/synth_command.cc)
+set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/calibrate_problem.cc PROPERTIES
+  COMPILE_DEFINITIONS "DIFFPD_PROJECT_DATA_DIR=\"${CMAKE_CURRENT_LIST_DIR}/../data\"")

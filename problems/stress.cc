@@ -199,7 +199,7 @@ StressGradientCheck CheckStressGradient(const Scene& scene, const SolverOptions&
 }
 
 StressCase RunStressCase(const StressProblem& problem, Method method, double youngs_modulus, double poissons_ratio,
-                         double time_step, const StressOptions& options) {
+                         double time_step, const StressOptions& options, std::ostream* progress) {
   StressCase c;
   c.problem = problem.name;
   c.method = ToString(method);
@@ -248,6 +248,7 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
       return e;
     };
     const EnergyParts e0 = energy(initial);
+    auto last_report = Clock::now();
     for (int k = 0; k < steps; ++k) {
       State next;
       try {
@@ -279,6 +280,10 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
       c.max_energy_excess = std::max(c.max_energy_excess, excess);
       rollout.states.push_back(std::move(next));
       c.steps_completed = k + 1;
+      if (progress && std::chrono::duration<double>(Clock::now() - last_report).count() > 10) {
+        last_report = Clock::now();
+        *progress << "  ... step " << k + 1 << " of " << steps << std::endl;
+      }
     }
     const double energy_tolerance =
         method == Method::kSemiImplicit ? options.explicit_energy_tolerance : options.energy_tolerance;
@@ -346,7 +351,7 @@ std::vector<StressCase> RunStress(const StressOptions& options, std::ostream* pr
       for (double e : options.youngs_moduli)
         for (double nu : options.poissons_ratios)
           for (double h : options.time_steps) {
-            cases.push_back(RunStressCase(p, method, e, nu, h, options));
+            cases.push_back(RunStressCase(p, method, e, nu, h, options, progress));
             if (progress) {
               const StressCase& c = cases.back();
               *progress << "[stress " << cases.size() << "/" << total << "] " << c.problem << " " << c.method

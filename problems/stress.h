@@ -80,12 +80,15 @@ struct StressCase {
   double seconds = 0;
 };
 
-// An absolute tolerance on |grad g| (N) ten times above its rounding floor
-// (never below the library default 1e-9): the floor is machine epsilon
-// times the largest terms that cancel in grad g, the inertia term
-// M (x - y) / h^2 ~ m |x| / h^2 and the elastic forces ~ (2 mu + lambda) A
-// sqrt(3n) (A an element's face area; lambda grows without bound as nu -> 0.5). Defaults of 1e-9 N fail with "line search failed"
-// near E = 1e10 Pa or h = 1e-5 s without it.
+// An absolute tolerance on |grad g| (N) ten times an estimate of its
+// rounding floor, never below the library default 1e-9: the floor is
+// machine epsilon times the largest terms that cancel in grad g, the
+// inertia term M (x - y) / h^2 ~ m |x| / h^2 (m = rho V / #nodes over the
+// rest bounding box V) and the elastic forces ~ (2 mu + lambda) A sqrt(3n)
+// (A an element's face area; lambda grows without bound as nu -> 0.5). With
+// 1e-9 N the solvers stop with "line search failed" near E = 1e10 Pa or
+// h = 1e-5 s. The floor grows with |x|: a body far from the origin (a cube
+// falling for minutes) can still reach it.
 double AutoAbsTolerance(const Scene& scene, double time_step);
 
 // Directional central-difference check of the reverse-mode gradient of
@@ -134,9 +137,10 @@ struct StressGradientCheck {
 StressGradientCheck CheckStressGradient(const Scene& scene, const SolverOptions& options, const State& initial,
                                         int steps, std::uint64_t seed, double tolerance = 1e-4);
 
-// Runs one case.
+// Runs one case; a line every 10 s of a long rollout goes to `progress`
+// (nullptr: silent).
 StressCase RunStressCase(const StressProblem& problem, Method method, double youngs_modulus, double poissons_ratio,
-                         double time_step, const StressOptions& options);
+                         double time_step, const StressOptions& options, std::ostream* progress = nullptr);
 
 // Runs the whole grid (problems x methods x E x nu x h), one progress line per
 // case on `progress` (nullptr: silent). Throws InvalidInputError on bad options.

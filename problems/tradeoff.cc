@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -234,8 +235,8 @@ std::vector<TradeoffRow> RunTradeoff(const std::string& problem_name, const Trad
     MustSucceed(ref.m, "resolution sweep");
     for (Method method : o.methods)
       for (int j = o.resolution_levels - 1; j >= 0; --j) {
-        const CornerMeasurement c = MeasureCorners(problem_name, o.refine - 3 * j,
-                                                   method_options(method, o.rel_tolerance, h0), o.steps, corner_weights);
+        const SolverOptions so = method_options(method, o.rel_tolerance, h0);
+        const CornerMeasurement c = MeasureCorners(problem_name, o.refine - 3 * j, so, o.steps, corner_weights);
         TradeoffRow row = MakeRow("resolution", method, "elements", c.elements, c.m, c.dofs, c.steps);
         if (c.m.ok()) {
           row.state_rel_error = RelativeError(c.displacement, ref.displacement);

@@ -71,6 +71,7 @@ nlohmann::json RunJson(const OptimizationRun& run) {
           {"adjoint_passes", s.backward_passes},
           {"total_s", s.total_seconds},
           {"improved", run.improved},
+          {"required_objective", run.required_objective},
           {"jacobian_mode", solvers::ToString(run.jacobian_mode)},
           {"variables", run.num_variables},
           {"constraints", run.num_constraints},
@@ -79,6 +80,12 @@ nlohmann::json RunJson(const OptimizationRun& run) {
 }
 
 }  // namespace
+
+std::string TrajectoryOptimizationProblem::improvement_rule() const {
+  std::ostringstream s;
+  s << "objective lowered by at least " << 100 * improvement_margin() << " % of |initial objective|";
+  return s.str();
+}
 
 SolverOptions TrajectoryOptimizationProblem::BaseOptions(InstanceSize size) const {
   SolverOptions o;
@@ -103,7 +110,7 @@ OptimizationReport RunOptimization(const TrajectoryOptimizationProblem& problem,
   }
   OptimizationReport report;
   report.problem = problem.name();
-  report.improvement_margin = problem.improvement_margin();
+  report.improvement_rule = problem.improvement_rule();
   std::vector<Method> methods = {settings.method};
   if (settings.compare_newton && settings.method != Method::kNewtonCholesky) methods.push_back(Method::kNewtonCholesky);
   if (!settings.out_dir.empty()) std::filesystem::create_directories(settings.out_dir);
@@ -142,8 +149,8 @@ OptimizationReport RunOptimization(const TrajectoryOptimizationProblem& problem,
                    solvers::ToString(run.jacobian_mode));
     run.summary = SolveWithIpopt(nlp, ipopt);
     const IpoptSummary& s = run.summary;
-    run.improved = s.constraint_violation <= 1e-6 && std::isfinite(s.objective) &&
-                   s.objective <= s.initial_objective - report.improvement_margin * std::abs(s.initial_objective);
+    run.required_objective = problem.RequiredObjective(s.initial_objective);
+    run.improved = s.constraint_violation <= 1e-6 && std::isfinite(s.objective) && s.objective <= run.required_objective;
     if (settings.log) std::fprintf(settings.log, "# %s: %s\n", ToString(run.method), s.BriefReport().c_str());
 
     if (!settings.out_dir.empty()) {
@@ -212,9 +219,9 @@ void PrintReport(const OptimizationReport& report, FILE* out) {
     std::fprintf(out, "newton-cholesky / %s simulation time (forward + backward): %.3f\n",
                  ToString(report.runs[0].method), report.newton_time_ratio);
   for (const OptimizationRun& run : report.runs)
-    std::fprintf(out, "%s: %s; objective %s by the %.0f %% margin, constraints %s\n", ToString(run.method),
+    std::fprintf(out, "%s: %s; objective %s (%s: <= %.6e), constraints %s\n", ToString(run.method),
                  DescribeOutcome(run.summary).c_str(), run.improved ? "improved" : "NOT improved",
-                 100 * report.improvement_margin,
+                 report.improvement_rule.c_str(), run.required_objective,
                  run.summary.constraint_violation <= 1e-6 ? "satisfied" : "VIOLATED");
   for (const std::string& f : report.files) std::fprintf(out, "wrote %s\n", f.c_str());
 }
@@ -222,7 +229,7 @@ void PrintReport(const OptimizationReport& report, FILE* out) {
 nlohmann::json ReportJson(const OptimizationReport& report) {
   nlohmann::json out = RunJson(report.runs.at(0));
   out["problem"] = report.problem;
-  out["improvement_margin"] = report.improvement_margin;
+  out["improvement_rule"] = report.improvement_rule;
   out["outcome"] = DescribeOutcome(report.runs[0].summary);
   if (report.runs.size() == 2) {
     out["newton_cholesky"] = RunJson(report.runs[1]);

@@ -5,6 +5,7 @@
 // the optimised motion and a PNG plot of the objective history.
 #pragma once
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -37,9 +38,14 @@ class TrajectoryOptimizationProblem : public Problem {
   // Ipopt options of the problem (max_iter, tol, ...), before the user's.
   virtual solvers::IpoptOptions DefaultIpoptOptions(InstanceSize size) const;
   // What "improves the objective" means for this problem: the solution's
-  // objective must be at most initial_objective - margin * |initial_objective|
-  // (0 < margin <= 1).
+  // objective must be at most RequiredObjective(initial objective); by
+  // default initial - margin * |initial| with improvement_margin() in (0, 1].
   virtual double improvement_margin() const { return 0.5; }
+  virtual double RequiredObjective(double initial_objective) const {
+    return initial_objective - improvement_margin() * std::abs(initial_objective);
+  }
+  // The rule in words, for the report.
+  virtual std::string improvement_rule() const;
 
   // `diffpd run <problem>`: solves as the arguments say (--small,
   // --method, --threads, --rtol, --out, --json, --no-compare, --ipopt
@@ -69,14 +75,15 @@ struct OptimizationSettings {
 struct OptimizationRun {
   Method method = Method::kPd;
   solvers::IpoptSummary summary;
-  solvers::JacobianMode jacobian_mode = solvers::JacobianMode::kReverse;
+  solvers::ConstraintJacobianMode jacobian_mode = solvers::ConstraintJacobianMode::kReverse;
   int num_variables = 0, num_constraints = 0, num_dofs = 0, num_steps = 0;
-  bool improved = false;  // feasible (violation <= 1e-6) and improved by the margin
+  double required_objective = 0;  // RequiredObjective(initial objective)
+  bool improved = false;  // feasible (violation <= 1e-6) and objective <= required_objective
 };
 
 struct OptimizationReport {
   std::string problem;
-  double improvement_margin = 0;
+  std::string improvement_rule;
   std::vector<OptimizationRun> runs;  // [0]: the main method; [1]: newton-cholesky when compared
   // Newton-Cholesky's simulation time (forward + backward) over the main
   // method's; 0 if not compared.

@@ -294,10 +294,10 @@ bool RolloutNlp::ComputeJacobian() {
     std::vector<double> values;
     values.reserve(nnz_jac_);
     if (!constraints_.empty()) {
-      if (ResolvedJacobianMode() == JacobianMode::kForward) {
+      if (ResolvedJacobianMode() == ConstraintJacobianMode::kForward) {
         if (!ForwardModeAvailable()) {
           last_error_ = "constraint Jacobian: forward mode does not cover this problem (muscle activations, contact, "
-                        "muscles or state forces); use JacobianMode::kReverse or kAuto";
+                        "muscles or state forces); use ConstraintJacobianMode::kReverse or kAuto";
           return false;
         }
         JacobianForward(&values);
@@ -383,17 +383,17 @@ bool RolloutNlp::ForwardModeAvailable() const {
   return true;
 }
 
-JacobianMode RolloutNlp::ResolvedJacobianMode() const {
-  if (jacobian_mode_ != JacobianMode::kAuto) return jacobian_mode_;
-  return ForwardModeAvailable() && num_variables() < static_cast<int>(constraints_.size()) ? JacobianMode::kForward
-                                                                                           : JacobianMode::kReverse;
+ConstraintJacobianMode RolloutNlp::ResolvedJacobianMode() const {
+  if (jacobian_mode_ != ConstraintJacobianMode::kAuto) return jacobian_mode_;
+  return ForwardModeAvailable() && num_variables() < static_cast<int>(constraints_.size()) ? ConstraintJacobianMode::kForward
+                                                                                           : ConstraintJacobianMode::kReverse;
 }
 
-const char* ToString(JacobianMode mode) {
+const char* ToString(ConstraintJacobianMode mode) {
   switch (mode) {
-    case JacobianMode::kAuto: return "auto";
-    case JacobianMode::kReverse: return "reverse";
-    case JacobianMode::kForward: return "forward";
+    case ConstraintJacobianMode::kAuto: return "auto";
+    case ConstraintJacobianMode::kReverse: return "reverse";
+    case ConstraintJacobianMode::kForward: return "forward";
   }
   return "unknown";
 }

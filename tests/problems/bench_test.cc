@@ -44,11 +44,20 @@ TEST(MakeRefinedProblemTest, RejectsTooCoarseAndUnknownProblems) {
     EXPECT_STREQ(e.what(), "refinement = -10 is invalid for cantilever: it must be >= -9 (4 x 1 x 1 cells)");
   }
   try {
-    MakeRefinedProblem("starfish", 0);
+    MakeRefinedProblem("no-such-problem", 3);
     FAIL() << "expected InvalidInputError";
   } catch (const InvalidInputError& e) {
     EXPECT_STREQ(e.what(),
-                 "problem 'starfish' cannot be refined: refinement is available for cantilever and falling-cube");
+                 "problem 'no-such-problem' cannot be refined: refinement is available for cantilever and "
+                 "falling-cube");
+  }
+  // Unrefined, any registered problem; an unknown one lists the valid names.
+  EXPECT_EQ(MakeRefinedProblem("falling-cube", 0)->name(), "falling-cube");
+  try {
+    MakeRefinedProblem("no-such-problem", 0);
+    FAIL() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("unknown problem 'no-such-problem': valid problems are ", 0), 0u);
   }
 }
 

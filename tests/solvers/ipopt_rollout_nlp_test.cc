@@ -281,14 +281,14 @@ TEST(RolloutNlpTest, ForwardModeJacobianEqualsReverseMode) {
   BeamNlp p(TightNewton());
   const VectorXd x = p.nlp->starting_point();
   ASSERT_TRUE(p.nlp->ForwardModeAvailable());
-  EXPECT_EQ(p.nlp->ResolvedJacobianMode(), solvers::JacobianMode::kReverse);  // 22 variables, 3 constraints
+  EXPECT_EQ(p.nlp->ResolvedJacobianMode(), solvers::ConstraintJacobianMode::kReverse);  // 22 variables, 3 constraints
   MatrixXd reverse, forward;
-  p.nlp->SetJacobianMode(solvers::JacobianMode::kReverse);
+  p.nlp->SetJacobianMode(solvers::ConstraintJacobianMode::kReverse);
   ASSERT_TRUE(p.nlp->ConstraintJacobian(x, &reverse));
   EXPECT_EQ(p.nlp->statistics().tangent_passes, 0);
   // A fresh NLP, so that nothing is cached.
   BeamNlp q(TightNewton());
-  q.nlp->SetJacobianMode(solvers::JacobianMode::kForward);
+  q.nlp->SetJacobianMode(solvers::ConstraintJacobianMode::kForward);
   ASSERT_TRUE(q.nlp->ConstraintJacobian(x, &forward)) << q.nlp->last_error();
   EXPECT_EQ(q.nlp->statistics().tangent_passes, 1);
   EXPECT_EQ(q.nlp->statistics().backward_passes, 1);
@@ -310,8 +310,8 @@ TEST(RolloutNlpTest, AutoModeChoosesForwardForFewVariablesAndManyConstraints) {
   };
   Simulator sim_a(SmallBeamScene(), TightNewton()), sim_b(SmallBeamScene(), TightNewton());
   auto automatic = make(&sim_a), reverse = make(&sim_b);
-  reverse->SetJacobianMode(solvers::JacobianMode::kReverse);
-  EXPECT_EQ(automatic->ResolvedJacobianMode(), solvers::JacobianMode::kForward);
+  reverse->SetJacobianMode(solvers::ConstraintJacobianMode::kReverse);
+  EXPECT_EQ(automatic->ResolvedJacobianMode(), solvers::ConstraintJacobianMode::kForward);
   const VectorXd x = VectorXd::Constant(3, 0.01);
   MatrixXd jac_auto, jac_reverse;
   ASSERT_TRUE(automatic->ConstraintJacobian(x, &jac_auto));
@@ -362,7 +362,7 @@ struct MuscleBeam {
 TEST(RolloutNlpTest, ActivationGradientAndJacobianMatchCentralDifferences) {
   MuscleBeam p;
   EXPECT_FALSE(p.nlp->ForwardModeAvailable());
-  EXPECT_EQ(p.nlp->ResolvedJacobianMode(), solvers::JacobianMode::kReverse);
+  EXPECT_EQ(p.nlp->ResolvedJacobianMode(), solvers::ConstraintJacobianMode::kReverse);
   // A block with activations starts at rest (a = 1) by default.
   {
     std::vector<solvers::ActivationControl::Channel> channels(1);

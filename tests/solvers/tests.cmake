@@ -8,3 +8,7 @@ diffpd_add_test(ceres_coordinate_manifold_test ${CMAKE_CURRENT_LIST_DIR}/ceres_c
 diffpd_add_test(ipopt_control_signal_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_control_signal_test.cc LIBS diffpd_solvers)
 diffpd_add_test(ceres_calibration_recovery_test ${CMAKE_CURRENT_LIST_DIR}/ceres_calibration_recovery_test.cc LIBS diffpd_solvers)
 diffpd_add_test(ipopt_bunny_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_bunny_test.cc LIBS diffpd_problems diffpd_solvers)
+diffpd_add_test(ipopt_locomotion_torus_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_locomotion_torus_test.cc LIBS diffpd_problems diffpd_solvers)
+diffpd_add_test(ipopt_locomotion_quadruped_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_locomotion_quadruped_test.cc LIBS diffpd_problems diffpd_solvers)
+diffpd_add_test(ipopt_locomotion_cow_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_locomotion_cow_test.cc LIBS diffpd_problems diffpd_solvers)
+diffpd_add_test(ipopt_routing_tendon_opt_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_routing_tendon_opt_test.cc LIBS diffpd_problems diffpd_solvers)

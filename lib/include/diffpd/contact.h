@@ -29,7 +29,8 @@
 // and the backward pass (kRefactorize instead factorises the erased matrix;
 // same solution, for comparison and benchmarks). Newton methods pin the same
 // nodes as extra fixed DoFs. Semi-implicit Euler does not support frictional
-// contact (Step throws InvalidInputError).
+// contact (Step throws InvalidInputError); SolveQuasiStatic ignores it (there
+// is no previous state to pin from).
 //
 // Gradients: the backward pass holds each step's recorded active set fixed, so
 // the gradient is that of the smooth piece of the trajectory on which the

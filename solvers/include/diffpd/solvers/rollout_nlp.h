@@ -12,7 +12,7 @@
 //
 // Derivatives, all exact to the simulator's tolerances:
 //  - objective gradient: one reverse-mode pass (Simulator::Backward) per point;
-//  - constraint Jacobian, chosen by size (JacobianMode::kAuto):
+//  - constraint Jacobian, chosen by size (ConstraintJacobianMode::kAuto):
 //    reverse mode, one Backward per trajectory constraint, each over the
 //    rollout truncated after the constraint's last state (a constraint at
 //    step k costs k adjoint steps); or forward mode, one Simulator::Tangents
@@ -67,12 +67,12 @@ struct RolloutNlpStatistics {
 };
 
 // How the constraint Jacobian is computed (see the file comment).
-enum class JacobianMode {
+enum class ConstraintJacobianMode {
   kAuto,     // forward if available and num_variables < trajectory constraints, else reverse
   kReverse,  // one adjoint pass per trajectory constraint
   kForward,  // one tangent pass; evaluation fails (returns false) where unavailable
 };
-const char* ToString(JacobianMode mode);
+const char* ToString(ConstraintJacobianMode mode);
 
 // One Ipopt iteration as reported to intermediate_callback.
 struct IterationRecord {
@@ -105,11 +105,11 @@ class RolloutNlp : public Ipopt::TNLP {
   // Throws InvalidInputError on a size mismatch or a non-finite entry.
   void SetStartingPoint(const VectorXd& x);
 
-  void SetJacobianMode(JacobianMode mode) { jacobian_mode_ = mode; }
+  void SetJacobianMode(ConstraintJacobianMode mode) { jacobian_mode_ = mode; }
   // True if forward mode covers this problem (see the file comment).
   bool ForwardModeAvailable() const;
   // kForward or kReverse: what kAuto resolves to, or the mode set.
-  JacobianMode ResolvedJacobianMode() const;
+  ConstraintJacobianMode ResolvedJacobianMode() const;
 
   int num_variables() const { return static_cast<int>(lower_.size()); }
   int num_constraints() const;
@@ -213,7 +213,7 @@ class RolloutNlp : public Ipopt::TNLP {
   std::vector<LinearConstraint> linear_;
   std::vector<std::vector<int>> row_columns_;  // per constraint row
   int nnz_jac_ = -1;
-  JacobianMode jacobian_mode_ = JacobianMode::kAuto;
+  ConstraintJacobianMode jacobian_mode_ = ConstraintJacobianMode::kAuto;
 
   std::unique_ptr<Cache> cache_;
   RolloutNlpStatistics stats_;

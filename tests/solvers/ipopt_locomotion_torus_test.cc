@@ -1,0 +1,16 @@
+// The torus locomotion problem (problems/locomotion.h), small instance.
+#include "ipopt_locomotion_test.h"
+
+namespace diffpd::problems::testing {
+namespace {
+
+TEST(IpoptLocomotionTorusTest, DerivativeCheckerReportsNoError) {
+  ExpectDerivativeCheckerPasses(Locomotion::Body::kTorus, 6);
+}
+
+TEST(IpoptLocomotionTorusTest, FewIterationsMoveItForwardWithinBoundsAndUpright) {
+  ExpectForwardProgress(Locomotion::Body::kTorus, 12, 3);
+}
+
+}  // namespace
+}  // namespace diffpd::problems::testing
