@@ -6,6 +6,6 @@ set -euo pipefail
 cd "$(dirname "$0")"
 ./scripts/setup.sh --target diffpd_cli
 if [ $# -eq 0 ]; then
-  exec build/bin/diffpd run cantilever --out out/cantilever
+  exec build/bin/diffpd run calibrate-plant --out out/calibrate-plant
 fi
 exec build/bin/diffpd run "$@"

@@ -170,6 +170,11 @@ RolloutMeasurement MeasureRollout(const Scene& scene, const SolverOptions& optio
       return m;
     }
     m.final_state = rollout.states.back();
+    if (!m.final_state.x.allFinite() || !m.final_state.v.allFinite() || !m.gradient.allFinite()) {
+      m.failure = "non-finite result returned without an error (a library bug)";
+      m.status = SolverStatus::kNonFinite;
+      return m;
+    }
     m.total_iterations = 0;
     for (const auto& rep : rollout.reports) m.total_iterations += rep.iterations;
   }

@@ -77,7 +77,8 @@ struct RolloutMeasurement {
 
 // Runs `repeat` (>= 1) rollouts of `inputs` from `initial` on fresh
 // simulators of (scene, options) and the backward pass of `loss`; times are
-// medians. SolverError is caught into `failure`; InvalidInputError propagates.
+// medians. SolverError is caught into `failure`, and so is a non-finite
+// final state or gradient returned without one; InvalidInputError propagates.
 RolloutMeasurement MeasureRollout(const Scene& scene, const SolverOptions& options, const State& initial,
                                   const std::vector<StepInput>& inputs, const LinearLoss& loss, int repeat = 1);
 

@@ -176,7 +176,7 @@ int CalibrationProblem::default_steps() const {
   return MarkerObservations::RequiredSteps(motion, default_time_step());
 }
 
-CapturedMotion CalibrationProblem::Synthesize(bool clean) const {
+Rollout CalibrationProblem::TruthRollout() const {
   Scene scene = MakeScene();
   scene.material = truth();
   SolverOptions options;
@@ -186,15 +186,22 @@ CapturedMotion CalibrationProblem::Synthesize(bool clean) const {
   options.abs_tolerance = 1e-11;
   options.num_threads = 1;
   Simulator sim(scene, options);
-  const Rollout rollout = sim.Simulate(InitialState(sim), Inputs(sim, default_steps()));
-  return SampleMarkers(scene.mesh, rollout.states, options.time_step, Markers(scene.mesh), CaptureTimes(),
+  return sim.Simulate(InitialState(sim), Inputs(sim, default_steps()));
+}
+
+CapturedMotion CalibrationProblem::Sample(const Rollout& truth_rollout, bool clean) const {
+  const Mesh mesh = MakeScene().mesh;
+  return SampleMarkers(mesh, truth_rollout.states, default_time_step(), Markers(mesh), CaptureTimes(),
                        clean ? 0.0 : noise(), seed());
 }
+
+CapturedMotion CalibrationProblem::Synthesize(bool clean) const { return Sample(TruthRollout(), clean); }
 
 std::vector<std::string> CalibrationProblem::WriteSyntheticData(const std::string& dir) const {
   std::filesystem::create_directories(dir);
   std::vector<std::string> paths;
   const MaterialParameters t = truth();
+  const Rollout truth_rollout = TruthRollout();
   for (bool clean : {false, true}) {
     const std::string path =
         (std::filesystem::path(dir) / (clean ? Stem(data_file()) + "_clean.csv" : data_file())).string();
@@ -210,7 +217,7 @@ std::vector<std::string> CalibrationProblem::WriteSyntheticData(const std::strin
     else
       comment << "plus Gaussian noise of standard deviation " << noise() << " m on every coordinate (seed " << seed()
               << ", std::mt19937_64 and Box-Muller).";
-    WriteCapturedMotion(path, Synthesize(clean), comment.str());
+    WriteCapturedMotion(path, Sample(truth_rollout, clean), comment.str());
     paths.push_back(path);
   }
   return paths;
@@ -219,7 +226,7 @@ std::vector<std::string> CalibrationProblem::WriteSyntheticData(const std::strin
 std::string CalibrationProblem::DefaultDataPath() const {
   const char* env = std::getenv("DIFFPD_DATA");
   const std::string dir = env && *env ? env : DIFFPD_PROJECT_DATA_DIR;
-  return (std::filesystem::path(dir) / data_file()).string();
+  return (std::filesystem::path(dir) / data_file()).lexically_normal().string();
 }
 
 CalibrationFit CalibrationProblem::Fit(const CapturedMotion& motion, Method method, int max_iterations,

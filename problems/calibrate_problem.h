@@ -103,6 +103,12 @@ class CalibrationProblem : public Problem {
   // "evaluations", "forward_seconds", "backward_seconds", and "fits" with
   // one object per method.
   nlohmann::json Report(const std::vector<CalibrationFit>& fits, const std::string& data_path) const;
+
+ private:
+  // The true trajectory (newton-cholesky, relative tolerance 1e-11) and its
+  // markers at the capture times.
+  Rollout TruthRollout() const;
+  CapturedMotion Sample(const Rollout& truth_rollout, bool clean) const;
 };
 
 }  // namespace diffpd::problems

@@ -1,6 +1,7 @@
 #include "problem_registry.h"
 
 #include "bouncing_ball.h"
+#include "calibrate_bouncing_ball.h"
 #include "calibrate_plant.h"
 #include "bunny.h"
 #include "cantilever.h"
@@ -27,6 +28,7 @@ std::vector<std::unique_ptr<Problem>> AllProblems() {
   all.push_back(std::make_unique<Locomotion>(Locomotion::Body::kQuadruped));
   all.push_back(std::make_unique<Locomotion>(Locomotion::Body::kCow));
   all.push_back(std::make_unique<PlantCalibration>());
+  all.push_back(std::make_unique<BouncingBallCalibration>());
   return all;
 }
 

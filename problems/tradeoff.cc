@@ -330,9 +330,16 @@ void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& 
                                                                                           : "mesh-resolution sweep";
       script << "set title '" << label << "'\nset xlabel 'forward + backward time (s)'\nset ylabel '" << what[row]
              << " relative error'\nplot ";
-      for (size_t k = 0; k < methods.size(); ++k)
-        script << (k ? ", " : "") << block(s, methods[k]) << " using 1:" << (row + 2) << " with linespoints title '"
-               << methods[k] << "'";
+      bool first = true;
+      for (const auto& m : methods) {
+        const bool any = std::any_of(rows.begin(), rows.end(), [&](const TradeoffRow& r) {
+          return r.sweep == s && r.method == m && r.failure.empty();
+        });
+        if (!any) continue;  // every run failed: no curve (and no gnuplot warning)
+        script << (first ? "" : ", ") << block(s, m) << " using 1:" << (row + 2) << " with linespoints title '" << m
+               << "'";
+        first = false;
+      }
       script << "\n";
     }
   script << "unset multiplot\nset output\n";

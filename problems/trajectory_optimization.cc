@@ -71,6 +71,7 @@ nlohmann::json RunJson(const OptimizationRun& run) {
           {"adjoint_passes", s.backward_passes},
           {"total_s", s.total_seconds},
           {"improved", run.improved},
+          {"returned_best_feasible", s.returned_best_feasible},
           {"required_objective", run.required_objective},
           {"jacobian_mode", solvers::ToString(run.jacobian_mode)},
           {"variables", run.num_variables},
@@ -239,8 +240,10 @@ nlohmann::json ReportJson(const OptimizationReport& report) {
 }
 
 int ExitCode(const OptimizationReport& report) {
-  const IpoptSummary& s = report.runs.at(0).summary;
+  const OptimizationRun& run = report.runs.at(0);
+  const IpoptSummary& s = run.summary;
   if (s.succeeded()) return 0;
+  if (s.status == Ipopt::Maximum_Iterations_Exceeded && run.improved) return 0;
   return s.infeasible() ? 4 : 5;
 }
 
@@ -286,7 +289,8 @@ int TrajectoryOptimizationProblem::Run(const CommandArgs& args) const {
   const OptimizationReport report = RunOptimization(*this, settings);
   PrintReport(report, text);
   if (!report.runs[0].summary.succeeded())
-    std::fprintf(stderr, "diffpd: %s: %s\n", name().c_str(), DescribeOutcome(report.runs[0].summary).c_str());
+    std::fprintf(stderr, "diffpd: %s: %s%s\n", name().c_str(), DescribeOutcome(report.runs[0].summary).c_str(),
+                 report.runs[0].improved ? "; the point reached is feasible and meets the improvement rule" : "");
   if (args.json) std::printf("%s\n", ReportJson(report).dump(2).c_str());
   return ExitCode(report);
 }

@@ -112,8 +112,10 @@ nlohmann::json ReportJson(const OptimizationReport& report);
 // InvalidInputError without '=' or with an empty name or value.
 void AddIpoptOption(const std::string& name_value, solvers::IpoptOptions* options);
 
-// Process exit code of a run: 0 if the main run succeeded, 4 if Ipopt found
-// the problem infeasible, 5 for any other unsuccessful end.
+// Process exit code of a run: 0 if the main run succeeded, or stopped at
+// its iteration limit (small instances cap it on purpose) at a feasible point
+// that meets the improvement rule; 4 if Ipopt found the problem infeasible;
+// 5 for any other end.
 int ExitCode(const OptimizationReport& report);
 
 }  // namespace diffpd::problems

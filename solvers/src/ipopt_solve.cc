@@ -108,7 +108,7 @@ std::string IpoptSummary::BriefReport() const {
                 "%ld adjoints, forward %.3f s, backward %.3f s",
                 status_name.c_str(), objective, initial_objective, constraint_violation, iterations, evaluations,
                 backward_passes, forward_seconds, backward_seconds);
-  return line;
+  return returned_best_feasible ? std::string(line) + " (best feasible point visited)" : std::string(line);
 }
 
 IpoptSummary SolveWithIpopt(const Ipopt::SmartPtr<RolloutNlp>& nlp, const IpoptOptions& options) {
@@ -145,6 +145,8 @@ IpoptSummary SolveWithIpopt(const Ipopt::SmartPtr<RolloutNlp>& nlp, const IpoptO
   const VectorXd x0 = nlp->starting_point();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   if (!nlp->Objective(x0, &summary.initial_objective)) summary.initial_objective = nan;
+  constexpr double kFeasibility = 1e-6;
+  nlp->ResetBestFeasible(kFeasibility);
   if (status == Ipopt::Solve_Succeeded) status = app->OptimizeTNLP(Ipopt::GetRawPtr(nlp));
 
   summary.status = status;
@@ -152,6 +154,14 @@ IpoptSummary SolveWithIpopt(const Ipopt::SmartPtr<RolloutNlp>& nlp, const IpoptO
   summary.x = nlp->has_solution() && nlp->solution().size() == x0.size() ? nlp->solution() : x0;
   if (!nlp->Objective(summary.x, &summary.objective)) summary.objective = nan;
   summary.constraint_violation = nlp->ConstraintViolation(summary.x);
+  const bool success = status == Ipopt::Solve_Succeeded || status == Ipopt::Solved_To_Acceptable_Level;
+  if (!success && nlp->has_best_feasible() &&
+      (!(summary.constraint_violation <= kFeasibility) || !(summary.objective <= nlp->best_feasible_objective()))) {
+    summary.x = nlp->best_feasible_x();
+    summary.returned_best_feasible = true;
+    if (!nlp->Objective(summary.x, &summary.objective)) summary.objective = nan;
+    summary.constraint_violation = nlp->ConstraintViolation(summary.x);
+  }
   const RolloutNlpStatistics& after = nlp->statistics();
   summary.evaluations = after.rollouts - before.rollouts;
   summary.backward_passes = after.backward_passes - before.backward_passes;

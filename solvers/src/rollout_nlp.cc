@@ -171,6 +171,8 @@ bool RolloutNlp::Guarded(const char* what, Fn&& fn) {
     last_error_ = std::string(what) + ": solver failed (" + ToString(e.status()) + "): " + e.what();
   } catch (const std::exception& e) {
     last_error_ = std::string(what) + ": " + e.what();
+  } catch (...) {
+    last_error_ = std::string(what) + ": unknown exception";
   }
   return false;
 }
@@ -244,6 +246,7 @@ bool RolloutNlp::ComputeObjective() {
     }
     cache_->f = f;
     cache_->has_f = true;
+    ConsiderBest();
     return true;
   });
 }
@@ -283,6 +286,7 @@ bool RolloutNlp::ComputeConstraints() {
     }
     cache_->g = std::move(g);
     cache_->has_g = true;
+    ConsiderBest();
     return true;
   });
 }
@@ -455,6 +459,31 @@ bool RolloutNlp::ConstraintJacobian(const VectorXd& x, MatrixXd* jacobian) {
 const Rollout* RolloutNlp::RolloutAt(const VectorXd& x) {
   if (x.size() != num_variables()) return nullptr;
   return Update(x.data(), true) ? &cache_->rollout : nullptr;
+}
+
+void RolloutNlp::ResetBestFeasible(double tolerance) {
+  best_x_.resize(0);
+  best_f_ = 0;
+  best_tolerance_ = tolerance;
+}
+
+void RolloutNlp::ConsiderBest() {
+  if (!cache_->ok || !cache_->has_f) return;
+  if (!cache_->has_g) {
+    if (num_constraints() > 0) return;
+    cache_->g.resize(0);
+    cache_->has_g = true;
+  }
+  if (has_best_feasible() && cache_->f >= best_f_) return;
+  double v = 0;
+  for (size_t c = 0; c < constraints_.size(); ++c)
+    v = std::max(v, Violation(cache_->g(c), constraints_[c].lower, constraints_[c].upper));
+  for (size_t l = 0; l < linear_.size(); ++l)
+    v = std::max(v, Violation(cache_->g(constraints_.size() + l), linear_[l].lower, linear_[l].upper));
+  for (int j = 0; j < num_variables(); ++j) v = std::max(v, Violation(cache_->x(j), lower_(j), upper_(j)));
+  if (v > best_tolerance_) return;
+  best_x_ = cache_->x;
+  best_f_ = cache_->f;
 }
 
 double RolloutNlp::ConstraintViolation(const VectorXd& x) {

@@ -84,9 +84,9 @@ TEST(FrictionalContactTest, WoodburyAndRefactorisationGiveTheSameTrajectory) {
   Simulator a(scene, options), b(refactor, options);
   State init = a.RestState();
   for (int i = 0; i < init.x.size() / 3; ++i) init.v.segment<3>(3 * i) = Vec3(0.2, 0.0, -0.3);
-  const Rollout ra = a.Simulate(init, std::vector<StepInput>(6));
-  const Rollout rb = b.Simulate(init, std::vector<StepInput>(6));
-  for (int k = 0; k < 6; ++k) {
+  const Rollout ra = a.Simulate(init, std::vector<StepInput>(4));
+  const Rollout rb = b.Simulate(init, std::vector<StepInput>(4));
+  for (int k = 0; k < 4; ++k) {
     EXPECT_EQ(ra.reports[k].contact_nodes, rb.reports[k].contact_nodes);
     EXPECT_EQ(ra.reports[k].iterations, rb.reports[k].iterations);
     EXPECT_LT((ra.states[k + 1].x - rb.states[k + 1].x).cwiseAbs().maxCoeff(), 1e-12);

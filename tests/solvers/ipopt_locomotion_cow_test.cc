@@ -5,11 +5,11 @@ namespace diffpd::problems::testing {
 namespace {
 
 TEST(IpoptLocomotionCowTest, DerivativeCheckerReportsNoError) {
-  ExpectDerivativeCheckerPasses(Locomotion::Body::kCow, 8);
+  ExpectDerivativeCheckerPasses(Locomotion::Body::kCow, 6);
 }
 
 TEST(IpoptLocomotionCowTest, FewIterationsMoveItForwardWithinBoundsAndUpright) {
-  ExpectForwardProgress(Locomotion::Body::kCow, 12, 3);
+  ExpectForwardProgress(Locomotion::Body::kCow, 10, 3);
 }
 
 }  // namespace

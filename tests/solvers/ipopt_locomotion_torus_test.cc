@@ -5,7 +5,7 @@ namespace diffpd::problems::testing {
 namespace {
 
 TEST(IpoptLocomotionTorusTest, DerivativeCheckerReportsNoError) {
-  ExpectDerivativeCheckerPasses(Locomotion::Body::kTorus, 6);
+  ExpectDerivativeCheckerPasses(Locomotion::Body::kTorus, 5);
 }
 
 TEST(IpoptLocomotionTorusTest, FewIterationsMoveItForwardWithinBoundsAndUpright) {

@@ -397,6 +397,55 @@ TEST(RolloutNlpTest, ActivationGradientAndJacobianMatchCentralDifferences) {
   EXPECT_EQ(jac(0, 3), 0.0);
 }
 
+TEST(RolloutNlpTest, KeepsTheBestFeasiblePointWhereBothFAndGWereEvaluated) {
+  // A free cube thrown with velocity v (|v_i| <= 1): objective -c_z(K), the
+  // constraint c_x(K) - c_x(0) <= 0 (c the centre of mass).
+  Scene scene;
+  scene.mesh = BoxHexMesh(2, 2, 2, 0.1, 0.1, 0.1);
+  scene.gravity = Vec3(0, 0, -9.81);
+  SolverOptions options = TightNewton();
+  options.abs_tolerance = 1e-9;
+  options.rel_tolerance = 1e-9;
+  Simulator sim(scene, options);
+  std::vector<int> all(scene.mesh.num_vertices());
+  for (int i = 0; i < scene.mesh.num_vertices(); ++i) all[i] = i;
+  RolloutNlp nlp(&sim, RestSetup(sim, 3));
+  auto v0 = std::make_unique<solvers::InitialStateVariables>(solvers::InitialStateVariables::kVelocity, all);
+  v0->SetBounds(-1.0, 1.0);
+  nlp.AddVariables(std::move(v0));
+  const solvers::TrackedPoint com = solvers::CentreOfMass(sim.LumpedMass());
+  nlp.AddObjective(std::make_unique<solvers::PointCoordinate>(com, solvers::kFinalState, Vec3::UnitZ()), -1.0);
+  nlp.AddConstraint(std::make_unique<solvers::PointTravel>(com, 0, solvers::kFinalState, Vec3::UnitX()), -1.0, 0.0);
+  nlp.ResetBestFeasible(1e-6);
+  EXPECT_FALSE(nlp.has_best_feasible());
+  const VectorXd x0 = VectorXd::Zero(3), x1 = Vec3(0.5, 0, 0.5), x2 = Vec3(-0.5, 0, 0.5), x3 = Vec3(0, 0, 1.5);
+  double f0, f1, f2, f3;
+  VectorXd g;
+  ASSERT_TRUE(nlp.Objective(x0, &f0)) << nlp.last_error();
+  EXPECT_FALSE(nlp.has_best_feasible());  // g not evaluated there yet
+  ASSERT_TRUE(nlp.Constraints(x0, &g));
+  ASSERT_TRUE(nlp.has_best_feasible());
+  EXPECT_EQ(nlp.best_feasible_x(), x0);
+  EXPECT_EQ(nlp.best_feasible_objective(), f0);
+  // Lower objective, but c_x(K) > 0: not kept.
+  ASSERT_TRUE(nlp.Constraints(x1, &g));
+  ASSERT_TRUE(nlp.Objective(x1, &f1));
+  ASSERT_LT(f1, f0);
+  ASSERT_GT(g(0), 0.0);
+  EXPECT_EQ(nlp.best_feasible_x(), x0);
+  // Lower objective outside the variable bounds: not kept either.
+  ASSERT_TRUE(nlp.Objective(x3, &f3));
+  ASSERT_TRUE(nlp.Constraints(x3, &g));
+  ASSERT_LT(f3, f0);
+  EXPECT_EQ(nlp.best_feasible_x(), x0);
+  // The same height, feasible: kept.
+  ASSERT_TRUE(nlp.Objective(x2, &f2));
+  ASSERT_TRUE(nlp.Constraints(x2, &g));
+  EXPECT_NEAR(f2, f1, 1e-12);
+  EXPECT_EQ(nlp.best_feasible_x(), x2);
+  EXPECT_EQ(nlp.best_feasible_objective(), f2);
+}
+
 TEST(RolloutNlpTest, BadInputIsRefusedWithAMessage) {
   Simulator sim(SmallBeamScene(), TightNewton());
   solvers::RolloutSetup setup = RestSetup(sim, 0);

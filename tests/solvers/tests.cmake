@@ -12,3 +12,10 @@ diffpd_add_test(ipopt_locomotion_torus_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_loco
 diffpd_add_test(ipopt_locomotion_quadruped_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_locomotion_quadruped_test.cc LIBS diffpd_problems diffpd_solvers)
 diffpd_add_test(ipopt_locomotion_cow_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_locomotion_cow_test.cc LIBS diffpd_problems diffpd_solvers)
 diffpd_add_test(ipopt_routing_tendon_opt_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_routing_tendon_opt_test.cc LIBS diffpd_problems diffpd_solvers)
+# The README's example program, run on synthetic data by readme_example_test.
+add_executable(readme_example ${CMAKE_CURRENT_LIST_DIR}/readme_example.cc)
+target_link_libraries(readme_example PRIVATE diffpd_solvers diffpd_compile_options)
+diffpd_add_test(readme_example_test ${CMAKE_CURRENT_LIST_DIR}/readme_example_test.cc)
+target_compile_definitions(readme_example_test PRIVATE DIFFPD_README_EXAMPLE="$<TARGET_FILE:readme_example>")
+add_dependencies(readme_example_test readme_example)
+diffpd_add_test(ceres_calibrate_plant_test ${CMAKE_CURRENT_LIST_DIR}/ceres_calibrate_plant_test.cc LIBS diffpd_problems)

@@ -51,6 +51,20 @@
 //   v_t = v_i - (n . v_i) n,  eps = friction_velocity,
 //
 // smooth in the state (explicit: keep mu f_n h / (eps m) < 2 for stability).
+//
+// Scene::Validate rejects, with InvalidInputError, e.g.:
+//   "scene: frictional_contacts[0].surface.normal = (0, 0, 0) is invalid: must be finite with non-zero length",
+//   "scene: frictional_contacts[0].surface.radius = 0 is invalid: must be finite and > 0 (m)",
+//   "scene: frictional_contacts[0].surface: a height field needs both height and height_gradient",
+//   "scene: frictional_contacts[0].nodes[2] = 45 is out of range [0, 45) (no such node)",
+//   "scene: node 40 is a candidate of frictional_contacts[0] and frictional_contacts[1] (a node may be a
+//    frictional contact candidate once)",
+//   "scene: frictional_contacts[0].nodes[2] = 0 has a Dirichlet DoF; frictional contact candidates must be free",
+//   "scene: frictional_contact_options.max_passes = 0 is invalid: must be >= 1",
+//   "scene: frictional_contact_options.penetration_tolerance = -1 is invalid: must be finite and >= 0 (m)",
+//   "scene: penalty_contacts[0].stiffness = 0 is invalid: must be finite and > 0 (N/m)",
+//   "scene: penalty_contacts[0].friction = nan is invalid: must be finite and >= 0"
+// (likewise normal, offset, friction_velocity of penalty contacts).
 #pragma once
 
 #include <functional>

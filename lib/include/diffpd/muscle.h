@@ -16,6 +16,17 @@
 // fibre direction m is used), so PD solves it with the constant matrix A
 // (activation does not enter A) and Newton with its exact Hessian.
 // Gradients w.r.t. the activations: RolloutGradient::activation.
+//
+// Scene::Validate rejects, with InvalidInputError (j, t indices):
+//   "scene: muscles[j] has no elements",
+//   "scene: muscles[j].elements[t] = 99 is out of range [0, 40) (no such element)",
+//   "scene: muscles[j] has 3 fibre directions for 2 elements (need one per element or a single shared one)",
+//   "scene: muscles[j].fibers[t] = (0, 0, 0) is invalid: must be finite with non-zero length",
+//   "scene: muscles[j].stiffness = -1 is invalid: must be finite and > 0 (Pa)".
+// Step rejects a StepInput::activation of the wrong size or with a negative
+// or non-finite entry:
+//   "activation has 3 entries, expected 2 (one per muscle)",
+//   "activation[1] = nan is invalid: must be finite and >= 0".
 #pragma once
 
 #include <vector>

@@ -24,6 +24,14 @@
 // face) to drag_normal (flow normal to it); defaults 0.05 and 2.05 follow the
 // starfish fact sheet. Each triangle's force is shared equally by its three
 // nodes. Both terms are O(|u|^2): zero with zero derivative at u = 0.
+//
+// Scene::Validate rejects, with InvalidInputError, e.g.:
+//   "scene: hydrodynamics.triangles(2, 5) = 99 is out of range [0, 45) (no such node)",
+//   "scene: hydrodynamics.fluid_density = nan is invalid: must be finite and >= 0 (kg/m^3)",
+//   "scene: hydrodynamics.drag_normal = inf is invalid: must be finite and >= 0" (also drag_tangential),
+//   "scene: hydrodynamics.thrust = nan is invalid: must be finite",
+//   "scene: hydrodynamics.flow_velocity = (0, inf, 0) is invalid: must be finite (m/s)",
+//   "scene: linear_damping = -2 is invalid: must be finite and >= 0 (1/s)".
 #pragma once
 
 #include <vector>

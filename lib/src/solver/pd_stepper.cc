@@ -76,7 +76,19 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
       d = -pd.Solve(grad);
     }
     const VectorXd x_old = x, grad_old = grad;
-    report->line_search_steps += BacktrackingLineSearch(objective, d, &x, &value, &grad);
+    try {
+      report->line_search_steps += BacktrackingLineSearch(objective, d, &x, &value, &grad);
+    } catch (const SolverError& e) {
+      // Stale curvature pairs can spoil the direction near convergence:
+      // restart once from the plain PD direction before giving up.
+      if (e.status() != SolverStatus::kLineSearchFailed || s_list.empty()) throw;
+      s_list.clear();
+      y_list.clear();
+      rho_list.clear();
+      d = -pd.Solve(grad);
+      sim.ZeroFixed(&d);
+      report->line_search_steps += BacktrackingLineSearch(objective, d, &x, &value, &grad);
+    }
     VectorXd s = x - x_old, y = grad - grad_old;
     const double sy = s.dot(y);
     if (sy > 1e-12 * s.norm() * y.norm()) {

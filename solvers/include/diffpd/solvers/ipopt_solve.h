@@ -44,7 +44,13 @@ struct IpoptSummary {
   double forward_seconds = 0;     // in Simulator::Simulate during the solve
   double backward_seconds = 0;    // in Simulator::Backward during the solve
   double total_seconds = 0;       // wall time of the whole solve
-  VectorXd x;                     // the returned point (the starting point if Ipopt returned none)
+  // The returned point: Ipopt's, or, when Ipopt ended without success at a
+  // point that is infeasible or worse than the best feasible point it
+  // evaluated, that best feasible point (returned_best_feasible = true);
+  // the starting point if Ipopt returned none. objective and
+  // constraint_violation are those of x.
+  VectorXd x;
+  bool returned_best_feasible = false;
   std::vector<double> objective_history;  // objective per Ipopt iteration (0 = start)
   std::string log;                // Ipopt's output at the chosen print_level
   // From derivative_test output: -1 if it did not run, else the number of

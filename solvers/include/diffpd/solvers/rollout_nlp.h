@@ -133,6 +133,15 @@ class RolloutNlp : public Ipopt::TNLP {
   // +infinity if the rollout fails.
   double ConstraintViolation(const VectorXd& x);
 
+  // The feasible point with the lowest objective among the evaluation
+  // points where both f and g were evaluated (Ipopt evaluates both at every
+  // trial point): constraints and bounds met within `tolerance`. Cleared by
+  // ResetBestFeasible (SolveWithIpopt does so before solving).
+  void ResetBestFeasible(double tolerance = 1e-6);
+  bool has_best_feasible() const { return best_x_.size() > 0; }
+  const VectorXd& best_feasible_x() const { return best_x_; }
+  double best_feasible_objective() const { return best_f_; }
+
   const RolloutNlpStatistics& statistics() const { return stats_; }
   const std::vector<IterationRecord>& iterations() const { return iterations_; }
   const std::string& last_error() const { return last_error_; }
@@ -197,6 +206,8 @@ class RolloutNlp : public Ipopt::TNLP {
   void PullBackLoss(const LossGradient& loss, int last, Eigen::Ref<VectorXd> out);
   // Column lists of the Jacobian rows (built once).
   void BuildStructure();
+  // Records the cached point as the best feasible one if it is.
+  void ConsiderBest();
   template <typename Fn>
   bool Guarded(const char* what, Fn&& fn);
 
@@ -216,6 +227,9 @@ class RolloutNlp : public Ipopt::TNLP {
   ConstraintJacobianMode jacobian_mode_ = ConstraintJacobianMode::kAuto;
 
   std::unique_ptr<Cache> cache_;
+  VectorXd best_x_;
+  double best_f_ = 0;
+  double best_tolerance_ = 1e-6;
   RolloutNlpStatistics stats_;
   std::vector<IterationRecord> iterations_;
   std::string last_error_;
