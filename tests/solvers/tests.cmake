@@ -19,3 +19,4 @@ diffpd_add_test(readme_example_test ${CMAKE_CURRENT_LIST_DIR}/readme_example_tes
 target_compile_definitions(readme_example_test PRIVATE DIFFPD_README_EXAMPLE="$<TARGET_FILE:readme_example>")
 add_dependencies(readme_example_test readme_example)
 diffpd_add_test(ceres_calibrate_plant_test ${CMAKE_CURRENT_LIST_DIR}/ceres_calibrate_plant_test.cc LIBS diffpd_problems)
+diffpd_add_test(ipopt_trajectory_constraint_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_trajectory_constraint_test.cc LIBS diffpd_solvers)
