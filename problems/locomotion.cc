@@ -132,7 +132,7 @@ Scene Locomotion::MakeScene(InstanceSize size) const {
     case Body::kTorus: {
       const SurfaceMesh surface = ReadObj(SharedDataPath("meshes/torus.obj"));
       const double extent = (surface.vertices.rowwise().maxCoeff() - surface.vertices.rowwise().minCoeff()).maxCoeff();
-      scene.mesh = VoxelizeSurface(surface, small ? 0.016 : 0.008, 0.1 / extent);
+      scene.mesh = VoxelizeSurface(surface, small ? 0.016 : 0.0125, 0.1 / extent);
       PlaceOnGround(&scene.mesh);
       scene.muscles = RingMuscles(scene.mesh, small ? 4 : 8);
       break;
@@ -144,7 +144,7 @@ Scene Locomotion::MakeScene(InstanceSize size) const {
     case Body::kCow: {
       const SurfaceMesh surface = ReadObj(SharedDataPath("meshes/spot.obj"));
       const double length = surface.vertices.row(0).maxCoeff() - surface.vertices.row(0).minCoeff();
-      scene.mesh = VoxelizeSurface(surface, small ? 0.02 : 0.0086, 0.1 / length);
+      scene.mesh = VoxelizeSurface(surface, small ? 0.02 : 0.0125, 0.1 / length);
       PlaceOnGround(&scene.mesh);
       const double height = scene.mesh.vertices.row(2).maxCoeff();
       scene.muscles = LegMuscles(scene.mesh, 0.35 * height, /*split=*/false);

@@ -21,8 +21,10 @@
 //  - cow: the shared spot.obj scaled to 0.1 m long (z up, legs below
 //    35 % of its height); muscles = the four legs, fibres vertical; "up"
 //    as for the quadruped.
-// Small: coarse voxels, 20 steps (two periods; quadruped 30), 8 Ipopt iterations; full:
-// finer voxels, 80 steps, 40 iterations. Ipopt accepts a trial point after 3
+// Small: coarse voxels, 20 steps (two periods; quadruped 30), 8 Ipopt
+// iterations; full: finer voxels (torus and cow 12.5 mm, quadruped 15 mm),
+// 40 steps, 40 iterations (a full rollout takes about 10 s with
+// newton-cholesky on one core: finer meshes are out of reach for now). Ipopt accepts a trial point after 3
 // backtracking steps (accept_after_max_steps): the contact makes the
 // objective piecewise smooth, and long line searches cost a rollout each.
 // Start: a travelling wave of amplitude 0.1.
@@ -44,7 +46,7 @@ class Locomotion : public TrajectoryOptimizationProblem {
   std::string name() const override;
   std::string description() const override;
   Scene MakeScene(InstanceSize size) const override;
-  int steps(InstanceSize size) const override { return size == InstanceSize::kSmall ? small_steps_ : 80; }
+  int steps(InstanceSize size) const override { return size == InstanceSize::kSmall ? small_steps_ : 40; }
   double time_step(InstanceSize size) const override { return 0.01; }
   SolverOptions BaseOptions(InstanceSize size) const override;
   Ipopt::SmartPtr<solvers::RolloutNlp> MakeNlp(Simulator* sim, InstanceSize size) const override;

@@ -296,6 +296,8 @@ VectorXd CalibrationModel::ParameterGradient(const RolloutGradient& g, int last_
     if (d.v0.size()) v += g.v0.dot(d.v0);
     for (int k = 0; k < last_step && k < static_cast<int>(d.external_force.size()); ++k)
       if (d.external_force[k].size()) v += g.external_force[k].dot(d.external_force[k]);
+    for (int k = 0; k < last_step && k < static_cast<int>(d.activation.size()); ++k)
+      if (d.activation[k].size() && g.activation[k].size()) v += g.activation[k].dot(d.activation[k]);
     out(column++) = v;
   }
   return out;

@@ -199,7 +199,7 @@ TEST(FrictionalContactTest, AnInactivePlaneLeavesTheTrajectoryUnchanged) {
 }
 
 // A box sliding onto a tilted plane: its bottom nodes arrive during the first
-// step (entry pins) and stay pinned; gradients w.r.t. every input match
+// step and stay pinned; gradients w.r.t. every input match
 // central differences (the perturbations leave the active sets unchanged).
 Scene SlidingBoxScene(const ContactSurface& surface) {
   Scene scene;

@@ -320,7 +320,10 @@ TEST(TangentRolloutTest, FrictionalContactTangentsMatchReverseModeAndFiniteDiffe
       const Rollout minus = Perturbed(scene, options, start, steps, dirs[p], -eps);
       for (int k = 0; k < steps; ++k) ASSERT_EQ(plus.reports[k].contact_nodes, rollout.reports[k].contact_nodes);
       const VectorXd fd = (plus.states[steps].x - minus.states[steps].x) / (2 * eps);
-      EXPECT_LT((t.dx[steps].col(p) - fd).norm(), 1e-6 * fd.norm()) << ToString(method) << " direction " << p;
+      // Central differences carry the forward solves' rounding / eps, about
+      // 1e-15 m / 1e-6 = 1e-9 m per unit, which matters where the pinned
+      // contact nodes make the final state almost insensitive to v0.
+      EXPECT_LT((t.dx[steps].col(p) - fd).norm(), 1e-6 * fd.norm() + 5e-9) << ToString(method) << " direction " << p;
     }
   }
 }

@@ -4,17 +4,17 @@
 // Frictional contact. At every implicit step an active-set loop decides which
 // candidate nodes touch the surface; those become Dirichlet nodes for that
 // step only (all three axes: static friction, the node sticks where it
-// touches), pinned at
+// touches), pinned at the projection of their previous position onto the
+// surface,
 //
-//   p(x_i, v_i) = the point where the segment x_i -> x_i + h v_i enters the
-//                 surface, if x_i is outside (gap > 1e-9 m) and x_i + h v_i
-//                 is inside (gap < 0);
-//               = Project(x_i) otherwise (a node resting on the surface stays
-//                 where it is; a node pulled in by the rest of the body drops
-//                 straight onto the surface),
+//   p(x_i) = Project(x_i)
 //
-// a smooth function of the previous state. The loop starts from the
-// candidates whose predicted position x_i + h v_i has gap <= 1e-9 m, solves the
+// (a node resting on the surface stays where it is; an arriving node lands
+// at the surface point below where it was, so its tangential motion stops in
+// the step it lands, an O(h |v_t|) difference from the exact entry point
+// that keeps p smooth: the entry point of a grazing segment jumps with the
+// node's height, which would make gradients meaningless). The loop starts
+// from the candidates whose predicted position x_i + h v_i has gap <= 1e-9 m, solves the
 // step with them pinned, then releases every pinned node whose contact force
 // pulls it into the surface (n . f_c < 0, f_c = grad g at the node) and adds
 // every free candidate deeper than `penetration_tolerance`; it repeats until
@@ -36,7 +36,7 @@
 // the gradient is that of the smooth piece of the trajectory on which the
 // rollout lies (the active set is piecewise constant in the inputs; a
 // perturbation that changes it leaves that piece). Pins are differentiated
-// through p(x_i, v_i).
+// through p(x_i).
 //
 // Penalty contact. The half-space H = {x : n . x >= offset} repels candidate
 // nodes with the PD vertex energy

@@ -25,24 +25,6 @@ std::vector<Candidate> Candidates(const Scene& scene) {
   return out;
 }
 
-// Root of Gap(x + t d) in (0, 1) given Gap(x) > 0 > Gap(x + d): Newton
-// steps safeguarded by bisection, to rounding.
-double EntryParameter(const ContactSurface& surface, const Vec3& x, const Vec3& d) {
-  double lo = 0, hi = 1;
-  const double g0 = surface.Gap(x), g1 = surface.Gap(x + d);
-  double t = g0 / (g0 - g1);  // exact for a plane
-  for (int it = 0; it < 100; ++it) {
-    const double g = surface.Gap(x + t * d);
-    if (g > 0) lo = t; else hi = t;
-    if (std::abs(g) <= 1e-15 * (std::abs(g0) + std::abs(g1)) || hi - lo <= 1e-16) break;
-    const double slope = surface.GapGradient(x + t * d).dot(d);
-    double next = slope != 0 ? t - g / slope : 0.5 * (lo + hi);
-    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-    t = next;
-  }
-  return t;
-}
-
 // Replaces the step tolerance by an absolute one (target > 0) for its lifetime.
 class ToleranceScope {
  public:
@@ -64,27 +46,8 @@ class ToleranceScope {
 
 }  // namespace
 
-ContactPin ComputeContactPin(const ContactSurface& surface, const Vec3& x, const Vec3& v, double h) {
-  ContactPin pin;
-  const Vec3 d = h * v;
-  if (surface.Gap(x) > kTouch && surface.Gap(x + d) < 0) {
-    const double t = EntryParameter(surface, x, d);
-    pin.position = x + t * d;
-    const Vec3 g = surface.GapGradient(pin.position);
-    const double gd = g.dot(d);
-    if (gd < 0) {
-      // Gap(x + t d) = 0: dt = -g . (dx + t h dv) / (g . d), so
-      // dpin = Q (dx + t h dv) with Q = I - d g^T / (g . d).
-      const Mat3 q = Mat3::Identity() - d * g.transpose() / gd;
-      pin.d_dx = q;
-      pin.d_dv = (t * h) * q;
-      return pin;
-    }
-  }
-  pin.position = surface.Project(x);
-  pin.d_dx = surface.ProjectJacobian(x);
-  pin.d_dv = Mat3::Zero();
-  return pin;
+ContactPin ComputeContactPin(const ContactSurface& surface, const Vec3& x, const Vec3& /*v*/, double /*h*/) {
+  return ContactPin{surface.Project(x), surface.ProjectJacobian(x), Mat3::Zero()};
 }
 
 VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const VectorXd& force,

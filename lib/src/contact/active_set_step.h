@@ -16,8 +16,10 @@ namespace diffpd::internal {
 // A forward solver of one implicit step (NewtonSolve, PdSolve, ...).
 using ImplicitSolver = std::function<VectorXd(StepObjective&, const VectorXd& x0, StepReport*)>;
 
-// Where a candidate node is pinned from the previous state (x, v) of the
-// node, and d pin / dx, d pin / dv (3x3 each); see diffpd/contact.h.
+// Where a candidate node is pinned from its previous state (x, v) with time
+// step h, and d pin / dx, d pin / dv (3x3 each); see diffpd/contact.h. The
+// current rule, Project(x), does not depend on v and h (d_dv = 0); callers
+// pass them so that they need not know the rule.
 struct ContactPin {
   Vec3 position;
   Mat3 d_dx;

@@ -47,8 +47,8 @@ enum class MaterialParameter { kYoungsModulus, kPoissonsRatio, kDensity };
 const char* ToString(MaterialParameter parameter);
 
 // Scene parameters that act through a rollout's differentiable inputs
-// (initial state, per-step external forces). Implementations must be pure
-// functions of p.
+// (initial state, per-step external forces and muscle activations).
+// Implementations must be pure functions of p.
 class InputParameters {
  public:
   virtual ~InputParameters() = default;
