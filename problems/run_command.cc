@@ -51,7 +51,7 @@ int RunCommand(const CommandArgs& args) {
     std::fprintf(table, "%6d %8d %12.4e %12.4e %12.3f %14.6e %14.6e\n", i + 1, rep.iterations,
                  rep.initial_residual, rep.final_residual, 1e3 * rep.seconds, max_disp, kinetic);
     std::fflush(table);
-    step_rows.push_back({{"step", i + 1}, {"iterations", rep.iterations}, {"residual", rep.final_residual},
+    step_rows.push_back({{"step", i + 1}, {"iterations", rep.iterations}, {"line_search_steps", rep.line_search_steps}, {"residual", rep.final_residual},
                          {"seconds", rep.seconds}, {"max_displacement", max_disp}, {"kinetic_energy", kinetic}});
     if (pvd) pvd->AddFrame((i + 1) * options.time_step, mesh,
                            Eigen::Map<const Eigen::Matrix3Xd>(state.x.data(), 3, mesh.num_vertices()));

@@ -27,7 +27,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <vector>
 
 #include <Eigen/LU>
 
@@ -54,10 +53,10 @@ inline Root LargerRoot(double s, double mu) {
 // A point of the stationary path of the all-positive problem for target s,
 // parametrised by t = d_k (k: index of the smallest entry of s).
 struct PathPoint {
-  Vec3 d;
-  double h;     // log(d_0 d_1 d_2)
-  double dh;    // dh / dt
-  double mu;    // multiplier: d_i (d_i - s_i) = mu
+  Vec3 d = Vec3::Ones();
+  double h = 0;   // log(d_0 d_1 d_2)
+  double dh = 0;  // dh / dt
+  double mu = 0;  // multiplier: d_i (d_i - s_i) = mu
 };
 
 class StationaryPath {
@@ -95,6 +94,27 @@ class StationaryPath {
   int k_ = 0;
 };
 
+// Keeps the candidate closest to the target s (no allocation: this runs at
+// every quadrature point in every PD iteration).
+class ClosestRoot {
+ public:
+  explicit ClosestRoot(const Vec3& s) : s_(s) {}
+  void push_back(const PathPoint& p) {
+    const double distance = (p.d - s_).squaredNorm();
+    if (distance < distance_) {
+      distance_ = distance;
+      best_ = p;
+    }
+  }
+  double distance() const { return distance_; }
+  const PathPoint& best() const { return best_; }
+
+ private:
+  Vec3 s_;
+  double distance_ = std::numeric_limits<double>::infinity();
+  PathPoint best_;
+};
+
 // Midpoint for bisection of a positive bracket: geometric when wide.
 inline double Midpoint(double lo, double hi) {
   return hi > 4.0 * lo ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
@@ -122,13 +142,16 @@ PathPoint FindRoot(const StationaryPath& path, double lo, double hi, double dire
 }
 
 // Appends the roots of h on the increasing part t >= max(s_k / 2, 0).
-void GrowingBranchRoots(const StationaryPath& path, std::vector<PathPoint>* roots) {
+void GrowingBranchRoots(const StationaryPath& path, ClosestRoot* roots) {
   const Vec3& s = path.s();
   const double sk = path.sk();
   double lo;
   if (sk > 0.0) {
     lo = 0.5 * sk;
-    if (path.Evaluate(lo).h > 0.0) return;  // every t >= s_k/2 has t d_i d_j > 1
+    // At t = s_k/2, d_j <= s_j, so t d_i d_j <= prod(s)/2: only a large
+    // expansion (prod(s) > 2) can put h(lo) above 0, and then every
+    // t >= s_k/2 has t d_i d_j > 1 (no root on this branch).
+    if (!(s.prod() <= 2.0) && path.Evaluate(lo).h > 0.0) return;
   } else {
     // For t <= 1: mu <= 1 + |s_k|, d_j <= max(s_j, 0) + sqrt(1 + |s_k|).
     const double bound = std::sqrt(1.0 - sk);
@@ -146,7 +169,7 @@ void GrowingBranchRoots(const StationaryPath& path, std::vector<PathPoint>* root
 }
 
 // Appends the roots of h on 0 < t < s_k / 2 (the shrinking branch of d_k).
-void ShrinkingBranchRoots(const StationaryPath& path, std::vector<PathPoint>* roots) {
+void ShrinkingBranchRoots(const StationaryPath& path, ClosestRoot* roots) {
   const Vec3& s = path.s();
   const double sk = path.sk();
   if (!(sk > 0.0) || !(s.prod() >= 2.0)) return;
@@ -189,20 +212,14 @@ void ShrinkingBranchRoots(const StationaryPath& path, std::vector<PathPoint>* ro
 // squared distance (infinity if no candidate was found).
 double SolvePositive(const Vec3& s, VolumeProjection* best) {
   const StationaryPath path(s);
-  std::vector<PathPoint> roots;
-  roots.reserve(4);
+  ClosestRoot roots(s);
   GrowingBranchRoots(path, &roots);
   ShrinkingBranchRoots(path, &roots);
-  double best_distance = std::numeric_limits<double>::infinity();
-  for (const PathPoint& root : roots) {
-    const double distance = (root.d - s).squaredNorm();
-    if (distance < best_distance) {
-      best_distance = distance;
-      best->d = root.d;
-      best->multiplier = root.mu;
-    }
+  if (roots.distance() < std::numeric_limits<double>::infinity()) {
+    best->d = roots.best().d;
+    best->multiplier = roots.best().mu;
   }
-  return best_distance;
+  return roots.distance();
 }
 
 }  // namespace
