@@ -261,6 +261,8 @@ BenchResult RunBench(const std::string& problem, const BenchOptions& options, st
       row.iters_per_step = m.iters_per_step;
       row.forward_per_iteration_ms = m.total_iterations > 0 ? 1e3 * m.forward_s / m.total_iterations : 0;
       row.state_rel_error = RelativeError(StackState(m.final_state), ref_state);
+      row.position_rel_error = RelativeError(m.final_state.x, reference.final_state.x);
+      row.velocity_rel_error = RelativeError(m.final_state.v, reference.final_state.v);
       row.grad_rel_error = RelativeError(m.gradient, reference.gradient);
       row.grad_rel_error_by_input["x0"] = RelativeError(m.gradient.head(n), reference.gradient.head(n));
       row.grad_rel_error_by_input["v0"] = RelativeError(m.gradient.segment(n, n), reference.gradient.segment(n, n));
@@ -293,6 +295,8 @@ nlohmann::json BenchToJson(const BenchResult& result, const BenchOptions& option
                     {"backward_s", NumberOrNull(ok, r.backward_s)},
                     {"iters_per_step", NumberOrNull(ok, r.iters_per_step)},
                     {"state_rel_error", NumberOrNull(ok, r.state_rel_error)},
+                    {"position_rel_error", NumberOrNull(ok, r.position_rel_error)},
+                    {"velocity_rel_error", NumberOrNull(ok, r.velocity_rel_error)},
                     {"grad_rel_error", NumberOrNull(ok, r.grad_rel_error)},
                     {"grad_rel_error_by_input", ok ? by_input : nlohmann::json(nullptr)},
                     {"forward_per_iteration_ms", NumberOrNull(ok, r.forward_per_iteration_ms)},

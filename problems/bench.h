@@ -111,7 +111,9 @@ struct BenchRow {
   double backward_s = 0;
   double iters_per_step = 0;
   double forward_per_iteration_ms = 0;  // forward_s / total iterations, ms
-  double state_rel_error = 0;
+  double state_rel_error = 0;     // of [x; v] stacked
+  double position_rel_error = 0;  // of x alone
+  double velocity_rel_error = 0;  // of v alone (about |x error| / h: the strictest part)
   double grad_rel_error = 0;
   // Relative errors of the gradient's parts: "x0", "v0", "youngs_modulus",
   // "poissons_ratio", "density".

@@ -16,14 +16,16 @@ Measures one rollout (the problem's steps, or --steps) and its backward pass
 per method. The loss is L = c_x . x_K + c_v . v_K with fixed N(0,1) vectors
 (--seed); the gradient compared is the concatenation
 [dL/dx0, dL/dv0, dL/dE, dL/dnu, dL/drho]. The reference is newton-cholesky
-with rel_tolerance 1e-10 (adjoint 1e-12). state_rel_error and grad_rel_error
+with rel_tolerance 1e-10 (adjoint 1e-12). state_rel_error ([x; v] stacked),
+position_rel_error (x), velocity_rel_error (v) and grad_rel_error
 are relative 2-norms against it. forward_s / backward_s: wall-clock seconds of
 Simulate / Backward on a fresh simulator (forward includes PD's factorisation),
 median of --repeat runs. The adjoint tolerance is --rtol unless
 --backward-rtol is given. speedup_vs_newton_cholesky = (forward+backward of
 newton-cholesky in this run) / (this method's).
 JSON: a list of objects {method, status, forward_s, backward_s,
-iters_per_step, state_rel_error, grad_rel_error, grad_rel_error_by_input,
+iters_per_step, state_rel_error, position_rel_error, velocity_rel_error,
+grad_rel_error, grad_rel_error_by_input,
 forward_per_iteration_ms, speedup_vs_newton_cholesky, problem, dofs, ...}.
 --scaling: the problem at --scales x the elements (default 1,2,4,8); rows
 {method, factor, elements, vertices, dofs, forward_s, iters_per_step,
@@ -50,16 +52,16 @@ struct BenchArgs {
 void PrintBenchTable(const BenchResult& r) {
   std::printf("# %s: %d elements, %d DoFs, %d steps of %g s; reference newton-cholesky rtol 1e-10 (%.3f s)\n",
               r.problem.c_str(), r.elements, r.dofs, r.steps, r.time_step, r.reference_forward_s);
-  std::printf("%-16s %10s %10s %10s %12s %12s %12s %10s\n", "method", "forward_s", "backward_s", "iters/step",
-              "ms/iter", "state_err", "grad_err", "speedup");
+  std::printf("%-16s %10s %10s %10s %12s %12s %10s %10s %12s %10s\n", "method", "forward_s", "backward_s",
+              "iters/step", "ms/iter", "state_err", "x_err", "v_err", "grad_err", "speedup");
   for (const auto& row : r.rows) {
     if (!row.failure.empty()) {
       std::printf("%-16s failed: %s\n", row.method.c_str(), row.failure.c_str());
       continue;
     }
-    std::printf("%-16s %10.4f %10.4f %10.2f %12.4f %12.3e %12.3e", row.method.c_str(), row.forward_s,
+    std::printf("%-16s %10.4f %10.4f %10.2f %12.4f %12.3e %10.2e %10.2e %12.3e", row.method.c_str(), row.forward_s,
                 row.backward_s, row.iters_per_step, row.forward_per_iteration_ms, row.state_rel_error,
-                row.grad_rel_error);
+                row.position_rel_error, row.velocity_rel_error, row.grad_rel_error);
     if (row.speedup_vs_newton_cholesky) std::printf(" %10.2f\n", *row.speedup_vs_newton_cholesky);
     else std::printf(" %10s\n", "-");
   }

@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+
 #include "bench.h"
 #include "diffpd/error.h"
 
@@ -158,6 +160,14 @@ TEST(BenchTest, JsonIsAListWithTheRequiredFields) {
   }
   EXPECT_EQ(parsed[0].at("method"), "pd-lbfgs");
   EXPECT_DOUBLE_EQ(parsed[0].at("state_rel_error").get<double>(), r.rows[0].state_rel_error);
+  // The stacked error is the root of the sum of the parts' squared absolute errors.
+  const auto& row = r.rows[0];
+  EXPECT_GT(row.position_rel_error, 0.0);
+  EXPECT_GT(row.velocity_rel_error, 0.0);
+  EXPECT_DOUBLE_EQ(parsed[0].at("position_rel_error").get<double>(), row.position_rel_error);
+  EXPECT_DOUBLE_EQ(parsed[0].at("velocity_rel_error").get<double>(), row.velocity_rel_error);
+  EXPECT_LE(row.state_rel_error, std::max(row.position_rel_error, row.velocity_rel_error) * (1 + 1e-12));
+  EXPECT_GE(row.state_rel_error, std::min(row.position_rel_error, row.velocity_rel_error) * (1 - 1e-12));
 }
 
 TEST(BenchTest, AMethodThatFailsIsReportedWithItsSolverError) {
