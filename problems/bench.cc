@@ -11,6 +11,7 @@
 #include "cantilever.h"
 #include "diffpd/error.h"
 #include "problem_registry.h"
+#include "invalid_option.h"
 
 namespace diffpd::problems {
 namespace {
@@ -196,11 +197,7 @@ VectorXd StackState(const State& s) {
 }
 
 void BenchOptions::Validate() const {
-  auto fail = [](const std::string& field, double value, const std::string& range) {
-    std::ostringstream msg;
-    msg << field << " = " << value << " is invalid: must be " << range;
-    throw InvalidInputError(msg.str());
-  };
+  const auto fail = ThrowInvalidOption;
   if (methods.empty()) throw InvalidInputError("methods is empty: name at least one method");
   for (Method m : methods)
     if (m == Method::kSemiImplicit)

@@ -10,6 +10,7 @@
 #include "bench.h"
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
+#include "invalid_option.h"
 
 namespace diffpd::problems {
 namespace {
@@ -52,11 +53,7 @@ double AutoAbsTolerance(const Scene& scene, double time_step) {
 }
 
 void StressOptions::Validate() const {
-  auto fail = [](const std::string& field, double value, const std::string& range) {
-    std::ostringstream msg;
-    msg << field << " = " << value << " is invalid: must be " << range;
-    throw InvalidInputError(msg.str());
-  };
+  const auto fail = ThrowInvalidOption;
   if (problems.empty()) throw InvalidInputError("problems is empty: name at least one problem");
   if (methods.empty()) throw InvalidInputError("methods is empty: name at least one method");
   if (youngs_moduli.empty() || poissons_ratios.empty() || time_steps.empty())

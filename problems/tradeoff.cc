@@ -13,6 +13,7 @@
 #include "bench.h"
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
+#include "invalid_option.h"
 
 namespace diffpd::problems {
 namespace {
@@ -138,11 +139,7 @@ std::string GnuplotQuote(const std::string& s) {
 }  // namespace
 
 void TradeoffOptions::Validate() const {
-  auto fail = [](const std::string& field, double value, const std::string& range) {
-    std::ostringstream msg;
-    msg << field << " = " << value << " is invalid: must be " << range;
-    throw InvalidInputError(msg.str());
-  };
+  const auto fail = ThrowInvalidOption;
   if (methods.empty()) throw InvalidInputError("methods is empty: name at least one method");
   for (Method m : methods)
     if (m == Method::kSemiImplicit)
