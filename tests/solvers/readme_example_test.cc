@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "diffpd/captured_motion.h"
@@ -70,6 +71,22 @@ TEST(ReadmeExampleTest, RecoversTheMaterialOfSyntheticCapturedMotion) {
   EXPECT_NEAR(e / 2e5, 1.0, 1e-2) << output;
   EXPECT_NEAR(nu / 0.35, 1.0, 1e-2) << output;
   EXPECT_NE(output.find("iter"), std::string::npos);  // Ceres' progress table
+}
+
+// The README shows the program exactly as it is compiled here (from its
+// first #include to its end), so the two cannot drift apart.
+TEST(ReadmeExampleTest, ReadmeShowsTheExampleProgramVerbatim) {
+  auto read = [](const std::string& path) {
+    std::ifstream in(path);
+    EXPECT_TRUE(in.good()) << path;
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  const std::string readme = read(std::string(DIFFPD_SOURCE_DIR) + "/README.md");
+  const std::string program = read(std::string(DIFFPD_SOURCE_DIR) + "/tests/solvers/readme_example.cc");
+  const size_t body = program.find("#include");
+  ASSERT_NE(body, std::string::npos);
+  EXPECT_NE(readme.find(program.substr(body)), std::string::npos)
+      << "README.md must contain tests/solvers/readme_example.cc from its first #include on";
 }
 
 }  // namespace
