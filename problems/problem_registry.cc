@@ -3,6 +3,7 @@
 #include "bouncing_ball.h"
 #include "calibrate_bouncing_ball.h"
 #include "calibrate_plant.h"
+#include "calibrate_starfish.h"
 #include "bunny.h"
 #include "cantilever.h"
 #include "routing_tendon_opt.h"
@@ -29,6 +30,7 @@ std::vector<std::unique_ptr<Problem>> AllProblems() {
   all.push_back(std::make_unique<Locomotion>(Locomotion::Body::kCow));
   all.push_back(std::make_unique<PlantCalibration>());
   all.push_back(std::make_unique<BouncingBallCalibration>());
+  all.push_back(std::make_unique<StarfishCalibration>());
   return all;
 }
 

@@ -34,6 +34,7 @@ list(APPEND DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/calibrate_problem.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibrate_plant.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibrate_bouncing_ball.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibrate_starfish.cc
   ${CMAKE_CURRENT_LIST_DIR}/synth_command.cc)
 set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/calibrate_problem.cc PROPERTIES
   COMPILE_DEFINITIONS "DIFFPD_PROJECT_DATA_DIR=\"${CMAKE_CURRENT_LIST_DIR}/../data\"")
