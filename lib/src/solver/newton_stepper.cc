@@ -48,17 +48,11 @@ VectorXd NewtonSolve(StepObjective& objective, const VectorXd& x0, StepReport* r
   VectorXd x = x0;
   VectorXd grad;
   double value = objective.Evaluate(x, &grad);
-  const double initial = grad.norm();
-  report->initial_residual = initial;
+  report->initial_residual = grad.norm();
   std::vector<double> blocks;
   SparseMatrix h;
   for (int it = 0;; ++it) {
-    const double norm = grad.norm();
-    report->iterations = it;
-    report->final_residual = norm;
-    if (sim.options.verbosity >= 2) std::fprintf(stderr, "  %s iteration %d |grad g| = %.3e\n", ToString(sim.options.method), it, norm);
-    if (Converged(sim.options, norm, initial)) return x;
-    if (it >= sim.options.max_iterations) ThrowNotConverged(sim.options, it, norm, initial);
+    if (IterationConverged(sim.options, it, grad.norm(), report)) return x;
     sim.elastic.ElementHessians(x, sim.mu(), sim.lambda(), /*project_spd=*/true, &blocks, sim.threads());
     sim.aux.AddElementHessians(x, sim.activation, /*project_spd=*/true, &blocks);
     sim.hessian_assembler().Assemble(blocks, objective.inertia_diagonal(), sim.fixed, &h);

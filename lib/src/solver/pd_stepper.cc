@@ -22,15 +22,9 @@ VectorXd PdSolve(StepObjective& objective, const VectorXd& x0, StepReport* repor
   VectorXd x = x0;
   VectorXd grad;
   objective.Evaluate(x, &grad);
-  const double initial = grad.norm();
-  report->initial_residual = initial;
+  report->initial_residual = grad.norm();
   for (int it = 0;; ++it) {
-    const double norm = grad.norm();
-    report->iterations = it;
-    report->final_residual = norm;
-    if (sim.options.verbosity >= 2) std::fprintf(stderr, "  pd iteration %d |grad g| = %.3e\n", it, norm);
-    if (Converged(sim.options, norm, initial)) return x;
-    if (it >= sim.options.max_iterations) ThrowNotConverged(sim.options, it, norm, initial);
+    if (IterationConverged(sim.options, it, grad.norm(), report)) return x;
     x -= pd.Solve(grad);
     objective.Evaluate(x, &grad);
   }
@@ -45,16 +39,10 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
   VectorXd x = x0;
   VectorXd grad;
   double value = objective.Evaluate(x, &grad);
-  const double initial = grad.norm();
-  report->initial_residual = initial;
+  report->initial_residual = grad.norm();
   std::vector<double> alpha(m);
   for (int it = 0;; ++it) {
-    const double norm = grad.norm();
-    report->iterations = it;
-    report->final_residual = norm;
-    if (sim.options.verbosity >= 2) std::fprintf(stderr, "  pd-lbfgs iteration %d |grad g| = %.3e\n", it, norm);
-    if (Converged(sim.options, norm, initial)) return x;
-    if (it >= sim.options.max_iterations) ThrowNotConverged(sim.options, it, norm, initial);
+    if (IterationConverged(sim.options, it, grad.norm(), report)) return x;
     // Two-loop recursion with H0 = A^{-1}.
     VectorXd q = grad;
     const int k = static_cast<int>(s_list.size());

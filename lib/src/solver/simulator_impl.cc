@@ -1,6 +1,7 @@
 #include "solver/simulator_impl.h"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "diffpd/error.h"
@@ -78,6 +79,16 @@ double StepObjective::Evaluate(const VectorXd& x, VectorXd* grad) {
 
 bool Converged(const SolverOptions& options, double grad_norm, double initial_norm) {
   return grad_norm <= options.abs_tolerance + options.rel_tolerance * initial_norm;
+}
+
+bool IterationConverged(const SolverOptions& options, int it, double grad_norm, StepReport* report) {
+  report->iterations = it;
+  report->final_residual = grad_norm;
+  if (options.verbosity >= 2)
+    std::fprintf(stderr, "  %s iteration %d |grad g| = %.3e\n", ToString(options.method), it, grad_norm);
+  if (Converged(options, grad_norm, report->initial_residual)) return true;
+  if (it >= options.max_iterations) ThrowNotConverged(options, it, grad_norm, report->initial_residual);
+  return false;
 }
 
 void ThrowNotConverged(const SolverOptions& options, int iterations, double grad_norm, double initial_norm) {

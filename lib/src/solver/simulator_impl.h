@@ -131,6 +131,11 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
 
 // True when ||grad|| meets the common convergence test.
 bool Converged(const SolverOptions& options, double grad_norm, double initial_norm);
+// The per-iteration bookkeeping every forward solver shares: records
+// iteration `it` and |grad| in the report, logs it (verbosity >= 2), and
+// returns true when converged; throws ThrowNotConverged's error when `it`
+// reached the iteration limit without converging.
+bool IterationConverged(const SolverOptions& options, int it, double grad_norm, StepReport* report);
 // Throws SolverError(kMaxIterations) with a message naming method and residuals.
 [[noreturn]] void ThrowNotConverged(const SolverOptions& options, int iterations, double grad_norm,
                                     double initial_norm);
