@@ -44,6 +44,7 @@ Scene RollingSphere::MakeScene() const {
     if (scene.mesh.vertices(2, i) <= center_z) ground.nodes.push_back(i);
   scene.frictional_contacts = {ground};
   scene.frictional_contact_options.pd_linear_solve = linear_solve_;
+  scene.frictional_contact_options.screening_rel_tolerance = kScreeningRelTolerance;
   return scene;
 }
 

@@ -74,13 +74,49 @@ TEST(ActiveSetErasureTest, WoodburyRefactorisationAndDenseReferenceAgree) {
     for (const int i : active) EXPECT_EQ(yw.col(c).segment<3>(3 * i).norm(), 0.0);
     // A_S y = r on the free DoFs.
     const VectorXd res = wood.Apply(yw.col(c));
-    for (int d = 0; d < n; ++d)
-      if (!fixed[d] && std::find(active.begin(), active.end(), d / 3) == active.end())
+    for (int d = 0; d < n; ++d) {
+      if (!fixed[d] && std::find(active.begin(), active.end(), d / 3) == active.end()) {
         EXPECT_NEAR(res(d), r(d, c), 1e-9 * r.col(c).norm());
+      }
+    }
   }
   EXPECT_EQ(wood.num_factorizations(), 1);
   EXPECT_EQ(wood.num_active_set_factorizations(), 0);
   EXPECT_EQ(refac.num_active_set_factorizations(), 2);  // one per group
+}
+
+TEST(ActiveSetErasureTest, LargeSetsCorrectedByASecondSolveAgreeWithRefactorisation) {
+  // More active nodes than kDenseCorrectionMax: the correction is applied by a
+  // second solve with A instead of the product with W; both paths stay exact,
+  // across growing, shrinking and repeated sets.
+  const Mesh mesh = testing::BoxHexMesh(12, 12, 1, 0.12, 0.12, 0.01);
+  internal::FemModel fem(mesh);
+  const int n = mesh.num_dofs();
+  const std::vector<char> fixed(n, 0);
+  internal::PdSystem wood(fem, fixed), refac(fem, fixed);
+  wood.Update(0.01, 1e3, 1e5);
+  refac.Update(0.01, 1e3, 1e5);
+  std::vector<int> bottom;
+  for (int i = 0; i < mesh.num_vertices(); ++i)
+    if (mesh.vertices(2, i) < 1e-9) bottom.push_back(i);
+  constexpr int kMax = internal::ActiveSetErasure::kDenseCorrectionMax;
+  ASSERT_EQ(bottom.size(), 169u);
+  ASSERT_GT(169, kMax);
+  std::mt19937_64 rng(11);
+  for (const int s : {kMax - 1, kMax + 1, 169, kMax, 169}) {
+    const std::vector<int> active(bottom.begin(), bottom.begin() + s);
+    wood.SetActiveNodes(active, ContactLinearSolve::kWoodbury);
+    refac.SetActiveNodes(active, ContactLinearSolve::kRefactorize);
+    MatrixXd r(n, 2);
+    for (int c = 0; c < 2; ++c) r.col(c) = Random(n, &rng);
+    const MatrixXd yw = wood.Solve(r), yr = refac.Solve(r);
+    const VectorXd ref = DenseReference(wood, fixed, active, r.col(0));
+    EXPECT_LT((yw.col(0) - ref).norm(), 1e-10 * ref.norm()) << s << " active nodes";
+    EXPECT_LT((yw - yr).norm(), 1e-10 * yr.norm()) << s << " active nodes";
+    for (const int i : active) EXPECT_EQ(yw.col(1).segment<3>(3 * i).norm(), 0.0);
+  }
+  EXPECT_EQ(wood.num_active_set_column_solves(), 169);  // one per node ever erased
+  EXPECT_EQ(wood.num_factorizations(), 1);
 }
 
 TEST(ActiveSetErasureTest, WoodburySolvesOnceForEachNewContactNodeAndFollowsRefactorisation) {

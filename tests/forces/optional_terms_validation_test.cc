@@ -86,6 +86,11 @@ TEST(OptionalTermsValidationTest, ContactErrorsNameTheContactAndTheValue) {
                 "free");
   ExpectMessage([](Scene* s) { s->frictional_contact_options.max_passes = 0; },
                 "scene: frictional_contact_options.max_passes = 0 is invalid: must be >= 1");
+  ExpectMessage([](Scene* s) { s->frictional_contact_options.screening_rel_tolerance = 1; },
+                "scene: frictional_contact_options.screening_rel_tolerance = 1 is invalid: must be finite and in [0, 1)");
+  ExpectMessage([](Scene* s) { s->frictional_contact_options.screening_rel_tolerance = std::nan(""); },
+                "scene: frictional_contact_options.screening_rel_tolerance = nan is invalid: must be finite and in [0, "
+                "1)");
   ExpectMessage([](Scene* s) { s->penalty_contacts[0].stiffness = 0; },
                 "scene: penalty_contacts[0].stiffness = 0 is invalid: must be finite and > 0 (N/m)");
   ExpectMessage([](Scene* s) { s->penalty_contacts[0].friction = std::nan(""); },

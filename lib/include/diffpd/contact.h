@@ -21,7 +21,13 @@
 // the set no longer changes, at most `max_passes` solves per step, else
 // SolverError(kActiveSetNotConverged). A node released and re-added within one
 // step is not released again in that step (no cycling). Each step's active
-// set and contact forces are recorded in its StepReport.
+// set and contact forces are recorded in its StepReport. With
+// screening_rel_tolerance = r > rel_tolerance, passes first solve only to
+// |grad g| <= abs_tolerance + r |grad g(x0)| (screening) until the set stops
+// changing, and that set is then solved to the step's tolerance and checked
+// once more; the returned step meets the same tolerance and the same
+// complementarity test, at fewer iterations when the set changes often
+// (rolling-sphere: 64 instead of 81 PD-LBFGS iterations per step with r = 0.1).
 //
 // The PD matrix A is never refactorised when the active set changes: the
 // erased rows and columns are a low-rank change handled by the
@@ -62,6 +68,7 @@
 //   "scene: frictional_contacts[0].nodes[2] = 0 has a Dirichlet DoF; frictional contact candidates must be free",
 //   "scene: frictional_contact_options.max_passes = 0 is invalid: must be >= 1",
 //   "scene: frictional_contact_options.penetration_tolerance = -1 is invalid: must be finite and >= 0 (m)",
+//   "scene: frictional_contact_options.screening_rel_tolerance = 1 is invalid: must be finite and in [0, 1)",
 //   "scene: penalty_contacts[0].stiffness = 0 is invalid: must be finite and > 0 (N/m)",
 //   "scene: penalty_contacts[0].friction = nan is invalid: must be finite and >= 0"
 // (likewise normal, offset, friction_velocity of penalty contacts).
@@ -127,6 +134,9 @@ struct FrictionalContact {
 struct FrictionalContactOptions {
   int max_passes = 20;                  // solves per step, >= 1
   double penetration_tolerance = 1e-6;  // m, >= 0: a free candidate deeper than this joins the set
+  // Relative tolerance of the screening solves (see above), finite and in
+  // [0, 1); 0 or <= the step's rel_tolerance: no screening.
+  double screening_rel_tolerance = 0;
   ContactLinearSolve pd_linear_solve = ContactLinearSolve::kWoodbury;
 };
 

@@ -61,10 +61,17 @@ void ActiveSetErasure::Set(const std::vector<int>& nodes, ContactLinearSolve mod
     num_column_solves_ += static_cast<int>(missing.size());
     for (size_t c = 0; c < missing.size(); ++c) columns_[missing[c]] = cols.col(static_cast<Eigen::Index>(c));
   }
-  w_.resize(n, s);
-  for (int c = 0; c < s; ++c) w_.col(c) = columns_.at(nodes_[c]);
   MatrixXd cap(s, s);
-  for (int r = 0; r < s; ++r) cap.row(r) = w_.row(nodes_[r]);
+  for (int c = 0; c < s; ++c) {
+    const VectorXd& column = columns_.at(nodes_[c]);
+    for (int r = 0; r < s; ++r) cap(r, c) = column(nodes_[r]);
+  }
+  if (s <= kDenseCorrectionMax) {
+    w_.resize(n, s);
+    for (int c = 0; c < s; ++c) w_.col(c) = columns_.at(nodes_[c]);
+  } else {
+    w_.resize(0, 0);
+  }
   capacitance_.compute(0.5 * (cap + cap.transpose()));
   if (capacitance_.info() != Eigen::Success) {
     active_ = false;
@@ -90,7 +97,15 @@ MatrixXd ActiveSetErasure::Solve(const CholmodSolver& base, MatrixXd rhs) const 
   const int s = static_cast<int>(nodes_.size());
   MatrixXd ys(s, y.cols());
   for (int r = 0; r < s; ++r) ys.row(r) = y.row(nodes_[r]);
-  y.noalias() -= w_ * capacitance_.solve(ys);
+  const MatrixXd lambda = capacitance_.solve(ys);
+  if (s <= kDenseCorrectionMax) {
+    y.noalias() -= w_ * lambda;
+  } else {
+    // A^-1 (R - P lambda): R is zero on S, so the corrected right-hand side
+    // is -lambda there and R elsewhere.
+    for (int r = 0; r < s; ++r) rhs.row(nodes_[r]) = -lambda.row(r);
+    y = base.Solve(rhs);
+  }
   ZeroErased(&y);
   return y;
 }

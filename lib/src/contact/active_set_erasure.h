@@ -12,7 +12,12 @@
 // P the n x s selection of S. Cost: s solves with A's factor for the columns
 // of W (cached per node until the factor changes, so a node that stays in
 // contact over many steps costs one solve in all), a dense s x s Cholesky per
-// change of S, and per solve one solve with A plus O(n s). kRefactorize
+// change of S, and per solve one solve with A plus O(n s). For s above
+// kDenseCorrectionMax the O(n s) product W C^-1 (A^-1 R)_S (memory-bound, it
+// reads all of W) costs about as much as a second solve with A (measured on a
+// 3125-node slab: equal near s = 150), so the correction is applied as
+// Y = A^-1 (R - P C^-1 (A^-1 R)_S) instead (same Y; W is then never
+// assembled, only C from the cached columns). kRefactorize
 // instead factorises A_S (for comparison; same solution). Either way the
 // prepared set is kept while erasure is switched off (empty Set), so setting
 // the same S again (the next step of a resting contact) costs nothing.
@@ -32,6 +37,10 @@ namespace diffpd::internal {
 
 class ActiveSetErasure {
  public:
+  // Largest active set whose Woodbury correction is the dense product with W
+  // (above: a second solve with A; see the comment at the top).
+  static constexpr int kDenseCorrectionMax = 128;
+
   ActiveSetErasure();
   ~ActiveSetErasure();
   ActiveSetErasure(ActiveSetErasure&&) noexcept;
@@ -62,7 +71,7 @@ class ActiveSetErasure {
   bool active_ = false;     // erasure on (a non-empty set is set)
   ContactLinearSolve mode_ = ContactLinearSolve::kWoodbury;
   std::unordered_map<int, VectorXd> columns_;  // node -> A^-1 e_node
-  MatrixXd w_;                                  // n x s
+  MatrixXd w_;                                  // n x s (s <= kDenseCorrectionMax), else empty
   Eigen::LLT<MatrixXd> capacitance_;            // of C = W_S
   std::unique_ptr<CholmodSolver> erased_solver_;
   int num_column_solves_ = 0;

@@ -25,12 +25,16 @@ std::vector<Candidate> Candidates(const Scene& scene) {
   return out;
 }
 
-// Replaces the step tolerance by an absolute one (target > 0) for its lifetime.
+// For its lifetime: an absolute step tolerance `target` (if > 0), else the
+// relative tolerance `rel` (if > 0), else the options' own.
 class ToleranceScope {
  public:
-  ToleranceScope(SimulatorImpl& sim, double target)
+  ToleranceScope(SimulatorImpl& sim, double target, double rel = -1.0)
       : sim_(sim), abs_(sim.options.abs_tolerance), rel_(sim.options.rel_tolerance) {
-    if (target <= 0) return;
+    if (target <= 0) {
+      if (rel > 0) sim.options.rel_tolerance = rel;
+      return;
+    }
     sim.options.abs_tolerance = target;
     sim.options.rel_tolerance = 0;
   }
@@ -72,7 +76,11 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
   for (int c = 0; c < nc; ++c) active[c] = cand[c].surface->Gap(xhat.segment<3>(3 * cand[c].node)) <= kTouch;
 
   VectorXd x = xhat;
-  double first_target = 0;
+  // Screening (contact.h): passes solve to screen_target until the set stops
+  // changing; then one refining pass to first_target (after it, no more
+  // screening).
+  bool screening = opt.screening_rel_tolerance > sim.options.rel_tolerance;
+  double first_target = 0, screen_target = 0;
   for (int pass = 1;; ++pass) {
     // Active nodes in increasing order, with their pins.
     std::vector<std::pair<int, int>> order;  // (node, candidate)
@@ -94,11 +102,16 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
       StepObjective objective(sim, xhat, force);
       // Later passes start from the previous solution; they must meet the
       // first pass's tolerance, not one relative to their smaller residual.
-      const ToleranceScope tolerance(sim, pass == 1 ? -1.0 : first_target);
+      const ToleranceScope tolerance(sim, pass == 1 ? -1.0 : screening ? screen_target : first_target,
+                                     screening ? opt.screening_rel_tolerance : -1.0);
       x = solve(objective, x0, &pass_report);
     }
-    if (pass == 1)
+    if (pass == 1) {
       first_target = sim.options.abs_tolerance + sim.options.rel_tolerance * pass_report.initial_residual;
+      screen_target = sim.options.abs_tolerance + opt.screening_rel_tolerance * pass_report.initial_residual;
+    }
+    // A screening solve that already meets the step's tolerance is final.
+    const bool final_pass = !screening || pass_report.final_residual <= first_target;
     if (pass == 1) report->initial_residual = pass_report.initial_residual;
     report->iterations += pass_report.iterations;
     report->line_search_steps += pass_report.line_search_steps;
@@ -128,14 +141,16 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
       }
     }
     if (sim.options.verbosity >= 2)
-      std::fprintf(stderr, "  contact pass %d: %zu pinned nodes%s\n", pass, nodes.size(), changed ? ", set changed" : "");
-    if (!changed) {
+      std::fprintf(stderr, "  contact pass %d%s: %zu pinned nodes%s\n", pass, final_pass ? "" : " (screening)",
+                   nodes.size(), changed ? ", set changed" : "");
+    if (!changed && final_pass) {
       report->contact_nodes = nodes;
       report->contact_forces.resize(3, static_cast<Eigen::Index>(nodes.size()));
       for (size_t k = 0; k < nodes.size(); ++k)
         report->contact_forces.col(static_cast<Eigen::Index>(k)) = grad.segment<3>(3 * nodes[k]);
       return x;
     }
+    if (!changed) screening = false;  // the set settled at the screening tolerance: refine it
     if (pass >= opt.max_passes) {
       std::ostringstream msg;
       msg << "frictional contact: the active set did not settle in " << opt.max_passes

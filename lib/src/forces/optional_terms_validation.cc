@@ -125,6 +125,10 @@ void ValidateContacts(const Scene& scene) {
   const FrictionalContactOptions& opt = scene.frictional_contact_options;
   if (opt.max_passes < 1) Invalid("frictional_contact_options.max_passes", std::to_string(opt.max_passes), ">= 1");
   CheckNonNegative("frictional_contact_options.penetration_tolerance", opt.penetration_tolerance, " (m)");
+  if (!(std::isfinite(opt.screening_rel_tolerance) && opt.screening_rel_tolerance >= 0 &&
+        opt.screening_rel_tolerance < 1))
+    Invalid("frictional_contact_options.screening_rel_tolerance", Str(opt.screening_rel_tolerance),
+            "finite and in [0, 1)");
   for (size_t c = 0; c < scene.penalty_contacts.size(); ++c) {
     const PenaltyContact& contact = scene.penalty_contacts[c];
     const std::string name = Indexed("penalty_contacts", c);
