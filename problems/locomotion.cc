@@ -164,7 +164,10 @@ Scene Locomotion::MakeScene(InstanceSize size) const {
 
 SolverOptions Locomotion::BaseOptions(InstanceSize size) const {
   SolverOptions o = TrajectoryOptimizationProblem::BaseOptions(size);
-  o.rel_tolerance = 1e-6;
+  // PD needs ~1000 iterations per step to reach 1e-6 on these muscle-driven
+  // bodies in contact; the small instance stops at 1e-4 (forward travel
+  // changes by ~3e-4 cm) so that it runs in about a minute with both methods.
+  o.rel_tolerance = size == InstanceSize::kSmall ? 1e-4 : 1e-6;
   return o;
 }
 

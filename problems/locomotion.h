@@ -22,7 +22,7 @@
 //    35 % of its height); muscles = the four legs, fibres vertical; "up"
 //    as for the quadruped.
 // Small: coarse voxels, 20 steps (two periods; quadruped 30), 8 Ipopt
-// iterations; full: finer voxels (torus and cow 12.5 mm, quadruped 15 mm),
+// iterations, steps solved to rel_tolerance 1e-4 (full: 1e-6); full: finer voxels (torus and cow 12.5 mm, quadruped 15 mm),
 // 40 steps, 40 iterations (a full rollout takes about 10 s with
 // newton-cholesky on one core: finer meshes are out of reach for now). Ipopt accepts a trial point after 3
 // backtracking steps (accept_after_max_steps): the contact makes the

@@ -31,10 +31,11 @@ std::string WriteHistory(const std::string& dir, const std::string& stem, const 
   return path;
 }
 
-// Plots the histories with gnuplot into <dir>/objective_history.png; returns
-// the path, or "" (with a message on stderr) if gnuplot failed.
+// Plots the histories with gnuplot into <dir>/objective_history.png (log
+// scale if every objective is positive); returns the path, or "" (with a
+// message on stderr) if gnuplot failed.
 std::string PlotHistories(const std::string& dir, const std::string& title,
-                          const std::vector<std::pair<std::string, std::string>>& series) {
+                          const std::vector<std::pair<std::string, std::string>>& series, bool positive) {
   const std::string png = (std::filesystem::path(dir) / "objective_history.png").string();
   FILE* gp = popen("gnuplot 2>/dev/null", "w");
   if (!gp) {
@@ -43,6 +44,7 @@ std::string PlotHistories(const std::string& dir, const std::string& title,
   }
   std::fprintf(gp, "set terminal pngcairo size 900,540\nset output '%s'\n", png.c_str());
   std::fprintf(gp, "set title '%s'\nset xlabel 'Ipopt iteration'\nset ylabel 'objective'\nset grid\n", title.c_str());
+  if (positive) std::fprintf(gp, "set logscale y\nset format y '%%.0e'\n");
   std::fprintf(gp, "plot ");
   for (size_t i = 0; i < series.size(); ++i)
     std::fprintf(gp, "%s'%s' using 1:2 with linespoints title '%s'", i ? ", " : "", series[i].second.c_str(),
@@ -116,6 +118,7 @@ OptimizationReport RunOptimization(const TrajectoryOptimizationProblem& problem,
   if (settings.compare_newton && settings.method != Method::kNewtonCholesky) methods.push_back(Method::kNewtonCholesky);
   if (!settings.out_dir.empty()) std::filesystem::create_directories(settings.out_dir);
   std::vector<std::pair<std::string, std::string>> histories;
+  bool all_positive = true;
 
   for (size_t r = 0; r < methods.size(); ++r) {
     SolverOptions options = problem.BaseOptions(settings.size);
@@ -159,6 +162,7 @@ OptimizationReport RunOptimization(const TrajectoryOptimizationProblem& problem,
       const std::string dat = WriteHistory(settings.out_dir, stem, s.objective_history);
       report.files.push_back(dat);
       histories.emplace_back(ToString(run.method), dat);
+      for (double f : s.objective_history) all_positive = all_positive && f > 0;
       if (r == 0) {  // frames of the optimised motion of the main run
         const Rollout* rollout = nlp->RolloutAt(s.x);
         if (rollout) {
@@ -181,7 +185,8 @@ OptimizationReport RunOptimization(const TrajectoryOptimizationProblem& problem,
     report.newton_time_ratio = sim_seconds(report.runs[1]) / std::max(sim_seconds(report.runs[0]), 1e-300);
   }
   if (!settings.out_dir.empty()) {
-    const std::string png = PlotHistories(settings.out_dir, problem.name() + ": objective per Ipopt iteration", histories);
+    const std::string png = PlotHistories(settings.out_dir, problem.name() + ": objective per Ipopt iteration", histories,
+                                          all_positive);
     if (!png.empty()) report.files.push_back(png);
     const std::string json_path = (std::filesystem::path(settings.out_dir) / "summary.json").string();
     std::ofstream(json_path) << ReportJson(report).dump(2) << "\n";
@@ -239,6 +244,10 @@ nlohmann::json ReportJson(const OptimizationReport& report) {
   return out;
 }
 
+std::string DefaultOutputDirectory(const std::string& problem) {
+  return (std::filesystem::path("out") / problem).string();
+}
+
 int ExitCode(const OptimizationReport& report) {
   const OptimizationRun& run = report.runs.at(0);
   const IpoptSummary& s = run.summary;
@@ -282,7 +291,7 @@ int TrajectoryOptimizationProblem::Run(const CommandArgs& args) const {
   settings.compare_newton = args.compare_newton;
   settings.threads = args.threads;
   settings.rel_tolerance = args.rel_tolerance;
-  settings.out_dir = args.out_dir;
+  settings.out_dir = args.out_dir.empty() ? DefaultOutputDirectory(name()) : args.out_dir;
   FILE* text = args.json ? stderr : stdout;
   settings.log = text;
   for (const std::string& o : args.ipopt_options) AddIpoptOption(o, &settings.ipopt);

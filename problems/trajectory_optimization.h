@@ -51,8 +51,10 @@ class TrajectoryOptimizationProblem : public Problem {
   // --method, --threads, --rtol, --out, --json, --no-compare, --ipopt
   // name=value), prints Ipopt's log and the final table (stderr with --json,
   // whose one JSON object goes to stdout), says so when Ipopt finds the
-  // problem infeasible, and returns ExitCode(). --steps and --dt are fixed
-  // by the problem (InvalidInputError).
+  // problem infeasible, writes VTK frames, the objective histories, their
+  // PNG plot and summary.json into --out (default
+  // DefaultOutputDirectory(name())), and returns ExitCode(). --steps and
+  // --dt are fixed by the problem (InvalidInputError).
   int Run(const CommandArgs& args) const override;
 
   // Problem interface: the full instance as a forward simulation.
@@ -111,6 +113,10 @@ nlohmann::json ReportJson(const OptimizationReport& report);
 // a number if it is a floating-point number, else a string. Throws
 // InvalidInputError without '=' or with an empty name or value.
 void AddIpoptOption(const std::string& name_value, solvers::IpoptOptions* options);
+
+// Where `diffpd run <problem>` writes without --out: out/<problem>
+// (relative to the working directory).
+std::string DefaultOutputDirectory(const std::string& problem);
 
 // Process exit code of a run: 0 if the main run succeeded, or stopped at
 // its iteration limit (small instances cap it on purpose) at a feasible point

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
@@ -68,6 +70,8 @@ TEST(IpoptBunnyTest, UnreachableWallIsReportedInfeasibleByTheProgram) {
   args.compare_newton = false;
   args.threads = 1;
   args.json = true;
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "diffpd_ipopt_bunny_infeasible";
+  args.out_dir = dir.string();
   ::testing::internal::CaptureStdout();
   ::testing::internal::CaptureStderr();
   const int code = bunny.Run(args);
@@ -83,6 +87,7 @@ TEST(IpoptBunnyTest, UnreachableWallIsReportedInfeasibleByTheProgram) {
                      "(Infeasible_Problem_Detected)"),
             std::string::npos)
       << err;
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
