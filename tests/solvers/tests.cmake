@@ -20,6 +20,6 @@ target_compile_definitions(readme_example_test PRIVATE DIFFPD_README_EXAMPLE="$<
 add_dependencies(readme_example_test readme_example)
 diffpd_add_test(ceres_calibrate_plant_test ${CMAKE_CURRENT_LIST_DIR}/ceres_calibrate_plant_test.cc LIBS diffpd_problems)
 diffpd_add_test(ipopt_trajectory_constraint_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_trajectory_constraint_test.cc LIBS diffpd_solvers)
+diffpd_add_test(ipopt_trajectory_optimization_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_trajectory_optimization_test.cc LIBS diffpd_problems diffpd_solvers)
 diffpd_add_test(ceres_calibrate_bouncing_ball_test ${CMAKE_CURRENT_LIST_DIR}/ceres_calibrate_bouncing_ball_test.cc LIBS diffpd_problems)
 diffpd_add_test(ceres_calibrate_starfish_test ${CMAKE_CURRENT_LIST_DIR}/ceres_calibrate_starfish_test.cc LIBS diffpd_problems)
-diffpd_add_test(ipopt_trajectory_optimization_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_trajectory_optimization_test.cc LIBS diffpd_problems diffpd_solvers)
