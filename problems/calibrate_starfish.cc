@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -29,15 +30,24 @@ constexpr double kMuscleStiffness = 2e6;      // Pa
 constexpr double kCentralHalfWidth = 0.018;   // m: the fixed central column, |y|, |z| < 18 mm
 constexpr double kStripHalfWidth = 0.0075;    // m: an arm's central strip
 constexpr double kFaceDistance = 0.001;       // m: flat-face layer / markers
+// A muscle element has a face (>= 3 nodes) on the flat face: its fibre
+// stretch along the arm is then the flat face's own stretch, so contraction
+// shortens the face and curls the arm. (Elements with only 1-2 nodes there
+// span the arm's thickness near the tips and shorten it without bending.)
+constexpr int kMuscleFaceNodes = 3;
 constexpr double kMarkerBand = 0.004;         // m: |z - target| of a marker candidate
 constexpr std::array<double, 4> kMarkerTargetZ = {-0.070, -0.040, 0.0362, 0.0632};
 constexpr double kLossScale = 0.002;          // m: residuals in units of 2 mm
 // Fit bounds and defaults.
 constexpr double kMinE = 1e4, kMaxE = 5e6, kMinNu = 0.2, kMaxNu = 0.45;
+constexpr double kMaxSlack = 0.015;                // m: slack in [0, 15 mm]
+constexpr double kMinLag = 1e-3, kMaxLag = 0.5;    // s: log lag in [log 1 ms, log 0.5 s]
+constexpr double kMinLength = 0.03, kMaxLength = 0.13;  // m: log tendon length in [log 30 mm, log 130 mm]
+constexpr double kSlackSmoothing = 0.001;          // m: width of the slack's quadratic onset
 constexpr double kFitStart = 1.0;    // s: the tendon first moves at 1.18 s in cyclic1
-constexpr double kFitSeconds = 1.0;  // s
+constexpr double kFitSeconds = 2.0;  // s
 constexpr double kDefaultSeconds = 10;
-constexpr int kDefaultIterations = 8;
+constexpr int kDefaultIterations = 10;
 
 const char* const kColumns[10] = {"time", "tendon", "M1 x", "M1 y", "M2 x", "M2 y", "M3 x", "M3 y", "M4 x", "M4 y"};
 
@@ -73,30 +83,62 @@ bool ParseNumber(const std::string& text, double* value) {
 double Sigmoid(double u) { return 1 / (1 + std::exp(-u)); }
 double Logit(double s) { return std::log(s / (1 - s)); }
 
-// The fit's objective over the bounded coordinates u (see
-// StarfishCalibration::FromCoordinates): the model's scalar loss with its
-// reverse-mode gradient, chained through the coordinate map.
-class BoundedMaterialLoss : public ceres::FirstOrderFunction {
+// The fit's objective over the bounded coordinates u (5 numbers: see
+// StarfishCalibration::FromCoordinates and ActuationFromCoordinates): the
+// model's scalar loss with its reverse-mode gradient, chained through the
+// coordinate maps.
+class BoundedLoss : public ceres::FirstOrderFunction {
  public:
-  BoundedMaterialLoss(solvers::CalibrationModel* model, double density) : model_(model), density_(density) {}
+  BoundedLoss(solvers::CalibrationModel* model, double density) : model_(model), density_(density) {}
   bool Evaluate(const double* u, double* cost, double* gradient) const override {
     const MaterialParameters m = StarfishCalibration::FromCoordinates(u, density_);
-    const double block[2] = {m.youngs_modulus, m.poissons_ratio};
-    const double* blocks[1] = {block};
-    double g[2] = {0, 0};
+    const StarfishActuation a = StarfishCalibration::ActuationFromCoordinates(u + 2);
+    const double material[2] = {m.youngs_modulus, m.poissons_ratio};
+    const double actuation[3] = {a.slack, a.lag, a.length};
+    const double* blocks[2] = {material, actuation};
+    double g[5] = {0, 0, 0, 0, 0};
     if (!model_->EvaluateLoss(blocks, {}, cost, gradient ? g : nullptr)) return false;
     if (gradient) {
-      const double se = Sigmoid(u[0]), sn = Sigmoid(u[1]);
+      const double se = Sigmoid(u[0]), sn = Sigmoid(u[1]), ss = Sigmoid(u[2]), sl = Sigmoid(u[3]);
       gradient[0] = g[0] * m.youngs_modulus * std::log(kMaxE / kMinE) * se * (1 - se);
       gradient[1] = g[1] * m.poissons_ratio * std::log(kMaxNu / kMinNu) * sn * (1 - sn);
+      gradient[2] = g[2] * kMaxSlack * ss * (1 - ss);
+      gradient[3] = g[3] * a.lag * std::log(kMaxLag / kMinLag) * sl * (1 - sl);
+      const double st = Sigmoid(u[4]);
+      gradient[4] = g[4] * a.length * std::log(kMaxLength / kMinLength) * st * (1 - st);
     }
     return std::isfinite(*cost);
   }
-  int NumParameters() const override { return 2; }
+  int NumParameters() const override { return 5; }
 
  private:
   solvers::CalibrationModel* model_;
   double density_;
+};
+
+// The activations of a window as the model's input block {slack, lag, length}.
+class TendonActuationInputs : public solvers::InputParameters {
+ public:
+  TendonActuationInputs(std::vector<double> contraction, double h, int muscles)
+      : contraction_(std::move(contraction)), h_(h), muscles_(muscles) {}
+  int size() const override { return 3; }
+  void Apply(const double* p, State* initial, std::vector<StepInput>* inputs,
+             std::vector<InputDirection>* directions) const override {
+    std::vector<std::array<double, 3>> d;
+    const std::vector<double> a =
+        StarfishActivations(contraction_, h_, StarfishActuation{p[0], p[1], p[2]}, directions ? &d : nullptr);
+    DIFFPD_CHECK(inputs->size() == a.size(), "TendonActuationInputs: step count mismatch");
+    for (size_t k = 0; k < a.size(); ++k) (*inputs)[k].activation = VectorXd::Constant(muscles_, a[k]);
+    if (!directions) return;
+    directions->assign(3, InputDirection());
+    for (size_t k = 0; k < a.size(); ++k)
+      for (int j = 0; j < 3; ++j) (*directions)[j].activation.push_back(VectorXd::Constant(muscles_, d[k][j]));
+  }
+
+ private:
+  std::vector<double> contraction_;
+  double h_;
+  int muscles_;
 };
 
 class FitTable : public ceres::IterationCallback {
@@ -104,11 +146,13 @@ class FitTable : public ceres::IterationCallback {
   FitTable(FILE* log, const double* u, double density) : log_(log), u_(u), density_(density) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     if (s.iteration == 0)
-      std::fprintf(log_, "%4s %13s %11s %11s %9s %14s %14s\n", "iter", "loss", "loss_change", "|gradient|", "total_t",
-                   "youngs_modulus", "poissons_ratio");
+      std::fprintf(log_, "%4s %13s %11s %11s %9s %14s %14s %9s %9s %9s\n", "iter", "loss", "loss_change",
+                   "|gradient|", "total_t", "youngs_modulus", "poissons_ratio", "slack_mm", "lag_s", "length_mm");
     const MaterialParameters m = StarfishCalibration::FromCoordinates(u_, density_);
-    std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %9.2f %14.6g %14.6g\n", s.iteration, s.cost, s.cost_change,
-                 s.gradient_max_norm, s.cumulative_time_in_seconds, m.youngs_modulus, m.poissons_ratio);
+    const StarfishActuation a = StarfishCalibration::ActuationFromCoordinates(u_ + 2);
+    std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %9.2f %14.6g %14.6g %9.4f %9.4f %9.3f\n", s.iteration, s.cost,
+                 s.cost_change, s.gradient_max_norm, s.cumulative_time_in_seconds, m.youngs_modulus,
+                 m.poissons_ratio, a.slack / kMm, a.lag, a.length / kMm);
     std::fflush(log_);
     return ceres::SOLVER_CONTINUE;
   }
@@ -119,11 +163,72 @@ class FitTable : public ceres::IterationCallback {
   double density_;
 };
 
+// Per camera frame: time (s), tendon (mm), activation, and per marker the
+// simulated and captured x and z displacements (mm), to
+// <dir>/<recording stem>_trace.csv.
+void WriteTrace(const std::string& dir, const Mesh& mesh, const Rollout& rollout, const StarfishRecording& rec,
+                const StarfishWindow& w, int substeps) {
+  std::filesystem::create_directories(dir);
+  const std::string path =
+      (std::filesystem::path(dir) / (std::filesystem::path(rec.path).stem().string() + "_trace.csv")).string();
+  std::ofstream out(path);
+  if (!out) throw InvalidInputError("cannot write '" + path + "'");
+  const std::array<int, 4> vertices = StarfishCalibration::MarkerVertices(mesh);
+  out << "time_s,tendon_mm,activation";
+  for (int m = 1; m <= 4; ++m)
+    out << ",M" << m << "_sim_x,M" << m << "_cap_x,M" << m << "_sim_z,M" << m << "_cap_z";
+  out << "\n";
+  const State& s0 = rollout.states[0];
+  for (int j = w.first; j <= w.last; ++j) {
+    const int k = (j - w.first) * substeps;
+    const State& s = rollout.states[k];
+    const int input = std::min(k, static_cast<int>(rollout.inputs.size()) - 1);
+    out << rec.time[j] << "," << rec.tendon[j] / kMm << "," << rollout.inputs[input].activation(0);
+    for (int m = 0; m < 4; ++m) {
+      const int v = vertices[m];
+      out << "," << (s.x(3 * v) - s0.x(3 * v)) / kMm << "," << (rec.markers[j][2 * m] - rec.markers[w.first][2 * m]) / kMm
+          << "," << (s.x(3 * v + 2) - s0.x(3 * v + 2)) / kMm << ","
+          << -(rec.markers[j][2 * m + 1] - rec.markers[w.first][2 * m + 1]) / kMm;
+    }
+    out << "\n";
+  }
+}
+
 double WindowTimeStep(const StarfishRecording& rec, const StarfishWindow& w, int substeps) {
   return (rec.time[w.last] - rec.time[w.first]) / (w.num_frames() - 1) / substeps;
 }
 
 }  // namespace
+
+std::vector<double> StarfishActivations(const std::vector<double>& c, double h, const StarfishActuation& act,
+                                        std::vector<std::array<double, 3>>* derivatives) {
+  if (!(std::isfinite(h) && h > 0)) throw InvalidInputError("time step = " + Num(h) + " is invalid: must be > 0 (s)");
+  if (!(std::isfinite(act.slack) && act.slack >= 0))
+    throw InvalidInputError("tendon slack = " + Num(act.slack) + " is invalid: must be finite and >= 0 (m)");
+  if (!(std::isfinite(act.lag) && act.lag >= 0))
+    throw InvalidInputError("tendon lag = " + Num(act.lag) + " is invalid: must be finite and >= 0 (s)");
+  if (!(std::isfinite(act.length) && act.length > 0))
+    throw InvalidInputError("tendon length = " + Num(act.length) + " is invalid: must be finite and > 0 (m)");
+  const size_t n = c.size();
+  std::vector<double> a(n);
+  if (derivatives) derivatives->assign(n, {0, 0, 0});
+  double f = n ? c[0] : 0, df = 0;  // filtered contraction and its derivative in lag
+  const double w = kSlackSmoothing, L = act.length;
+  for (size_t k = 0; k < n; ++k) {
+    const double f_new = (act.lag * f + h * c[k]) / (act.lag + h);
+    df = (f - f_new + act.lag * df) / (act.lag + h);
+    f = f_new;
+    const double x = f - act.slack;
+    const double hinge = x <= 0 ? 0 : x < w ? x * x / (2 * w) : x - w / 2;
+    const double slope = x <= 0 ? 0 : x < w ? x / w : 1;
+    a[k] = 1 - hinge / L;
+    if (a[k] < 0)
+      throw InvalidInputError("tendon: activation " + Num(a[k]) + " < 0 at step " + std::to_string(k) + " (slack " +
+                              Num(act.slack) + " m, length " + Num(L) + " m)");
+    if (derivatives) (*derivatives)[k] = {slope / L, -slope * df / L, hinge / (L * L)};
+  }
+  return a;
+}
 
 StarfishRecording ReadStarfishRecording(const std::string& path) {
   std::ifstream in(path);
@@ -215,7 +320,7 @@ StarfishWindow MakeStarfishWindow(const StarfishRecording& rec, double start, do
 }
 
 std::string StarfishCalibration::description() const {
-  return "fit E and nu of a soft starfish swimming underwater to real captured motion, predict other recordings";
+  return "fit E, nu, tendon slack, servo lag and tendon length of a soft starfish swimming underwater to real captured motion, predict other recordings";
 }
 
 void StarfishCalibration::set_substeps(int substeps) {
@@ -265,14 +370,14 @@ Scene StarfishCalibration::MakeScene() const {
   }
   for (int e = 0; e < mesh.num_elements(); ++e) {
     Vec3 c = Vec3::Zero();
-    bool at_face = false;
+    int on_face = 0;
     const int nodes = static_cast<int>(mesh.elements.rows());
     for (int a = 0; a < nodes; ++a) {
       const Vec3 p = mesh.vertices.col(mesh.elements(a, e));
       c += p / nodes;
-      at_face = at_face || std::abs(p(0)) <= kFaceDistance;
+      on_face += std::abs(p(0)) <= kFaceDistance;
     }
-    if (!at_face) continue;
+    if (on_face < kMuscleFaceNodes) continue;
     if (std::abs(c(1)) <= kStripHalfWidth && std::abs(c(2)) > kCentralHalfWidth)
       scene.muscles[c(2) < 0 ? 0 : 1].elements.push_back(e);
     else if (std::abs(c(2)) <= kStripHalfWidth && std::abs(c(1)) > kCentralHalfWidth)
@@ -300,22 +405,29 @@ SolverOptions StarfishCalibration::Options(Method method, int threads) const {
   return options;
 }
 
-std::vector<StepInput> StarfishCalibration::WindowInputs(const StarfishRecording& rec,
-                                                         const StarfishWindow& w) const {
-  std::vector<StepInput> inputs((w.num_frames() - 1) * substeps_);
-  for (size_t i = 0; i < inputs.size(); ++i) {
-    const double a = 1 - rec.tendon[w.first + static_cast<int>(i) / substeps_] / kTendonRest;
-    inputs[i].activation = VectorXd::Constant(4, a);
-  }
+std::vector<double> StarfishCalibration::WindowContractions(const StarfishRecording& rec,
+                                                            const StarfishWindow& w) const {
+  std::vector<double> c((w.num_frames() - 1) * substeps_);
+  for (size_t i = 0; i < c.size(); ++i) c[i] = rec.tendon[w.first + static_cast<int>(i) / substeps_];
+  return c;
+}
+
+std::vector<StepInput> StarfishCalibration::WindowInputs(const StarfishRecording& rec, const StarfishWindow& w,
+                                                         const StarfishActuation& actuation) const {
+  const std::vector<double> a =
+      StarfishActivations(WindowContractions(rec, w), WindowTimeStep(rec, w, substeps_), actuation, nullptr);
+  std::vector<StepInput> inputs(a.size());
+  for (size_t i = 0; i < a.size(); ++i) inputs[i].activation = VectorXd::Constant(4, a[i]);
   return inputs;
 }
 
-State StarfishCalibration::WindowInitialState(Simulator& sim, const StarfishRecording& rec,
-                                              const StarfishWindow& w) const {
+State StarfishCalibration::WindowInitialState(Simulator& sim, const StarfishRecording& rec, const StarfishWindow& w,
+                                              const StarfishActuation& actuation) const {
   State s = sim.RestState();
-  if (rec.tendon[w.first] == 0) return s;
+  const double a = StarfishActivations({rec.tendon[w.first]}, 1, actuation, nullptr)[0];
+  if (a == 1) return s;
   StepInput input;
-  input.activation = VectorXd::Constant(4, 1 - rec.tendon[w.first] / kTendonRest);
+  input.activation = VectorXd::Constant(4, a);
   s.x = sim.SolveQuasiStatic(s.x, input);
   return s;
 }
@@ -387,19 +499,22 @@ StarfishErrors StarfishCalibration::WindowErrors(const Mesh& mesh, const std::ve
 std::unique_ptr<solvers::CalibrationModel> StarfishCalibration::MakeModel(const StarfishRecording& rec,
                                                                           const StarfishWindow& w,
                                                                           const SolverOptions& options,
-                                                                          const MaterialParameters& material) const {
+                                                                          const MaterialParameters& material,
+                                                                          const StarfishActuation& actuation) const {
   solvers::CalibrationSetup setup;
   setup.scene = MakeScene();
   setup.scene.material = material;
   setup.solver = options;
   setup.solver.time_step = WindowTimeStep(rec, w, substeps_);
   setup.fitted = {solvers::MaterialParameter::kYoungsModulus, solvers::MaterialParameter::kPoissonsRatio};
-  setup.inputs = WindowInputs(rec, w);
+  setup.inputs = WindowInputs(rec, w, actuation);
   setup.num_steps = static_cast<int>(setup.inputs.size());
+  setup.input_parameters = std::make_shared<TendonActuationInputs>(WindowContractions(rec, w),
+                                                                   setup.solver.time_step, 4);
   setup.jacobian = solvers::JacobianMode::kReverse;
   {
     Simulator sim(setup.scene, setup.solver);
-    setup.initial = WindowInitialState(sim, rec, w);
+    setup.initial = WindowInitialState(sim, rec, w, actuation);
   }
   setup.motion = WindowMotion(setup.scene.mesh, *setup.initial, rec, w);
   return std::make_unique<solvers::CalibrationModel>(std::move(setup));
@@ -407,11 +522,12 @@ std::unique_ptr<solvers::CalibrationModel> StarfishCalibration::MakeModel(const 
 
 StarfishFit StarfishCalibration::Fit(const StarfishRecording& rec, const StarfishWindow& w,
                                      const SolverOptions& options, const MaterialParameters& guess,
-                                     int max_iterations, FILE* log) const {
-  std::unique_ptr<solvers::CalibrationModel> model = MakeModel(rec, w, options, guess);
-  double u[2];
+                                     const StarfishActuation& actuation_guess, int max_iterations, FILE* log) const {
+  std::unique_ptr<solvers::CalibrationModel> model = MakeModel(rec, w, options, guess, actuation_guess);
+  double u[5];
   ToCoordinates(guess, u);
-  ceres::GradientProblem problem(new BoundedMaterialLoss(model.get(), guess.density));
+  ActuationToCoordinates(actuation_guess, u + 2);
+  ceres::GradientProblem problem(new BoundedLoss(model.get(), guess.density));
   ceres::GradientProblemSolver::Options solver_options;
   solver_options.line_search_direction_type = ceres::LBFGS;
   // Scale L-BFGS' initial inverse Hessian by the observed curvature: the
@@ -429,6 +545,7 @@ StarfishFit StarfishCalibration::Fit(const StarfishRecording& rec, const Starfis
   ceres::Solve(solver_options, problem, u, &summary);
   StarfishFit fit;
   fit.material = FromCoordinates(u, guess.density);
+  fit.actuation = ActuationFromCoordinates(u + 2);
   fit.initial_cost = summary.initial_cost;
   fit.final_cost = summary.final_cost;
   fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
@@ -453,6 +570,26 @@ void StarfishCalibration::ToCoordinates(const MaterialParameters& m, double* u) 
     throw InvalidInputError("poissons_ratio = " + Num(m.poissons_ratio) + " is outside the fit's interval (0.2, 0.45)");
   u[0] = Logit(std::log(m.youngs_modulus / kMinE) / std::log(kMaxE / kMinE));
   u[1] = Logit(std::log(m.poissons_ratio / kMinNu) / std::log(kMaxNu / kMinNu));
+}
+
+StarfishActuation StarfishCalibration::ActuationFromCoordinates(const double* u) {
+  StarfishActuation a;
+  a.slack = kMaxSlack * Sigmoid(u[0]);
+  a.lag = std::exp(std::log(kMinLag) + std::log(kMaxLag / kMinLag) * Sigmoid(u[1]));
+  a.length = std::exp(std::log(kMinLength) + std::log(kMaxLength / kMinLength) * Sigmoid(u[2]));
+  return a;
+}
+
+void StarfishCalibration::ActuationToCoordinates(const StarfishActuation& a, double* u) {
+  if (!(a.slack > 0 && a.slack < kMaxSlack))
+    throw InvalidInputError("tendon slack = " + Num(a.slack) + " is outside the fit's interval (0, 0.015) m");
+  if (!(a.lag > kMinLag && a.lag < kMaxLag))
+    throw InvalidInputError("tendon lag = " + Num(a.lag) + " is outside the fit's interval (0.001, 0.5) s");
+  u[0] = Logit(a.slack / kMaxSlack);
+  if (!(a.length > kMinLength && a.length < kMaxLength))
+    throw InvalidInputError("tendon length = " + Num(a.length) + " is outside the fit's interval (0.03, 0.13) m");
+  u[1] = Logit(std::log(a.lag / kMinLag) / std::log(kMaxLag / kMinLag));
+  u[2] = Logit(std::log(a.length / kMinLength) / std::log(kMaxLength / kMinLength));
 }
 
 int StarfishCalibration::Run(const CommandArgs& args) const {
@@ -505,15 +642,19 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
 
   // The fit.
   const MaterialParameters guess = scene.material;
-  std::fprintf(log, "# fit: Ceres L-BFGS on (log E, log nu) mapped into E in [1e4, 5e6] Pa, nu in [0.2, 0.45]; "
+  const StarfishActuation actuation_guess = ActuationGuess();
+  std::fprintf(log, "# fit: Ceres L-BFGS on (log E, log nu, slack, log lag, log length) mapped into E in [1e4, 5e6] "
+               "Pa, nu in [0.2, 0.45], tendon slack in [0, 15] mm, servo lag in [1, 500] ms, tendon length in [30, 130] mm; "
                "loss = 1/2 weighted mean squared marker error / (2 mm)^2\n");
-  const StarfishFit fit = Fit(calibration, fit_window, options, guess,
-                              args.max_iterations > 0 ? args.max_iterations : kDefaultIterations, log);
+  const StarfishFit fit = Fit(calibration, fit_window, options, guess, actuation_guess,
+                              args.max_iterations >= 0 ? args.max_iterations : kDefaultIterations, log);
   const MaterialParameters& fitted = fit.material;
+  const StarfishActuation& actuation = fit.actuation;
   const solvers::CalibrationStatistics& stats = fit.statistics;
-  std::fprintf(log, "# fit: %s after %d iterations; E = %.6g Pa, nu = %.6g; loss %.6e -> %.6e\n",
-               fit.termination.c_str(), fit.iterations, fitted.youngs_modulus, fitted.poissons_ratio,
-               fit.initial_cost, fit.final_cost);
+  std::fprintf(log, "# fit: %s after %d iterations; E = %.6g Pa, nu = %.6g, slack = %.3f mm, lag = %.4f s, "
+               "length = %.2f mm; loss %.6e -> %.6e\n", fit.termination.c_str(), fit.iterations, fitted.youngs_modulus,
+               fitted.poissons_ratio, actuation.slack / kMm, actuation.lag, actuation.length / kMm, fit.initial_cost,
+               fit.final_cost);
   std::fprintf(log, "# fit: %d rollouts (%.2f s forward), %d gradients (%.2f s backward), %d failed\n", stats.rollouts,
                stats.forward_seconds, stats.gradients, stats.backward_seconds, stats.failures);
   if (stats.failures > 0) std::fprintf(log, "# last failure: %s\n", stats.last_error.c_str());
@@ -532,10 +673,11 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
     o.time_step = WindowTimeStep(rec, w, substeps_);
     Simulator sim(s, o);
     const auto t0 = std::chrono::steady_clock::now();
-    const State initial = WindowInitialState(sim, rec, w);
-    const Rollout rollout = sim.Simulate(initial, WindowInputs(rec, w));
+    const State initial = WindowInitialState(sim, rec, w, actuation);
+    const Rollout rollout = sim.Simulate(initial, WindowInputs(rec, w, actuation));
     const double sim_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const StarfishErrors e = WindowErrors(s.mesh, rollout.states, rec, w);
+    if (!args.out_dir.empty()) WriteTrace(args.out_dir, s.mesh, rollout, rec, w, substeps_);
     const double window_seconds = rec.time[w.last] - rec.time[w.first];
     std::fprintf(log, "%-40s %8.3f %8d %10.3f %12.3f %10.1f\n", rec.path.c_str(), window_seconds, w.num_frames(),
                  e.rmse / kMm, e.arm_relative_rmse / kMm, sim_seconds);
@@ -559,8 +701,14 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                           {"youngs_modulus", fitted.youngs_modulus},
                           {"poissons_ratio", fitted.poissons_ratio},
                           {"density", fitted.density},
+                          {"tendon_slack_mm", actuation.slack / kMm},
+                          {"tendon_lag_s", actuation.lag},
+                          {"tendon_length_mm", actuation.length / kMm},
                           {"truth", nlohmann::json::object()},
-                          {"initial_guess", {{"youngs_modulus", guess.youngs_modulus}, {"poissons_ratio", guess.poissons_ratio}}},
+                          {"initial_guess", {{"youngs_modulus", guess.youngs_modulus}, {"poissons_ratio", guess.poissons_ratio},
+                                             {"tendon_slack_mm", actuation_guess.slack / kMm},
+                                             {"tendon_lag_s", actuation_guess.lag},
+                                             {"tendon_length_mm", actuation_guess.length / kMm}}},
                           {"method", ToString(method)},
                           {"initial_cost", fit.initial_cost},
                           {"final_cost", fit.final_cost},

@@ -9,11 +9,15 @@
 // 780 nodes, 2163 linear tets. pd-corotated + pd-volume, density 400 kg/m^3,
 // no gravity, no contact. Boundary: every node with |y| < 18 mm and
 // |z| < 18 mm has y and z fixed (x free). Four muscles (one per arm, k = 2e6
-// Pa): the elements with a node within 1 mm of the flat face x = 0, centroid
-// in the arm's central strip (|y| <= 7.5 mm for z-arms, |z| <= 7.5 mm for
-// y-arms) and beyond the central square; fibres along the arm. All four are
-// driven by the same activation a = 1 - contraction / 65 mm (one servo pulls
-// all legs), held for the steps within a camera frame. Water: drag and
+// Pa): the elements with a face on the flat face x = 0 (>= 3 nodes within
+// 1 mm of it; the fact sheet's "a node within 1 mm" takes in, on this coarse
+// mesh, tets spanning the thin arm tips' whole thickness, which shorten the
+// arms instead of curling them), centroid in the arm's central strip
+// (|y| <= 7.5 mm for z-arms, |z| <= 7.5 mm for y-arms) and beyond the
+// central square; fibres along the arm. All four are driven by the same
+// activation (one servo pulls all legs), StarfishActuation below: the
+// recorded tendon contraction, held per camera frame, through a fitted servo
+// lag and tendon slack, a = 1 - (c - slack) / 65 mm. Water: drag and
 // thrust on every boundary triangle (state_forces.h, fluid density 1000
 // kg/m^3, Cd from 0.05 along the face to 2.05 normal to it, no separate
 // thrust term: the normal pressure is the normal drag). Implicit Euler with 2
@@ -89,9 +93,40 @@ struct StarfishErrors {
   int frames = 0;                // frames compared (frame 0 excluded: zero by construction)
 };
 
+// The map from the recorded tendon contraction c (servo command, m, held per
+// camera frame) to the muscle activation of every simulation step, fitted
+// with the material:
+//   servo lag:  c_f(k) = (lag c_f(k-1) + h c(k)) / (lag + h)  (first-order
+//               lag, implicit Euler per step h, starting at c_f = c of the
+//               window's first frame),
+//   slack:      a(k) = 1 - H(c_f(k) - slack) / length, H(x) = 0 for x <= 0,
+//               x^2 / (2 mm) below 1 mm, x - 0.5 mm above (a slack tendon
+//               pulls nothing; the quadratic onset keeps a smooth),
+//   length:     the tendon length over which the contraction is spread (the
+//               fact sheet's 65 mm).
+// slack = 0, lag = 0, length = 65 mm is the fact sheet's a = 1 - c / 65 mm
+// except below 1 mm.
+struct StarfishActuation {
+  double slack = 0;       // m, >= 0
+  double lag = 0;         // s, >= 0
+  double length = 0.065;  // m, > 0
+};
+
+// Activations a(k) of the steps of a contraction sequence (one value per
+// step, m) at time step h (s), and if not nullptr, per step the derivatives
+// {da/dslack (1/m), da/dlag (1/s), da/dlength (1/m)}. Throws
+// InvalidInputError for h <= 0, a negative or non-finite slack or lag, or a
+// length <= 0 ("tendon lag = -1 is invalid: must be finite and >= 0 (s)"),
+// and for a negative activation ("tendon: activation -0.2 < 0 at step 7 (slack
+// 0 m, length 0.01 m)").
+std::vector<double> StarfishActivations(const std::vector<double>& contraction, double h,
+                                        const StarfishActuation& actuation,
+                                        std::vector<std::array<double, 3>>* derivatives);
+
 // The outcome of a fit (StarfishCalibration::Fit).
 struct StarfishFit {
   MaterialParameters material;   // fitted
+  StarfishActuation actuation;   // fitted
   double initial_cost = 0;       // loss 1/2 |r|^2 (see WindowMotion) at the start
   double final_cost = 0;
   int iterations = 0;            // Ceres L-BFGS iterations
@@ -105,7 +140,7 @@ class StarfishCalibration : public Problem {
   // Marker weights of the fit, M1..M4 (weights of the squared errors).
   static constexpr std::array<double, 4> kMarkerWeights = {10, 1, 1, 10};
   static constexpr double kFrameRate = 60;     // Hz, the camera
-  static constexpr double kTendonRest = 0.065; // m: a = 1 - contraction / 65 mm
+  static constexpr double kTendonRest = 0.065; // m: the fact sheet's a = 1 - contraction / 65 mm
 
   std::string name() const override { return "calibrate-starfish"; }
   std::string description() const override;
@@ -131,12 +166,17 @@ class StarfishCalibration : public Problem {
   // displacement (x from image x, z from minus image y, y the initial y with
   // weight 0), weights sqrt(w_m / (sum w * (frames - 1))) / 2 mm on x and z,
   // so that 1/2 |r|^2 = 1/2 weighted mean squared error / (2 mm)^2.
-  std::vector<StepInput> WindowInputs(const StarfishRecording& recording, const StarfishWindow& window) const;
+  std::vector<StepInput> WindowInputs(const StarfishRecording& recording, const StarfishWindow& window,
+                                      const StarfishActuation& actuation) const;
+  // The tendon contraction of every step of a window (m, zero-order hold).
+  std::vector<double> WindowContractions(const StarfishRecording& recording, const StarfishWindow& window) const;
   CapturedMotion WindowMotion(const Mesh& mesh, const State& initial, const StarfishRecording& recording,
                               const StarfishWindow& window) const;
-  // The window's initial state: rest if its first tendon value is 0, else the
-  // quasi-static equilibrium under that activation.
-  State WindowInitialState(Simulator& sim, const StarfishRecording& recording, const StarfishWindow& window) const;
+  // The window's initial state: rest if the activation of its first tendon
+  // value (lag at steady state) is 1, else the quasi-static equilibrium
+  // under that activation.
+  State WindowInitialState(Simulator& sim, const StarfishRecording& recording, const StarfishWindow& window,
+                           const StarfishActuation& actuation) const;
   // Errors of a simulated window (states at every step, rollout from
   // WindowInitialState) against the recording.
   StarfishErrors WindowErrors(const Mesh& mesh, const std::vector<State>& states, const StarfishRecording& recording,
@@ -148,18 +188,25 @@ class StarfishCalibration : public Problem {
   SolverOptions Options(Method method, int threads) const;
 
   // The calibration model of a window (reverse-mode gradients of the scalar
-  // loss 1/2 |r|^2; fitted: E and nu) at `material`.
+  // loss 1/2 |r|^2) at `material` and `actuation`. Parameter blocks: {E, nu}
+  // (Pa, 1) and {slack, lag, length} (m, s, m; the activations are an input
+  // block). The initial state is WindowInitialState at `actuation` and is
+  // held fixed, so the gradient is exact when the window starts with the
+  // tendon slack (a = 1, as in the default fit window from rest).
   std::unique_ptr<solvers::CalibrationModel> MakeModel(const StarfishRecording& recording,
                                                        const StarfishWindow& window, const SolverOptions& options,
-                                                       const MaterialParameters& material) const;
+                                                       const MaterialParameters& material,
+                                                       const StarfishActuation& actuation) const;
 
-  // Fits E and nu on a window with Ceres' L-BFGS (GradientProblem) on the
-  // bounded coordinates below, starting from `guess`, at most
-  // `max_iterations` iterations; the iteration table goes to `log` (nullptr:
-  // silent). Throws what MakeModel throws; a failed rollout makes Ceres
+  // Fits E, nu, slack, lag and length on a window with Ceres' L-BFGS
+  // (GradientProblem) on the bounded coordinates below (u = 2 material then
+  // 3 actuation coordinates), starting from `guess` and `actuation_guess`,
+  // at most `max_iterations` iterations; the iteration table goes to `log`
+  // (nullptr: silent). Throws what MakeModel throws; a failed rollout makes Ceres
   // shorten its step (the failure is counted in statistics).
   StarfishFit Fit(const StarfishRecording& recording, const StarfishWindow& window, const SolverOptions& options,
-                  const MaterialParameters& guess, int max_iterations, FILE* log) const;
+                  const MaterialParameters& guess, const StarfishActuation& actuation_guess, int max_iterations,
+                  FILE* log) const;
 
   // Bounds of the fit: E in [1e4, 5e6] Pa, nu in [0.2, 0.45]. The optimiser's
   // coordinates u (2 numbers) map to log E = lo + (hi - lo) s(u_0), log nu
@@ -168,14 +215,27 @@ class StarfishCalibration : public Problem {
   // Inverse map; throws InvalidInputError for E or nu outside the open
   // intervals, e.g. "youngs_modulus = 6e+06 is outside the fit's interval (1e4, 5e6) Pa".
   static void ToCoordinates(const MaterialParameters& m, double* u);
+  // Actuation coordinates (3 numbers): slack = 15 mm s(u_0); log lag in
+  // [log 1 ms, log 0.5 s] and log length in [log 30 mm, log 130 mm] like
+  // log E. The inverse throws InvalidInputError outside the open intervals
+  // ("tendon slack = 0.02 is outside the fit's interval (0, 0.015) m").
+  static StarfishActuation ActuationFromCoordinates(const double* u);
+  static void ActuationToCoordinates(const StarfishActuation& a, double* u);
+  // The fit's starting actuation: slack 3 mm, lag 50 ms, length 65 mm.
+  static StarfishActuation ActuationGuess() { return StarfishActuation{0.003, 0.05, kTendonRest}; }
 
   // `diffpd run calibrate-starfish [--calibrate FILE] [--predict FILE ...]
-  // [--seconds S] [--json] [--threads T] [--max-iterations N]`: fits E and
-  // nu on the calibration file's window [1 s, 2 s] (the tendon first moves
-  // at 1.18 s in cyclic1) with Ceres' L-BFGS on the scalar loss (at most 8
-  // iterations unless --max-iterations), then simulates the first S seconds
-  // (default 10) of every --predict file (default: the calibration file and, when no --calibrate is
-  // given, cyclic2 too) with the fitted material and reports the errors.
+  // [--seconds S] [--json] [--threads T] [--max-iterations N] [--out DIR]`:
+  // fits E, nu, tendon slack, lag and length on the calibration file's window
+  // [1 s, 3 s] (the tendon first moves at 1.18 s in cyclic1) with Ceres'
+  // L-BFGS on the scalar loss (at most 10 iterations unless
+  // --max-iterations; 0: no fit, predict at the starting values), then
+  // simulates the first S seconds (default 10) of every --predict file
+  // (default: the calibration file and, when no --calibrate is given,
+  // cyclic2 too) with the fitted parameters and reports the errors.
+  // --out DIR writes DIR/<file stem>_trace.csv per predicted file: time,
+  // tendon (mm), activation, simulated and captured x, z displacement of
+  // M1..M4 (mm) per camera frame.
   // Method: pd-lbfgs, or the first of --methods, or a --method other than
   // the command line's default pd. --threads as for every problem.
   int Run(const CommandArgs& args) const override;

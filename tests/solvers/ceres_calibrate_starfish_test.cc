@@ -1,10 +1,12 @@
 // calibrate-starfish (problems/calibrate_starfish.h): the real recordings are
 // parsed as the fact sheet describes them, malformed files are rejected with
 // messages naming file and line, the scene has the fact sheet's boundary,
-// markers and muscles, the reverse-mode loss gradient agrees with central
-// finite differences, and a short fit lowers the loss.
+// markers and muscles, the tendon-to-activation map (slack, lag) and its
+// derivatives, the reverse-mode loss gradient in E, nu, slack and lag agrees
+// with central finite differences, and a short fit lowers the loss.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -148,12 +150,12 @@ TEST_F(StarfishSceneTest, FourMusclesAlongTheArmsInTheFlatFaceLayer) {
     EXPECT_EQ(muscle.fibers[0], m < 2 ? Vec3(0, 0, 1) : Vec3(0, 1, 0));
     for (int e : muscle.elements) {
       Vec3 c = Vec3::Zero();
-      double min_abs_x = 1;
+      int on_face = 0;
       for (int a = 0; a < 4; ++a) {
         c += mesh.vertices.col(mesh.elements(a, e)) / 4;
-        min_abs_x = std::min(min_abs_x, std::abs(mesh.vertices(0, mesh.elements(a, e))));
+        on_face += std::abs(mesh.vertices(0, mesh.elements(a, e))) <= 1e-3;
       }
-      EXPECT_LE(min_abs_x, 1e-3);
+      EXPECT_GE(on_face, 3) << "a muscle element has a face on the flat face";
       EXPECT_LE(std::abs(c(across)), 7.5e-3);
       EXPECT_GT((m % 2 ? 1 : -1) * c(along), 0.018);
     }
@@ -162,6 +164,58 @@ TEST_F(StarfishSceneTest, FourMusclesAlongTheArmsInTheFlatFaceLayer) {
   EXPECT_EQ(scene_->hydrodynamics->triangles.cols(), 1520);  // the OBJ's triangles (TetGen's Y switch)
   EXPECT_FALSE(scene_->gravity.has_value());
   EXPECT_DOUBLE_EQ(scene_->material.density, 400);
+}
+
+TEST(StarfishActivationsTest, SlackLagAndLengthShapeTheActivation) {
+  const double h = 0.01;
+  std::vector<double> c(40, 0.0);
+  for (int k = 5; k < 40; ++k) c[k] = 0.0179;
+  // No slack, no lag: the fact sheet's a = 1 - c / 65 mm (above the 1 mm onset).
+  std::vector<double> a = StarfishActivations(c, h, StarfishActuation{0, 0, 0.065}, nullptr);
+  EXPECT_EQ(a[4], 1.0);
+  EXPECT_NEAR(a[5], 1 - (0.0179 - 0.0005) / 0.065, 1e-14);
+  // Slack: nothing below it; the lag: a first-order approach to the held value.
+  a = StarfishActivations(c, h, StarfishActuation{0.005, 0.05, 0.04}, nullptr);
+  EXPECT_EQ(a[4], 1.0);
+  EXPECT_GT(a[5], a[8]);
+  const double filtered = 0.0179 * (1 - std::pow(0.05 / (0.05 + h), 35));  // after 35 steps from 0
+  EXPECT_NEAR(a[39], 1 - (filtered - 0.005 - 0.0005) / 0.04, 1e-12);
+  for (int k = 6; k < 40; ++k) EXPECT_LE(a[k], a[k - 1]);
+  // Derivatives vs central differences.
+  for (int k = 0; k < 40; ++k) c[k] = 0.009 + 0.008 * std::sin(0.7 * k);
+  const StarfishActuation at{0.004, 0.03, 0.05};
+  std::vector<std::array<double, 3>> d;
+  StarfishActivations(c, h, at, &d);
+  const double e = 1e-7;
+  double largest[3] = {0, 0, 0};
+  for (int j = 0; j < 3; ++j) {
+    StarfishActuation plus = at, minus = at;
+    double* p[2] = {j == 0 ? &plus.slack : j == 1 ? &plus.lag : &plus.length,
+                    j == 0 ? &minus.slack : j == 1 ? &minus.lag : &minus.length};
+    *p[0] += e;
+    *p[1] -= e;
+    const std::vector<double> ap = StarfishActivations(c, h, plus, nullptr);
+    const std::vector<double> am = StarfishActivations(c, h, minus, nullptr);
+    for (int k = 0; k < 40; ++k) {
+      EXPECT_NEAR(d[k][j], (ap[k] - am[k]) / (2 * e), 1e-6) << "parameter " << j << ", step " << k;
+      largest[j] = std::max(largest[j], std::abs(d[k][j]));
+    }
+  }
+  EXPECT_GT(largest[0], 1);    // 1/m
+  EXPECT_GT(largest[1], 0.1);  // 1/s
+  EXPECT_GT(largest[2], 1);    // 1/m
+  try {
+    StarfishActivations(c, h, StarfishActuation{0, -1, 0.065}, nullptr);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInputError& err) {
+    EXPECT_EQ(std::string(err.what()), "tendon lag = -1 is invalid: must be finite and >= 0 (s)");
+  }
+  try {
+    StarfishActivations({0.0, 0.0105}, h, StarfishActuation{0, 0, 0.005}, nullptr);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInputError& err) {
+    EXPECT_EQ(std::string(err.what()), "tendon: activation -1 < 0 at step 1 (slack 0 m, length 0.005 m)");
+  }
 }
 
 // The window of the gradient and fit tests: 0.15 s from 1.15 s of cyclic1
@@ -182,23 +236,30 @@ TEST_F(StarfishFitTest, LossGradientMatchesCentralDifferences) {
   options.abs_tolerance = 1e-10;
   options.backward_rel_tolerance = 1e-11;
   const MaterialParameters material{2e5, 0.35, 400};
-  auto model = starfish_.MakeModel(recording_, window_, options, material);
-  auto loss = [&](double E, double nu, double* gradient) {
-    const double block[2] = {E, nu};
-    const double* blocks[1] = {block};
+  const StarfishActuation actuation{0.004, 0.03, 0.05};
+  auto model = starfish_.MakeModel(recording_, window_, options, material, actuation);
+  auto loss = [&](const double* p, double* gradient) {
+    const double* blocks[2] = {p, p + 2};
     double cost = 0;
     EXPECT_TRUE(model->EvaluateLoss(blocks, {}, &cost, gradient)) << model->statistics().last_error;
     return cost;
   };
-  double g[2];
-  const double l0 = loss(2e5, 0.35, g);
+  const double p0[5] = {2e5, 0.35, 0.004, 0.03, 0.05};
+  double g[5];
+  const double l0 = loss(p0, g);
   EXPECT_GT(l0, 0);
-  const double dE = 2e5 * 1e-4, dnu = 1e-4;
-  const double fd_E = (loss(2e5 + dE, 0.35, nullptr) - loss(2e5 - dE, 0.35, nullptr)) / (2 * dE);
-  const double fd_nu = (loss(2e5, 0.35 + dnu, nullptr) - loss(2e5, 0.35 - dnu, nullptr)) / (2 * dnu);
-  EXPECT_NEAR(g[0], fd_E, 1e-4 * std::abs(fd_E)) << "dL/dE";
-  EXPECT_NEAR(g[1], fd_nu, 1e-4 * std::abs(fd_nu)) << "dL/dnu";
-  EXPECT_GT(std::abs(fd_E) * 2e5, 1e-3 * l0);  // the loss does depend on E here
+  const double step[5] = {2e5 * 1e-4, 1e-4, 1e-6, 1e-5, 1e-6};
+  const char* names[5] = {"dL/dE", "dL/dnu", "dL/dslack", "dL/dlag", "dL/dlength"};
+  for (int i = 0; i < 5; ++i) {
+    double pp[5], pm[5];
+    std::copy(p0, p0 + 5, pp);
+    std::copy(p0, p0 + 5, pm);
+    pp[i] += step[i];
+    pm[i] -= step[i];
+    const double fd = (loss(pp, nullptr) - loss(pm, nullptr)) / (2 * step[i]);
+    EXPECT_NEAR(g[i], fd, 1e-4 * std::abs(fd)) << names[i];
+    EXPECT_GT(std::abs(fd) * p0[i], 1e-3 * l0) << names[i] << ": the loss does depend on it here";
+  }
 }
 
 TEST_F(StarfishFitTest, CoordinatesMapIntoTheBoundsAndBack) {
@@ -212,12 +273,29 @@ TEST_F(StarfishFitTest, CoordinatesMapIntoTheBoundsAndBack) {
   EXPECT_NEAR(edge.youngs_modulus, 1e4, 1e-6);
   EXPECT_NEAR(edge.poissons_ratio, 0.45, 1e-12);
   EXPECT_THROW(StarfishCalibration::ToCoordinates(MaterialParameters{6e6, 0.4, 400}, u), InvalidInputError);
+  double v[3];
+  StarfishCalibration::ActuationToCoordinates(StarfishActuation{0.003, 0.05, 0.065}, v);
+  const StarfishActuation a = StarfishCalibration::ActuationFromCoordinates(v);
+  EXPECT_NEAR(a.slack, 0.003, 1e-15);
+  EXPECT_NEAR(a.lag, 0.05, 1e-15);
+  EXPECT_NEAR(a.length, 0.065, 1e-15);
+  const double ends[3] = {-60, 60, -60};
+  const StarfishActuation edge_a = StarfishCalibration::ActuationFromCoordinates(ends);
+  EXPECT_NEAR(edge_a.slack, 0, 1e-15);
+  EXPECT_NEAR(edge_a.lag, 0.5, 1e-12);
+  EXPECT_NEAR(edge_a.length, 0.03, 1e-12);
+  try {
+    StarfishCalibration::ActuationToCoordinates(StarfishActuation{0.02, 0.05, 0.065}, v);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInputError& e) {
+    EXPECT_EQ(std::string(e.what()), "tendon slack = 0.02 is outside the fit's interval (0, 0.015) m");
+  }
 }
 
 TEST_F(StarfishFitTest, ShortFitLowersTheLoss) {
   const StarfishFit fit =
-      starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400}, 3,
-                    nullptr);
+      starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
+                    StarfishCalibration::ActuationGuess(), 3, nullptr);
   EXPECT_TRUE(fit.usable) << fit.termination;
   EXPECT_GE(fit.iterations, 1);
   EXPECT_LT(fit.final_cost, 0.9 * fit.initial_cost);
