@@ -21,6 +21,21 @@ namespace diffpd::problems {
 namespace {
 
 namespace fs = std::filesystem;
+
+struct CapturedRun {
+  int code;
+  std::string out, err;
+};
+
+// problem.Run(args) with stdout and stderr captured.
+CapturedRun RunCaptured(const TrajectoryOptimizationProblem& problem, const CommandArgs& args) {
+  ::testing::internal::CaptureStdout();
+  ::testing::internal::CaptureStderr();
+  const int code = problem.Run(args);
+  std::string out = ::testing::internal::GetCapturedStdout();
+  std::string err = ::testing::internal::GetCapturedStderr();
+  return {code, std::move(out), std::move(err)};
+}
 using solvers::IpoptOptions;
 
 // A free soft cube (2 x 2 x 2 hexahedra, 0.1 m) thrown by its initial
@@ -145,11 +160,7 @@ TEST(IpoptTrajectoryOptimizationTest, RunWritesFramesHistoriesPlotAndOneJsonObje
   args.threads = 1;
   args.json = true;
   args.out_dir = dir.string();
-  ::testing::internal::CaptureStdout();
-  ::testing::internal::CaptureStderr();
-  const int code = problem.Run(args);
-  const std::string out = ::testing::internal::GetCapturedStdout();
-  const std::string err = ::testing::internal::GetCapturedStderr();
+  const auto [code, out, err] = RunCaptured(problem, args);
   EXPECT_EQ(code, 0) << err;
   // stdout is exactly one JSON object with the listed keys; the log and table on stderr.
   const nlohmann::json j = nlohmann::json::parse(out);
@@ -200,11 +211,7 @@ TEST(IpoptTrajectoryOptimizationTest, UnreachableConstraintIsReportedInfeasibleW
   args.method = Method::kNewtonCholesky;
   args.threads = 1;
   args.out_dir = dir.string();
-  ::testing::internal::CaptureStdout();
-  ::testing::internal::CaptureStderr();
-  const int code = problem.Run(args);
-  const std::string out = ::testing::internal::GetCapturedStdout();
-  const std::string err = ::testing::internal::GetCapturedStderr();
+  const auto [code, out, err] = RunCaptured(problem, args);
   EXPECT_EQ(code, 4) << out;
   EXPECT_NE(out.find("EXIT: Converged to a point of local infeasibility. Problem may be infeasible."),
             std::string::npos)
