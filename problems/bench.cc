@@ -45,6 +45,7 @@ SolverOptions MethodOptions(Method method, const BenchOptions& o, double time_st
   s.backward_rel_tolerance = o.backward_rel_tolerance > 0 ? o.backward_rel_tolerance : o.rel_tolerance;
   s.num_threads = o.threads;
   s.max_iterations = o.max_iterations;
+  s.lbfgs_weight_scale = o.lbfgs_weight_scale;
   return s;
 }
 
@@ -208,6 +209,7 @@ void BenchOptions::Validate() const {
   if (repeat < 1) fail("repeat", repeat, ">= 1");
   if (threads < 0) fail("threads", threads, ">= 0");
   if (max_iterations < 1) fail("max iterations", max_iterations, ">= 1");
+  if (!(lbfgs_weight_scale > 0 && lbfgs_weight_scale <= 1)) fail("lbfgs scale", lbfgs_weight_scale, "in (0, 1]");
   if (!std::isfinite(time_step)) fail("dt", time_step, "finite (> 0, or <= 0 for the default)");
 }
 

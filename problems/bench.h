@@ -96,6 +96,7 @@ struct BenchOptions {
   double time_step = -1;                 // <= 0: the problem's default (s)
   int threads = 0;                       // SolverOptions::num_threads
   int max_iterations = 1000;             // SolverOptions::max_iterations of each step
+  double lbfgs_weight_scale = SolverOptions().lbfgs_weight_scale;  // pd-lbfgs preconditioner
   int repeat = 1;                        // runs per method (median), >= 1
   int refine = 0;                        // MakeRefinedProblem doublings
   std::uint64_t seed = 20211;            // loss vectors

@@ -23,6 +23,7 @@ struct CommandArgs {
   int steps = -1;        // -1: the problem's default
   double dt = -1;        // -1: the problem's default (s)
   double rel_tolerance = -1;  // -1: the command's default
+  double lbfgs_weight_scale = SolverOptions().lbfgs_weight_scale;  // pd-lbfgs preconditioner
   std::string out_dir;   // "" : no files
   bool json = false;
   // Optimisation problems (Problem::Run): the reduced instance, whether to

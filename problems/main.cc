@@ -23,6 +23,9 @@ void AddCommonOptions(CLI::App* cmd, CommandArgs* args, std::string* method) {
   cmd->add_option("--steps", args->steps, "number of time steps (default: the problem's)");
   cmd->add_option("--dt", args->dt, "time step in seconds (default: the problem's)");
   cmd->add_option("--rtol", args->rel_tolerance, "relative tolerance on |grad g| per step");
+  cmd->add_option("--lbfgs-scale", args->lbfgs_weight_scale,
+                  "pd-lbfgs: elastic weight factor of its initial Hessian A, in (0, 1]")
+      ->capture_default_str();
   cmd->add_flag("--json", args->json, "print one JSON document on stdout");
 }
 

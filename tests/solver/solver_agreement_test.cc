@@ -45,6 +45,33 @@ TEST(SolverAgreementTest, AllImplicitMethodsReachTheSameStateAndGradient) {
   }
 }
 
+TEST(SolverAgreementTest, PdLbfgsPreconditionerScaleChangesNeitherTheStateNorTheGradient) {
+  // lbfgs_weight_scale only changes the initial Hessian A of PD-LBFGS (and
+  // its backward): every scale must converge to the same step and adjoint.
+  const Scene scene = testing::SmallBeamScene();
+  LossGradient dl(3);
+  Rollout r_ref;
+  RolloutGradient g_ref;
+  for (const double scale : {1.0, 0.6, 0.3}) {
+    SolverOptions o = Tight(Method::kPdLbfgs);
+    o.lbfgs_weight_scale = scale;
+    Simulator sim(scene, o);
+    const State s0 = Deformed(sim);
+    dl.dx[3] = VectorXd::LinSpaced(sim.num_dofs(), -1, 1);
+    const Rollout r = sim.Simulate(s0, std::vector<StepInput>(3));
+    const RolloutGradient g = sim.Backward(r, dl);
+    EXPECT_EQ(sim.num_pd_factorizations(), 1) << scale;
+    if (scale == 1.0) {
+      r_ref = r;
+      g_ref = g;
+      continue;
+    }
+    EXPECT_LT((r.states.back().x - r_ref.states.back().x).norm() / r_ref.states.back().x.norm(), 1e-10) << scale;
+    EXPECT_LT((g.x0 - g_ref.x0).norm() / g_ref.x0.norm(), 1e-8) << scale;
+    EXPECT_NEAR(g.youngs_modulus, g_ref.youngs_modulus, 1e-8 * std::abs(g_ref.youngs_modulus)) << scale;
+  }
+}
+
 TEST(SolverAgreementTest, NonProjectiveMaterialsAgreeBetweenNewtonAndPdLbfgs) {
   for (const ElasticEnergy e : {ElasticEnergy::kNeoHookean, ElasticEnergy::kCorotated, ElasticEnergy::kLinear}) {
     const Scene scene = testing::SmallBeamScene(false, {e});

@@ -40,6 +40,11 @@ TEST(SolverOptionsTest, InvalidFieldsAreRejectedWithTheFieldAndRange) {
   EXPECT_EQ(MessageOf([&] { o.Validate(); }),
             "solver options: num_threads = -2 is invalid: must be >= 0 (0: OpenMP default)");
   o = SolverOptions();
+  o.lbfgs_weight_scale = 0;
+  EXPECT_EQ(MessageOf([&] { o.Validate(); }), "solver options: lbfgs_weight_scale = 0 is invalid: must be in (0, 1]");
+  o.lbfgs_weight_scale = 1.5;
+  EXPECT_EQ(MessageOf([&] { o.Validate(); }), "solver options: lbfgs_weight_scale = 1.5 is invalid: must be in (0, 1]");
+  o = SolverOptions();
   o.abs_tolerance = 0;
   o.rel_tolerance = 0;
   EXPECT_EQ(MessageOf([&] { o.Validate(); }),

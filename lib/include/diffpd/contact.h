@@ -20,7 +20,10 @@
 // every free candidate deeper than `penetration_tolerance`; it repeats until
 // the set no longer changes, at most `max_passes` solves per step, else
 // SolverError(kActiveSetNotConverged). A node released and re-added within one
-// step is not released again in that step (no cycling). Each step's active
+// step is not released again in that step (no cycling). Because of that lock the
+// final set can depend on the path of the passes: screening or a different
+// PD-LBFGS preconditioner may pin one more or one fewer borderline node (both
+// results pass the same residual and penetration tests). Each step's active
 // set and contact forces are recorded in its StepReport. With
 // screening_rel_tolerance = r > rel_tolerance, passes first solve only to
 // |grad g| <= abs_tolerance + r |grad g(x0)| (screening) until the set stops

@@ -51,7 +51,9 @@ PdSystem& SimulatorImpl::pd_system() {
     pd_ = std::make_unique<PdSystem>(fem, fixed);
     if (!aux.empty()) pd_->SetAuxiliaryMatrix(aux.PdMatrix());
   }
-  pd_->Update(h(), rho(), elastic.PdWeight(mu(), lambda()));
+  // PD-LBFGS preconditions with a softer A (SolverOptions::lbfgs_weight_scale).
+  const double scale = options.method == Method::kPdLbfgs ? options.lbfgs_weight_scale : 1.0;
+  pd_->Update(h(), rho(), scale * elastic.PdWeight(mu(), lambda()));
   return *pd_;
 }
 

@@ -52,6 +52,8 @@ void SolverOptions::Validate() const {
   if (!(pcg_rel_tolerance > 0 && pcg_rel_tolerance < 1)) Reject("pcg_rel_tolerance", pcg_rel_tolerance, "in (0, 1)");
   if (pcg_max_iterations < 1) Reject("pcg_max_iterations", pcg_max_iterations, ">= 1");
   if (lbfgs_history < 1) Reject("lbfgs_history", lbfgs_history, ">= 1");
+  if (!(lbfgs_weight_scale > 0 && lbfgs_weight_scale <= 1))
+    Reject("lbfgs_weight_scale", lbfgs_weight_scale, "in (0, 1]");
   if (!(backward_rel_tolerance > 0 && backward_rel_tolerance < 1))
     Reject("backward_rel_tolerance", backward_rel_tolerance, "in (0, 1)");
   if (backward_max_iterations < 1) Reject("backward_max_iterations", backward_max_iterations, ">= 1");
