@@ -62,7 +62,9 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
   const VectorXd xhat = state.x + h * state.v;
   const std::vector<Candidate> cand = Candidates(sim.scene);
   const int nc = static_cast<int>(cand.size());
-  std::vector<char> active(nc, 0), released(nc, 0), locked(nc, 0);
+  // released/locked: anti-cycling of refining passes; screen_released: nodes
+  // released on a loose (screening) solve, which never lock anything.
+  std::vector<char> active(nc, 0), released(nc, 0), locked(nc, 0), screen_released(nc, 0);
   std::vector<ContactPin> pins(nc);
   std::vector<char> have_pin(nc, 0);
   auto pin_of = [&](int c) -> const ContactPin& {
@@ -112,6 +114,7 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
     }
     // A screening solve that already meets the step's tolerance is final.
     const bool final_pass = !screening || pass_report.final_residual <= first_target;
+    const bool screening_pass = !final_pass;
     if (pass == 1) report->initial_residual = pass_report.initial_residual;
     report->iterations += pass_report.iterations;
     report->line_search_steps += pass_report.line_search_steps;
@@ -124,22 +127,27 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
       StepObjective objective(sim, xhat, force);
       objective.Evaluate(x, &grad);
     }
-    bool changed = false;
+    bool changed = false, cycled = false;
     for (int c = 0; c < nc; ++c) {
       const int i = cand[c].node;
       if (active[c]) {
         const Vec3 normal = cand[c].surface->GapGradient(pin_of(c).position);
         if (!locked[c] && normal.dot(grad.segment<3>(3 * i)) < 0) {
           active[c] = 0;
-          released[c] = 1;
+          (screening_pass ? screen_released : released)[c] = 1;
           changed = true;
         }
       } else if (cand[c].surface->Gap(x.segment<3>(3 * i)) < -opt.penetration_tolerance) {
         active[c] = 1;
-        if (released[c]) locked[c] = 1;
+        // Only converged passes lock a node (the lock makes the final set
+        // depend on the path; loose solves must not choose it). A node back
+        // in on a loose solve ends screening instead.
+        if (screening_pass) cycled = cycled || screen_released[c];
+        else if (released[c]) locked[c] = 1;
         changed = true;
       }
     }
+    if (cycled) screening = false;
     if (sim.options.verbosity >= 2)
       std::fprintf(stderr, "  contact pass %d%s: %zu pinned nodes%s\n", pass, final_pass ? "" : " (screening)",
                    nodes.size(), changed ? ", set changed" : "");
