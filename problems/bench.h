@@ -174,8 +174,9 @@ nlohmann::json ScalingToJson(const ScalingResult& result);
 
 // --threads-compare: each method with num_threads 1 and 2. The whole step is
 // the forward time per step; the local step is approximated by
-// Simulator::ElasticEnergy(x) at the final state (one SVD-based projection of
-// every element, the PD local step's work), timed over `energy_evaluations`.
+// Simulator::ElasticEnergy(x) alternating between the last two states (one
+// SVD-based projection per quadrature point, the PD local step's work, with
+// the SVDs warm-started a step away), timed over `energy_evaluations`.
 struct ThreadsRow {
   std::string method;
   std::string failure;

@@ -36,8 +36,9 @@ log-log slope against DoFs (1 = linear). peak_rss_mib is the process's
 high-water mark.
 --threads-compare: each method with 1 and 2 threads: forward seconds per step
 (whole step), backward seconds, and the local step measured as one
-Simulator::ElasticEnergy(x) evaluation (per-element SVD/projection work, the
-PD local step's cost), with speed-ups 1-thread / 2-thread.)";
+Simulator::ElasticEnergy(x) evaluation, alternating between the last two
+states (per-element SVD/projection work, the PD local step's cost), with
+speed-ups 1-thread / 2-thread.)";
 
 struct BenchArgs {
   std::string problem;

@@ -119,6 +119,42 @@ TEST(ActiveSetErasureTest, LargeSetsCorrectedByASecondSolveAgreeWithRefactorisat
   EXPECT_EQ(wood.num_factorizations(), 1);
 }
 
+TEST(ActiveSetErasureTest, CachedColumnsStayBoundedAsContactMovesAcrossTheSurface) {
+  // A contact patch of 8 nodes sweeping over 169 bottom nodes (a rolling
+  // body): the cache keeps at most 2 |S| + kCacheSlack columns, solves stay
+  // exact, and a node that returns after its column was dropped is re-solved.
+  const Mesh mesh = testing::BoxHexMesh(12, 12, 1, 0.12, 0.12, 0.01);
+  internal::FemModel fem(mesh);
+  const int n = mesh.num_dofs();
+  const std::vector<char> fixed(n, 0);
+  internal::PdSystem pd(fem, fixed);
+  pd.Update(0.01, 1e3, 1e5);
+  std::vector<int> bottom;
+  for (int i = 0; i < mesh.num_vertices(); ++i)
+    if (mesh.vertices(2, i) < 1e-9) bottom.push_back(i);
+  constexpr int kPatch = 8;
+  const int bound = 2 * kPatch + internal::ActiveSetErasure::kCacheSlack;
+  std::mt19937_64 rng(3);
+  for (int start = 0; start + kPatch <= static_cast<int>(bottom.size()); start += kPatch) {
+    const std::vector<int> active(bottom.begin() + start, bottom.begin() + start + kPatch);
+    pd.SetActiveNodes(active, ContactLinearSolve::kWoodbury);
+    EXPECT_LE(pd.num_active_set_cached_columns(), bound) << "patch at " << start;
+    if (start % (4 * kPatch) == 0) {
+      const VectorXd r = Random(n, &rng);
+      const VectorXd ref = DenseReference(pd, fixed, active, r);
+      EXPECT_LT((pd.Solve(r) - ref).norm(), 1e-10 * ref.norm()) << "patch at " << start;
+    }
+  }
+  EXPECT_EQ(pd.num_active_set_column_solves(), 168);  // 21 patches, each new
+  const std::vector<int> first(bottom.begin(), bottom.begin() + kPatch);
+  pd.SetActiveNodes(first, ContactLinearSolve::kWoodbury);  // dropped long ago
+  EXPECT_EQ(pd.num_active_set_column_solves(), 168 + kPatch);
+  const VectorXd r = Random(n, &rng);
+  const VectorXd ref = DenseReference(pd, fixed, first, r);
+  EXPECT_LT((pd.Solve(r) - ref).norm(), 1e-10 * ref.norm());
+  EXPECT_EQ(pd.num_factorizations(), 1);
+}
+
 TEST(ActiveSetErasureTest, WoodburySolvesOnceForEachNewContactNodeAndFollowsRefactorisation) {
   Scene scene = testing::SmallBeamScene();
   internal::FemModel fem(scene.mesh);

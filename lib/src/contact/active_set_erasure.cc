@@ -1,5 +1,6 @@
 #include "contact/active_set_erasure.h"
 
+#include <algorithm>
 #include <sstream>
 
 #include "diffpd/error.h"
@@ -60,6 +61,15 @@ void ActiveSetErasure::Set(const std::vector<int>& nodes, ContactLinearSolve mod
     const MatrixXd cols = base.Solve(unit);
     num_column_solves_ += static_cast<int>(missing.size());
     for (size_t c = 0; c < missing.size(); ++c) columns_[missing[c]] = cols.col(static_cast<Eigen::Index>(c));
+  }
+  // Bound the cache: columns of nodes that left the set stay (a node that
+  // comes back costs nothing) until they outnumber the set plus
+  // kCacheSlack; then all of them go (re-solved if they return).
+  if (columns_.size() > 2 * nodes_.size() + kCacheSlack) {
+    for (auto it = columns_.begin(); it != columns_.end();) {
+      if (std::binary_search(nodes_.begin(), nodes_.end(), it->first)) ++it;
+      else it = columns_.erase(it);
+    }
   }
   MatrixXd cap(s, s);
   for (int c = 0; c < s; ++c) {

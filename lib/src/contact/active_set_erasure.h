@@ -11,7 +11,8 @@
 //
 // P the n x s selection of S. Cost: s solves with A's factor for the columns
 // of W (cached per node until the factor changes, so a node that stays in
-// contact over many steps costs one solve in all), a dense s x s Cholesky per
+// contact over many steps costs one solve in all; the cache is bounded, see
+// kCacheSlack), a dense s x s Cholesky per
 // change of S, and per solve one solve with A plus O(n s). For s above
 // kDenseCorrectionMax the O(n s) product W C^-1 (A^-1 R)_S (memory-bound, it
 // reads all of W) costs about as much as a second solve with A (measured on a
@@ -40,6 +41,9 @@ class ActiveSetErasure {
   // Largest active set whose Woodbury correction is the dense product with W
   // (above: a second solve with A; see the comment at the top).
   static constexpr int kDenseCorrectionMax = 128;
+  // Cached columns beyond the current set's own: at most |S| + kCacheSlack
+  // (memory O((2 |S| + kCacheSlack) n) however many nodes ever touched).
+  static constexpr int kCacheSlack = 64;
 
   ActiveSetErasure();
   ~ActiveSetErasure();
@@ -63,6 +67,7 @@ class ActiveSetErasure {
   void ZeroErased(MatrixXd* x) const;
 
   int num_column_solves() const { return num_column_solves_; }
+  int num_cached_columns() const { return static_cast<int>(columns_.size()); }
   int num_factorizations() const { return num_factorizations_; }
 
  private:

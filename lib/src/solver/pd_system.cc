@@ -92,6 +92,12 @@ int PdSystem::num_active_set_column_solves() const {
   return total;
 }
 
+int PdSystem::num_active_set_cached_columns() const {
+  int total = 0;
+  for (const ActiveSetErasure& e : erasures_) total += e.num_cached_columns();
+  return total;
+}
+
 int PdSystem::num_active_set_factorizations() const {
   int total = 0;
   for (const ActiveSetErasure& e : erasures_) total += e.num_factorizations();

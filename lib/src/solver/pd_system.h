@@ -48,6 +48,7 @@ class PdSystem {
   const std::vector<int>& active_nodes() const { return active_nodes_; }
   // Column solves and factorisations spent on active sets so far.
   int num_active_set_column_solves() const;
+  int num_active_set_cached_columns() const;  // Woodbury columns held, all groups
   int num_active_set_factorizations() const;
 
   int num_factorizations() const { return num_factorizations_; }
