@@ -82,6 +82,14 @@ TEST(BenchOptionsTest, ValidateNamesTheFieldValueAndRange) {
   o = BenchOptions();
   o.methods = {Method::kSemiImplicit};
   EXPECT_THROW(o.Validate(), InvalidInputError);
+  o = BenchOptions();
+  o.lbfgs_weight_scale = 0;
+  try {
+    o.Validate();
+    ADD_FAILURE() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_STREQ(e.what(), "lbfgs scale = 0 is invalid: must be in (0, 1]");
+  }
 }
 
 TEST(RelativeErrorTest, IsTheRelativeTwoNorm) {

@@ -60,7 +60,7 @@ struct SolverOptions {
   // rotations, so a smaller factor preconditions bending far better: measured
   // on the cantilever (README, "PD-LBFGS initial Hessian"), 0.3 cuts
   // iterations per step by 30-55% over nu = 0.3..0.49; much smaller factors
-  // under-weight volume change and slow it down again (0.1: as slow as 1;
+  // under-weight volume change and slow it down again (0.1: nearly as slow as 1;
   // 0.05: no convergence in 1000 iterations at rtol 1e-12). The plain `pd`
   // method always uses 1 (its fixed point needs the true A). With a factor
   // < 1 the fixed-point backward (PdBackwardMethod::kFixedPoint) may not
