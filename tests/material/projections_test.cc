@@ -167,6 +167,27 @@ TEST(VolumeProjectionTest, IsTheGlobalMinimiserOnHardSpectra) {
   }
 }
 
+// The common case (all sigma > 0, prod < 2) takes a Halley iteration on the
+// multiplier: it must give the global minimiser to rounding from
+// infinitesimal strains up to the edge of its domain (prod just below 2,
+// where the general path takes over), including strongly anisotropic spectra.
+TEST(VolumeProjectionTest, PositiveSpectraBelowProductTwoAreProjectedToRounding) {
+  const std::vector<Vec3> spectra = {
+      {1 + 1e-12, 1, 1 - 1e-12}, {1 + 1e-6, 1 - 1e-7, 1 - 2e-6}, {1.02, 0.99, 0.97},
+      {1.2599, 1.2599, 1.2599},  {1.9, 1.01, 1.04},              {1.5, 1.15, 1.15},
+      {30, 0.2, 0.1},            {1e4, 1e-2, 1e-3},              {0.3, 0.2, 0.01}};
+  for (const Vec3& sigma : spectra) {
+    ASSERT_LT(sigma.prod(), 2.0);
+    const VolumeProjection p = ProjectSingularValuesToUnitDeterminant(sigma);
+    EXPECT_NEAR(p.d.prod(), 1.0, 4e-15) << sigma.transpose();
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(p.d(i) * (p.d(i) - sigma(i)), p.multiplier, 1e-14 * (1 + sigma.squaredNorm()))
+          << sigma.transpose();
+    }
+    EXPECT_LE((p.d - sigma).norm(), BruteForceDistance(sigma) * (1 + 1e-12)) << sigma.transpose();
+  }
+}
+
 TEST(VolumeProjectionTest, InSetIdempotentInvariantAndClosest) {
   std::mt19937 rng(22);
   std::normal_distribution<double> normal;

@@ -59,6 +59,9 @@ IsotropicDifferentialCoefficients UnitDeterminantProjectionCoefficients(
 //    tie. The Newton iteration runs on t = d_k (smallest target entry), which
 //    fixes the multiplier as mu = t (t - s_k); `multiplier` is mu with
 //    d_i - sigma_i = mu / d_i (= mu prod(d) / d_i). Relative accuracy ~1e-15.
+//    The common case sigma_2 > 0, prod(sigma) < 2 (a unique candidate) first
+//    tries Halley's iteration on mu itself from the first-order guess (two
+//    evaluations for typical strains, 40% of the general path's cost).
 //  - UnitDeterminantProjectionDifferential: exact (implicit differentiation
 //    of the KKT system and the SVD-derivative formulas; see
 //    isotropic_differential.h), same denominator floor.
