@@ -151,5 +151,56 @@ TEST(Svd3Test, TenThousandRandomMatrices) {
   }
 }
 
+// The batched SVD runs every lane through the same rotations as the scalar
+// one (converged lanes are rotated by exactly the identity), so each result
+// must match ComputeSvd3(F, v_guess) to rounding, for warm and cold guesses,
+// partial batches, and lanes that take the scalar path (zero, non-finite,
+// extreme magnitude) mixed with regular ones.
+TEST(Svd3Test, BatchMatchesScalarLaneByLane) {
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int trial = 0; trial < 400; ++trial) {
+    const int count = 1 + trial % kSvdBatch;
+    Mat3 F[kSvdBatch], guess[kSvdBatch];
+    for (int l = 0; l < count; ++l) {
+      for (int i = 0; i < 9; ++i) F[l](i) = uniform(rng);
+      if ((trial + l) % 3 == 0) F[l] = Mat3::Identity() + 0.01 * F[l];
+      // Warm guess: the V of a nearby matrix; else a random rotation or I.
+      Mat3 nearby = F[l];
+      nearby(0, 1) += 1e-3;
+      guess[l] = (trial + l) % 4 == 0 ? Mat3(RandomRotation(rng))
+                 : (trial + l) % 4 == 1 ? Mat3::Identity() : ComputeSvd3(nearby).V;
+    }
+    if (trial % 7 == 3) F[count / 2].setZero();
+    if (trial % 7 == 4) F[count / 2](1, 1) = nan;
+    if (trial % 7 == 5) F[count / 2] *= 1e150;
+    if (trial % 7 == 6) F[count / 2] = Mat3(Vec3(1.0, 1.0, -1.0).asDiagonal());  // reflection
+    Svd3 batch[kSvdBatch];
+    ComputeSvd3Batch(count, F, guess, batch);
+    for (int l = 0; l < count; ++l) {
+      const Svd3 scalar = ComputeSvd3(F[l], guess[l]);
+      if (!F[l].allFinite()) {
+        EXPECT_TRUE(batch[l].sigma.array().isNaN().all());
+        continue;
+      }
+      // The vector clones may contract a * b + c into one FMA where the
+      // scalar code rounds twice: agreement to a few ulps, not bit for bit.
+      const double scale = std::max(1.0, scalar.sigma(0));
+      EXPECT_LE((batch[l].sigma - scalar.sigma).norm(), kUlps * kEps * scale) << "trial " << trial << " lane " << l;
+      // U and V are unique (up to the sign convention) only for distinct
+      // singular values.
+      const Vec3& sg = scalar.sigma;
+      if (std::min(sg(0) - sg(1), sg(1) - std::abs(sg(2))) > 1e-6 * scale) {
+        EXPECT_LE((batch[l].U - scalar.U).norm(), 1e-11) << "trial " << trial << " lane " << l;
+        EXPECT_LE((batch[l].V - scalar.V).norm(), 1e-11) << "trial " << trial << " lane " << l;
+      }
+      EXPECT_LE((batch[l].U * batch[l].sigma.asDiagonal() * batch[l].V.transpose() - F[l]).norm(),
+                kUlps * kEps * F[l].norm());
+      EXPECT_LE((batch[l].V.transpose() * batch[l].V - Mat3::Identity()).norm(), kUlps * kEps);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace diffpd::internal

@@ -37,15 +37,24 @@ void ParallelForElements(int m, int threads, Body&& body) {
 
 }  // namespace
 
-double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, double mu,
-                       double lambda, Mat3* stress, Mat9* dstress, Mat3* v_cache) {
+bool AnyNeedsSvd(const std::vector<ElasticEnergy>& energies) {
   bool need_svd = false;
   for (const ElasticEnergy energy : energies) need_svd = need_svd || NeedsSvd(energy);
+  return need_svd;
+}
+
+double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, double mu,
+                       double lambda, Mat3* stress, Mat9* dstress, Mat3* v_cache) {
   Svd3 svd;
-  if (need_svd) {
+  if (AnyNeedsSvd(energies)) {
     svd = v_cache ? ComputeSvd3(F, *v_cache) : ComputeSvd3(F);
     if (v_cache) *v_cache = svd.V;
   }
+  return EvaluateDensity(energies, F, svd, mu, lambda, stress, dstress);
+}
+
+double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, const Svd3& svd,
+                       double mu, double lambda, Mat3* stress, Mat9* dstress) {
   double psi = 0;
   if (stress) stress->setZero();
   if (dstress) dstress->setZero();
@@ -61,6 +70,7 @@ double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F
 ElasticForces::ElasticForces(const FemModel& fem, std::vector<ElasticEnergy> energies)
     : fem_(fem), energies_(std::move(energies)) {
   for (const ElasticEnergy e : energies_) all_projective_ = all_projective_ && IsProjective(e);
+  needs_svd_ = AnyNeedsSvd(energies_);
   element_buffer_.assign(static_cast<size_t>(fem_.num_elements()) * 3 * fem_.nodes_per_element(), 0.0);
   element_energy_.assign(fem_.num_elements(), 0.0);
   v_cache_.assign(fem_.num_samples(), Mat3::Identity());
@@ -96,17 +106,27 @@ double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, double mu, double
   if (!x.allFinite()) throw SolverError(SolverStatus::kNonFinite, "positions are not finite");
   const Mesh& mesh = fem_.mesh();
   const int q_per = fem_.samples_per_element();
+  DIFFPD_CHECK(q_per <= kSvdBatch, "more samples per element than an SVD batch");
   ParallelForElements(fem_.num_elements(), threads, [&](int e) {
     const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(mesh, x, e);
     Eigen::Matrix<double, 3, K> fe = Eigen::Matrix<double, 3, K>::Zero();
     double energy = 0;
+    // All samples' SVDs together (warm started from the last ones), then
+    // the densities sample by sample.
+    Mat3 F[kSvdBatch];
+    Svd3 svd[kSvdBatch];
+    const int s0 = e * q_per;
+    for (int q = 0; q < q_per; ++q) F[q] = DeformationGradient<K>(xe, fem_.grad(s0 + q));
+    if (needs_svd_) {
+      ComputeSvd3Batch(q_per, F, &v_cache_[s0], svd);
+      for (int q = 0; q < q_per; ++q) v_cache_[s0 + q] = svd[q].V;
+    }
     for (int q = 0; q < q_per; ++q) {
-      const int s = e * q_per + q;
+      const int s = s0 + q;
       const double* g = fem_.grad(s);
-      const Mat3 F = DeformationGradient<K>(xe, g);
       Mat3 P;
       const double vol = fem_.sample_volume(s);
-      energy += vol * EvaluateDensity(energies_, F, mu, lambda, grad ? &P : nullptr, nullptr, &v_cache_[s]);
+      energy += vol * EvaluateDensity(energies_, F[q], svd[q], mu, lambda, grad ? &P : nullptr, nullptr);
       if (grad) fe.noalias() += (vol * P) * Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
     }
     element_energy_[e] = energy;

@@ -13,6 +13,7 @@
 #include "diffpd/material.h"
 #include "diffpd/types.h"
 #include "fem/fem_model.h"
+#include "material/svd3.h"
 
 namespace diffpd::internal {
 
@@ -63,6 +64,7 @@ class ElasticForces {
   const FemModel& fem_;
   std::vector<ElasticEnergy> energies_;
   bool all_projective_ = true;
+  bool needs_svd_ = false;
   std::vector<double> element_buffer_;  // 3 * K per element
   std::vector<double> element_energy_;  // per element
   // Per-sample V of the last SVD: warm start of the next one (see svd3.h).
@@ -75,5 +77,10 @@ class ElasticForces {
 // for inverted neo-Hookean elements.
 double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, double mu,
                        double lambda, Mat3* stress, Mat9* dstress, Mat3* v_cache = nullptr);
+// The same with the signed SVD of F given (ignored when no energy needs it).
+double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, const Svd3& svd,
+                       double mu, double lambda, Mat3* stress, Mat9* dstress);
+// True when one of `energies` needs the SVD of F.
+bool AnyNeedsSvd(const std::vector<ElasticEnergy>& energies);
 
 }  // namespace diffpd::internal

@@ -34,6 +34,8 @@
 
 #include <Eigen/LU>
 
+#include "diffpd/error.h"
+
 namespace diffpd::internal {
 namespace {
 
@@ -96,6 +98,116 @@ inline void SwapColumns(Mat3& B, Mat3& V, Vec3& norms, int i, int j) {
   std::swap(norms(i), norms(j));
 }
 
+// Steps 2 and 3 on B = F V with orthogonal columns (V accumulated in svd->V);
+// det_sign_reference is det(F v_guess) (its sign is det F's), exponent the
+// power of two F was scaled by.
+void FinishSvd(Mat3 B, double det_sign_reference, int exponent, Svd3* svd) {
+  Mat3& V = svd->V;
+  Vec3 norms = B.colwise().squaredNorm().transpose();
+  bool odd = false;
+  if (norms(0) < norms(1)) { SwapColumns(B, V, norms, 0, 1); odd = !odd; }
+  if (norms(0) < norms(2)) { SwapColumns(B, V, norms, 0, 2); odd = !odd; }
+  if (norms(1) < norms(2)) { SwapColumns(B, V, norms, 1, 2); odd = !odd; }
+  if (odd) {
+    B.col(2) = -B.col(2);
+    V.col(2) = -V.col(2);
+  }
+
+  Mat3& U = svd->U;
+  U.setIdentity();
+  GivensZero(B, U, 0, 1, 0);
+  GivensZero(B, U, 0, 2, 0);
+  GivensZero(B, U, 1, 2, 1);
+
+  Vec3& sigma = svd->sigma;
+  sigma << B(0, 0), B(1, 1), B(2, 2);
+  // Rounding can leave (nearly) repeated values out of order by an ulp.
+  sigma(1) = std::min(sigma(1), sigma(0));
+  if (std::abs(sigma(2)) > sigma(1)) sigma(2) = std::copysign(sigma(1), sigma(2));
+  // When det F is at round-off level its computed sign and R22's may
+  // disagree; R22 is then itself at round-off level and flipping it costs
+  // O(eps |F|) in the reconstruction while keeping sign(sigma2) = sign(det F).
+  const bool negative = sigma(2) < 0.0;
+  if (negative != (det_sign_reference < 0.0) && std::abs(sigma(2)) <= 8.0 * kEps * sigma(0)) {
+    sigma(2) = -sigma(2);
+  }
+  if (exponent != 0) sigma *= std::ldexp(1.0, exponent);
+}
+
+// True when F can take the unscaled path: finite, nonzero, entries within
+// [1e-100, 1e100] in magnitude (no rescaling needed).
+inline bool NeedsNoRescaling(const Mat3& F) {
+  if (!F.allFinite()) return false;
+  const double max_abs = F.cwiseAbs().maxCoeff();
+  return max_abs != 0.0 && max_abs >= 1e-100 && max_abs <= 1e100;
+}
+
+// Structure-of-arrays Jacobi sweeps over kSvdBatch matrices: entry (r, c) of
+// lane l's B at b[r + 3 c][l]. The same rotations as OrthogonalizeColumns,
+// lane by lane; a lane whose columns are already orthogonal gets c = 1,
+// s = 0, which leaves it unchanged exactly, so every lane ends as its own
+// scalar sweep would.
+struct alignas(64) BatchColumns {
+  double b[9][kSvdBatch];
+  double v[9][kSvdBatch];
+};
+
+inline bool OrthogonalizeBatchColumns(BatchColumns& m, int i, int j) {
+  int any = 0;
+  const double eps2 = kEps * kEps;
+#pragma omp simd reduction(| : any)
+  for (int l = 0; l < kSvdBatch; ++l) {
+    const double bi0 = m.b[3 * i][l], bi1 = m.b[3 * i + 1][l], bi2 = m.b[3 * i + 2][l];
+    const double bj0 = m.b[3 * j][l], bj1 = m.b[3 * j + 1][l], bj2 = m.b[3 * j + 2][l];
+    const double alpha = bi0 * bi0 + bi1 * bi1 + bi2 * bi2;
+    const double beta = bj0 * bj0 + bj1 * bj1 + bj2 * bj2;
+    const double gamma = bi0 * bj0 + bi1 * bj1 + bi2 * bj2;
+    const bool rotate = gamma * gamma > eps2 * alpha * beta;
+    const double diff = beta - alpha;
+    const double root = std::sqrt(diff * diff + 4.0 * gamma * gamma);
+    const double q = std::abs(diff) + root;
+    // Computed in every lane (no branch; inf or NaN where nothing rotates,
+    // discarded by the selects).
+    const double w = 1.0 / std::sqrt(2.0 * q * root);
+    const double signed_two = diff >= 0.0 ? 2.0 : -2.0;
+    const double c = rotate ? q * w : 1.0;
+    const double s = rotate ? signed_two * gamma * w : 0.0;
+    any |= rotate ? 1 : 0;
+    m.b[3 * i][l] = c * bi0 - s * bj0;
+    m.b[3 * i + 1][l] = c * bi1 - s * bj1;
+    m.b[3 * i + 2][l] = c * bi2 - s * bj2;
+    m.b[3 * j][l] = s * bi0 + c * bj0;
+    m.b[3 * j + 1][l] = s * bi1 + c * bj1;
+    m.b[3 * j + 2][l] = s * bi2 + c * bj2;
+    const double vi0 = m.v[3 * i][l], vi1 = m.v[3 * i + 1][l], vi2 = m.v[3 * i + 2][l];
+    const double vj0 = m.v[3 * j][l], vj1 = m.v[3 * j + 1][l], vj2 = m.v[3 * j + 2][l];
+    m.v[3 * i][l] = c * vi0 - s * vj0;
+    m.v[3 * i + 1][l] = c * vi1 - s * vj1;
+    m.v[3 * i + 2][l] = c * vi2 - s * vj2;
+    m.v[3 * j][l] = s * vi0 + c * vj0;
+    m.v[3 * j + 1][l] = s * vi1 + c * vj1;
+    m.v[3 * j + 2][l] = s * vi2 + c * vj2;
+  }
+  return any != 0;
+}
+
+// The batch's sweeps, compiled for the widest vector unit the machine has
+// (AVX-512: one instruction per 8 lanes; AVX2; else the build's baseline),
+// chosen once at load time. The rest of the library keeps the baseline
+// instruction set, so binaries stay portable and Eigen's alignment (an ABI
+// matter for code linking the library) does not depend on the machine.
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#endif
+void BatchSweeps(BatchColumns& m) {
+  for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
+    bool rotated = OrthogonalizeBatchColumns(m, 0, 1);
+    rotated = OrthogonalizeBatchColumns(m, 0, 2) || rotated;
+    rotated = OrthogonalizeBatchColumns(m, 1, 2) || rotated;
+    if (!rotated) break;
+  }
+}
+
 }  // namespace
 
 Svd3 ComputeSvd3(const Mat3& F) { return ComputeSvd3(F, Mat3::Identity()); }
@@ -129,36 +241,43 @@ Svd3 ComputeSvd3(const Mat3& F, const Mat3& v_guess) {
     rotated = OrthogonalizeColumns(B, V, 1, 2) || rotated;
     if (!rotated) break;
   }
-
-  Vec3 norms = B.colwise().squaredNorm().transpose();
-  bool odd = false;
-  if (norms(0) < norms(1)) { SwapColumns(B, V, norms, 0, 1); odd = !odd; }
-  if (norms(0) < norms(2)) { SwapColumns(B, V, norms, 0, 2); odd = !odd; }
-  if (norms(1) < norms(2)) { SwapColumns(B, V, norms, 1, 2); odd = !odd; }
-  if (odd) {
-    B.col(2) = -B.col(2);
-    V.col(2) = -V.col(2);
-  }
-
-  Mat3& U = svd.U;
-  GivensZero(B, U, 0, 1, 0);
-  GivensZero(B, U, 0, 2, 0);
-  GivensZero(B, U, 1, 2, 1);
-
-  Vec3& sigma = svd.sigma;
-  sigma << B(0, 0), B(1, 1), B(2, 2);
-  // Rounding can leave (nearly) repeated values out of order by an ulp.
-  sigma(1) = std::min(sigma(1), sigma(0));
-  if (std::abs(sigma(2)) > sigma(1)) sigma(2) = std::copysign(sigma(1), sigma(2));
-  // When det F is at round-off level its computed sign and R22's may
-  // disagree; R22 is then itself at round-off level and flipping it costs
-  // O(eps |F|) in the reconstruction while keeping sign(sigma2) = sign(det F).
-  const bool negative = sigma(2) < 0.0;
-  if (negative != (det_sign_reference < 0.0) && std::abs(sigma(2)) <= 8.0 * kEps * sigma(0)) {
-    sigma(2) = -sigma(2);
-  }
-  if (exponent != 0) sigma *= std::ldexp(1.0, exponent);
+  FinishSvd(B, det_sign_reference, exponent, &svd);
   return svd;
+}
+
+void ComputeSvd3Batch(int count, const Mat3* F, const Mat3* v_guess, Svd3* out) {
+  DIFFPD_CHECK(count >= 0 && count <= kSvdBatch, "ComputeSvd3Batch: count = " << count);
+  if (count <= 2) {  // too few lanes to pay for the batch
+    for (int l = 0; l < count; ++l) out[l] = ComputeSvd3(F[l], v_guess[l]);
+    return;
+  }
+  BatchColumns m;
+  double det_sign_reference[kSvdBatch];
+  bool batched[kSvdBatch];
+  for (int l = 0; l < kSvdBatch; ++l) {
+    batched[l] = l < count && NeedsNoRescaling(F[l]);
+    // Unused and special lanes hold the identity: orthogonal, never rotated.
+    const Mat3 B = batched[l] ? Mat3(F[l] * v_guess[l]) : Mat3::Identity();
+    const Mat3 V = batched[l] ? v_guess[l] : Mat3::Identity();
+    det_sign_reference[l] = batched[l] ? B.determinant() : 1.0;
+    for (int k = 0; k < 9; ++k) {
+      m.b[k][l] = B(k);
+      m.v[k][l] = V(k);
+    }
+  }
+  BatchSweeps(m);
+  for (int l = 0; l < count; ++l) {
+    if (!batched[l]) {
+      out[l] = ComputeSvd3(F[l], v_guess[l]);
+      continue;
+    }
+    Mat3 B;
+    for (int k = 0; k < 9; ++k) {
+      B(k) = m.b[k][l];
+      out[l].V(k) = m.v[k][l];
+    }
+    FinishSvd(B, det_sign_reference[l], 0, &out[l]);
+  }
 }
 
 }  // namespace diffpd::internal
