@@ -63,4 +63,31 @@ inline Scene SmallBeamScene(bool tets = false, std::vector<ElasticEnergy> energi
   return scene;
 }
 
+// Elements whose centroid has lo <= x < hi.
+inline std::vector<int> ElementsWithCentroidX(const Mesh& mesh, double lo, double hi) {
+  std::vector<int> out;
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    double cx = 0;
+    for (int a = 0; a < mesh.elements.rows(); ++a) cx += mesh.vertices(0, mesh.elements(a, e));
+    cx /= mesh.elements.rows();
+    if (cx >= lo && cx < hi) out.push_back(e);
+  }
+  return out;
+}
+
+// SmallBeamScene with two material regions: region 0 the middle third of the
+// beam (softer, E / 5, other nu and density), region 1 the tip third (stiffer,
+// other nu and density); the clamped third keeps the base material.
+inline Scene TwoRegionBeamScene(bool tets = false) {
+  Scene scene = SmallBeamScene(tets);
+  const double length = scene.mesh.vertices.row(0).maxCoeff();
+  MaterialRegion middle, tip;
+  middle.elements = ElementsWithCentroidX(scene.mesh, length / 3, 2 * length / 3);
+  middle.material = MaterialParameters{scene.material.youngs_modulus / 5, 0.3, 1.4e3};
+  tip.elements = ElementsWithCentroidX(scene.mesh, 2 * length / 3, 2 * length);
+  tip.material = MaterialParameters{scene.material.youngs_modulus * 1.5, 0.35, 0.8e3};
+  scene.material_regions = {middle, tip};
+  return scene;
+}
+
 }  // namespace diffpd::testing
