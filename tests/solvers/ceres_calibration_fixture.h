@@ -35,13 +35,13 @@ inline State SwingStart(const Simulator& sim) {
   return s;
 }
 
-// Setup with motion synthesised from TrueMaterial() over `steps` steps of
-// 0.01 s, frames every 0.015 s, noise-free unless `noise` (m) > 0, and the
-// scene's material set to `start`.
-inline solvers::CalibrationSetup SyntheticSetup(Method method, bool tets, const MaterialParameters& start,
-                                                int steps = 8, double noise = 0) {
-  Scene scene = SmallBeamScene(tets);
-  scene.material = TrueMaterial();
+// Setup with motion synthesised from the scene `truth` (its materials, base
+// and regions, are the truth) over `steps` steps of 0.01 s, frames every
+// 0.015 s, noise-free unless `noise` (m) > 0. setup.scene is `truth`: set
+// the starting materials on it.
+inline solvers::CalibrationSetup SyntheticSetupFromScene(const Scene& truth_scene, Method method, int steps = 8,
+                                                         double noise = 0) {
+  const Scene& scene = truth_scene;
   const SolverOptions options = CalibrationSolverOptions(method);
   Simulator truth(scene, options);
   const State start_state = SwingStart(truth);
@@ -50,6 +50,7 @@ inline solvers::CalibrationSetup SyntheticSetup(Method method, bool tets, const 
   int far = 0;
   for (int v = 0; v < scene.mesh.num_vertices(); ++v)
     if (scene.mesh.vertices(0, v) > scene.mesh.vertices(0, far) + 1e-9) far = v;
+  const bool tets = scene.mesh.type == ElementType::kTet4;
   markers.push_back(Marker{0, far, -1, Vec3::Zero(), 0});
   markers.push_back(Marker{1, far - 1, -1, Vec3::Zero(), 0});
   markers.push_back(Marker{5, scene.mesh.num_vertices() / 2, -1, Vec3::Zero(), 0});
@@ -61,11 +62,21 @@ inline solvers::CalibrationSetup SyntheticSetup(Method method, bool tets, const 
   setup.motion = SampleMarkers(scene.mesh, rollout.states, options.time_step, markers, times, noise, 2021);
   // Per-axis weights: mm-scale residuals, the y axis (the swing) counted twice.
   for (MarkerSample& s : setup.motion.samples) s.weight = Vec3(1e3, 2e3, 1e3);
-  scene.material = start;
   setup.scene = scene;
   setup.solver = options;
   setup.initial = start_state;
   setup.num_steps = steps;
+  return setup;
+}
+
+// Setup with motion synthesised from TrueMaterial() on SmallBeamScene(tets)
+// (see SyntheticSetupFromScene), and the scene's material set to `start`.
+inline solvers::CalibrationSetup SyntheticSetup(Method method, bool tets, const MaterialParameters& start,
+                                                int steps = 8, double noise = 0) {
+  Scene scene = SmallBeamScene(tets);
+  scene.material = TrueMaterial();
+  solvers::CalibrationSetup setup = SyntheticSetupFromScene(scene, method, steps, noise);
+  setup.scene.material = start;
   return setup;
 }
 
