@@ -6,9 +6,13 @@
 
 #include <vector>
 
+#include <ceres/ceres.h>
+
 #include "diffpd/captured_motion.h"
 #include "diffpd/simulator.h"
 #include "diffpd/solvers/calibration_model.h"
+#include "diffpd/solvers/coordinate_manifold.h"
+#include "diffpd/solvers/marker_cost_function.h"
 #include "test_scenes.h"
 
 namespace diffpd::testing {
@@ -17,15 +21,49 @@ namespace diffpd::testing {
 inline MaterialParameters TrueMaterial() { return MaterialParameters{2e5, 0.4, 1e3}; }
 
 inline SolverOptions CalibrationSolverOptions(Method method) {
-  SolverOptions options;
-  options.method = method;
+  SolverOptions options = TightOptions(method);
   options.time_step = 0.01;
-  options.rel_tolerance = 1e-12;
-  options.abs_tolerance = 1e-11;
   options.backward_rel_tolerance = 1e-12;
-  options.max_iterations = 20000;
-  options.num_threads = 1;
   return options;
+}
+
+// Ceres settings of the noise-free recovery tests: converged far below the
+// recovery tolerances (1e-6 relative).
+inline ceres::Solver::Options TightRecoveryOptions() {
+  ceres::Solver::Options options;
+  options.max_num_iterations = 50;
+  options.function_tolerance = 1e-14;
+  options.parameter_tolerance = 1e-12;
+  options.gradient_tolerance = 1e-16;
+  return options;
+}
+
+// Fits the material block of `setup` (from its starting values) with
+// TightRecoveryOptions: marker residuals in one block, E and density in log
+// space, Poisson's ratios linear within [0.05, 0.49]. Returns the block.
+inline std::vector<double> FitMaterialBlock(const solvers::CalibrationSetup& setup, ceres::Solver::Summary* summary) {
+  solvers::CalibrationModel model(setup);
+  std::vector<double> material(model.parameter_block_sizes()[0]);
+  model.InitialMaterialBlock(material.data());
+  std::vector<solvers::MaterialParameter> kinds = setup.fitted;
+  for (const solvers::RegionParameter& rp : setup.fitted_regions) kinds.push_back(rp.parameter);
+  std::vector<solvers::CoordinateMap> maps;
+  for (const solvers::MaterialParameter p : kinds)
+    maps.push_back(p == solvers::MaterialParameter::kPoissonsRatio ? solvers::CoordinateMap::Linear()
+                                                                   : solvers::CoordinateMap::Log());
+  solvers::RolloutEvaluationCallback callback(&model, {material.data()});
+  ceres::Problem::Options po;
+  po.evaluation_callback = &callback;
+  ceres::Problem problem(po);
+  solvers::AddMarkerResidualBlocks(&problem, &model, {material.data()}, solvers::ResidualBlocks::kSingle);
+  problem.SetManifold(material.data(), new solvers::CoordinateManifold(maps));
+  for (size_t i = 0; i < kinds.size(); ++i)
+    if (kinds[i] == solvers::MaterialParameter::kPoissonsRatio) {
+      problem.SetParameterLowerBound(material.data(), static_cast<int>(i), 0.05);
+      problem.SetParameterUpperBound(material.data(), static_cast<int>(i), 0.49);
+    }
+  ceres::Solve(TightRecoveryOptions(), &problem, summary);
+  return material;
 }
 
 // Initial state: rest, with a sideways velocity growing along the beam.

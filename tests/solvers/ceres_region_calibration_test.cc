@@ -169,27 +169,8 @@ TEST(RegionCalibrationTest, RecoversAStiffAndASoftHalfFromNoiseFreeMarkers) {
   setup.scene.material_regions[0].material = MaterialParameters{1e5, 0.4, 1e3};
   setup.fitted = {MaterialParameter::kYoungsModulus, MaterialParameter::kPoissonsRatio};
   setup.fitted_regions = {{0, MaterialParameter::kYoungsModulus}, {0, MaterialParameter::kPoissonsRatio}};
-  CalibrationModel model(setup);
-  double material[4];
-  model.InitialMaterialBlock(material);
-  RolloutEvaluationCallback callback(&model, {material});
-  ceres::Problem::Options po;
-  po.evaluation_callback = &callback;
-  ceres::Problem problem(po);
-  AddMarkerResidualBlocks(&problem, &model, {material}, ResidualBlocks::kSingle);
-  problem.SetManifold(material, new CoordinateManifold({CoordinateMap::Log(), CoordinateMap::Linear(),
-                                                        CoordinateMap::Log(), CoordinateMap::Linear()}));
-  for (int i : {1, 3}) {
-    problem.SetParameterLowerBound(material, i, 0.05);
-    problem.SetParameterUpperBound(material, i, 0.49);
-  }
-  ceres::Solver::Options options;
-  options.max_num_iterations = 50;
-  options.function_tolerance = 1e-14;
-  options.parameter_tolerance = 1e-12;
-  options.gradient_tolerance = 1e-16;
   ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
+  const std::vector<double> material = testing::FitMaterialBlock(setup, &summary);
   ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
   EXPECT_NEAR(material[0] / 2e5, 1.0, 1e-5) << summary.FullReport();
   EXPECT_NEAR(material[1] / 0.4, 1.0, 1e-5);
