@@ -87,33 +87,46 @@ double Logit(double s) { return std::log(s / (1 - s)); }
 // StarfishCalibration::FromCoordinates and ActuationFromCoordinates): the
 // model's scalar loss with its reverse-mode gradient, chained through the
 // coordinate maps.
+// With arms (StarfishRegions::kBodyArms) u has a sixth coordinate, the arms'
+// E, and the model's material block is {E, nu, E_arms, nu_arms} with nu_arms
+// tied to nu.
 class BoundedLoss : public ceres::FirstOrderFunction {
  public:
-  BoundedLoss(solvers::CalibrationModel* model, double density) : model_(model), density_(density) {}
+  BoundedLoss(solvers::CalibrationModel* model, double density, bool arms)
+      : model_(model), density_(density), arms_(arms) {}
   bool Evaluate(const double* u, double* cost, double* gradient) const override {
     const MaterialParameters m = StarfishCalibration::FromCoordinates(u, density_);
     const StarfishActuation a = StarfishCalibration::ActuationFromCoordinates(u + 2);
-    const double material[2] = {m.youngs_modulus, m.poissons_ratio};
+    const double arms_e = arms_ ? StarfishCalibration::FromCoordinates(u + 5, density_).youngs_modulus : 0;
+    const double material[4] = {m.youngs_modulus, m.poissons_ratio, arms_e, m.poissons_ratio};
     const double actuation[3] = {a.slack, a.lag, a.length};
     const double* blocks[2] = {material, actuation};
-    double g[5] = {0, 0, 0, 0, 0};
+    double g[7] = {0, 0, 0, 0, 0, 0, 0};
     if (!model_->EvaluateLoss(blocks, {}, cost, gradient ? g : nullptr)) return false;
     if (gradient) {
+      // g: the material block (2 or 4 values) then the actuation block.
+      const double* ga = g + (arms_ ? 4 : 2);
+      const double g_nu = arms_ ? g[1] + g[3] : g[1];
       const double se = Sigmoid(u[0]), sn = Sigmoid(u[1]), ss = Sigmoid(u[2]), sl = Sigmoid(u[3]);
       gradient[0] = g[0] * m.youngs_modulus * std::log(kMaxE / kMinE) * se * (1 - se);
-      gradient[1] = g[1] * m.poissons_ratio * std::log(kMaxNu / kMinNu) * sn * (1 - sn);
-      gradient[2] = g[2] * kMaxSlack * ss * (1 - ss);
-      gradient[3] = g[3] * a.lag * std::log(kMaxLag / kMinLag) * sl * (1 - sl);
+      gradient[1] = g_nu * m.poissons_ratio * std::log(kMaxNu / kMinNu) * sn * (1 - sn);
+      gradient[2] = ga[0] * kMaxSlack * ss * (1 - ss);
+      gradient[3] = ga[1] * a.lag * std::log(kMaxLag / kMinLag) * sl * (1 - sl);
       const double st = Sigmoid(u[4]);
-      gradient[4] = g[4] * a.length * std::log(kMaxLength / kMinLength) * st * (1 - st);
+      gradient[4] = ga[2] * a.length * std::log(kMaxLength / kMinLength) * st * (1 - st);
+      if (arms_) {
+        const double sa = Sigmoid(u[5]);
+        gradient[5] = g[2] * arms_e * std::log(kMaxE / kMinE) * sa * (1 - sa);
+      }
     }
     return std::isfinite(*cost);
   }
-  int NumParameters() const override { return 5; }
+  int NumParameters() const override { return arms_ ? 6 : 5; }
 
  private:
   solvers::CalibrationModel* model_;
   double density_;
+  bool arms_;
 };
 
 // The activations of a window as the model's input block {slack, lag, length}.
@@ -143,16 +156,20 @@ class TendonActuationInputs : public solvers::InputParameters {
 
 class FitTable : public ceres::IterationCallback {
  public:
-  FitTable(FILE* log, const double* u, double density) : log_(log), u_(u), density_(density) {}
+  FitTable(FILE* log, const double* u, double density, bool arms) : log_(log), u_(u), density_(density), arms_(arms) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    if (s.iteration == 0)
-      std::fprintf(log_, "%4s %13s %11s %11s %9s %14s %14s %9s %9s %9s\n", "iter", "loss", "loss_change",
+    if (s.iteration == 0) {
+      std::fprintf(log_, "%4s %13s %11s %11s %9s %14s %14s %9s %9s %9s", "iter", "loss", "loss_change",
                    "|gradient|", "total_t", "youngs_modulus", "poissons_ratio", "slack_mm", "lag_s", "length_mm");
+      std::fprintf(log_, arms_ ? " %14s\n" : "\n", "arms_youngs_modulus");
+    }
     const MaterialParameters m = StarfishCalibration::FromCoordinates(u_, density_);
     const StarfishActuation a = StarfishCalibration::ActuationFromCoordinates(u_ + 2);
-    std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %9.2f %14.6g %14.6g %9.4f %9.4f %9.3f\n", s.iteration, s.cost,
+    std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %9.2f %14.6g %14.6g %9.4f %9.4f %9.3f", s.iteration, s.cost,
                  s.cost_change, s.gradient_max_norm, s.cumulative_time_in_seconds, m.youngs_modulus,
                  m.poissons_ratio, a.slack / kMm, a.lag, a.length / kMm);
+    if (arms_) std::fprintf(log_, " %14.6g", StarfishCalibration::FromCoordinates(u_ + 5, density_).youngs_modulus);
+    std::fprintf(log_, "\n");
     std::fflush(log_);
     return ceres::SOLVER_CONTINUE;
   }
@@ -161,6 +178,7 @@ class FitTable : public ceres::IterationCallback {
   FILE* log_;
   const double* u_;
   double density_;
+  bool arms_;
 };
 
 // Per camera frame: time (s), tendon (mm), activation, and per marker the
@@ -319,6 +337,20 @@ StarfishWindow MakeStarfishWindow(const StarfishRecording& rec, double start, do
   return w;
 }
 
+const char* ToString(StarfishRegions regions) {
+  switch (regions) {
+    case StarfishRegions::kNone: return "none";
+    case StarfishRegions::kBodyArms: return "body-arms";
+  }
+  return "unknown";
+}
+
+StarfishRegions ParseStarfishRegions(const std::string& name) {
+  if (name == "body-arms") return StarfishRegions::kBodyArms;
+  if (name == "none") return StarfishRegions::kNone;
+  throw InvalidInputError("--regions = '" + name + "' is invalid: calibrate-starfish knows 'body-arms'");
+}
+
 std::string StarfishCalibration::description() const {
   return "fit E, nu, tendon slack, servo lag and tendon length of a soft starfish swimming underwater to real captured motion, predict other recordings";
 }
@@ -382,6 +414,16 @@ Scene StarfishCalibration::MakeScene() const {
       scene.muscles[c(2) < 0 ? 0 : 1].elements.push_back(e);
     else if (std::abs(c(2)) <= kStripHalfWidth && std::abs(c(1)) > kCentralHalfWidth)
       scene.muscles[c(1) < 0 ? 2 : 3].elements.push_back(e);
+  }
+  if (regions_ == StarfishRegions::kBodyArms) {
+    MaterialRegion arms;
+    for (int e = 0; e < mesh.num_elements(); ++e) {
+      Vec3 c = Vec3::Zero();
+      for (int a = 0; a < mesh.elements.rows(); ++a) c += mesh.vertices.col(mesh.elements(a, e)) / mesh.elements.rows();
+      if (std::abs(c(1)) > kCentralHalfWidth || std::abs(c(2)) > kCentralHalfWidth) arms.elements.push_back(e);
+    }
+    arms.material = scene.material;
+    scene.material_regions = {arms};
   }
   Hydrodynamics water;
   water.triangles = BoundaryTriangles(mesh);
@@ -504,9 +546,13 @@ std::unique_ptr<solvers::CalibrationModel> StarfishCalibration::MakeModel(const 
   solvers::CalibrationSetup setup;
   setup.scene = MakeScene();
   setup.scene.material = material;
+  for (MaterialRegion& region : setup.scene.material_regions) region.material = material;
   setup.solver = options;
   setup.solver.time_step = WindowTimeStep(rec, w, substeps_);
   setup.fitted = {solvers::MaterialParameter::kYoungsModulus, solvers::MaterialParameter::kPoissonsRatio};
+  if (regions_ == StarfishRegions::kBodyArms)
+    setup.fitted_regions = {{0, solvers::MaterialParameter::kYoungsModulus},
+                            {0, solvers::MaterialParameter::kPoissonsRatio}};
   setup.inputs = WindowInputs(rec, w, actuation);
   setup.num_steps = static_cast<int>(setup.inputs.size());
   setup.input_parameters = std::make_shared<TendonActuationInputs>(WindowContractions(rec, w),
@@ -524,10 +570,16 @@ StarfishFit StarfishCalibration::Fit(const StarfishRecording& rec, const Starfis
                                      const SolverOptions& options, const MaterialParameters& guess,
                                      const StarfishActuation& actuation_guess, int max_iterations, FILE* log) const {
   std::unique_ptr<solvers::CalibrationModel> model = MakeModel(rec, w, options, guess, actuation_guess);
-  double u[5];
+  const bool arms = regions_ == StarfishRegions::kBodyArms;
+  double u[6];
   ToCoordinates(guess, u);
   ActuationToCoordinates(actuation_guess, u + 2);
-  ceres::GradientProblem problem(new BoundedLoss(model.get(), guess.density));
+  if (arms) {
+    double arms_u[2];
+    ToCoordinates(guess, arms_u);
+    u[5] = arms_u[0];
+  }
+  ceres::GradientProblem problem(new BoundedLoss(model.get(), guess.density, arms));
   ceres::GradientProblemSolver::Options solver_options;
   solver_options.line_search_direction_type = ceres::LBFGS;
   // Scale L-BFGS' initial inverse Hessian by the observed curvature: the
@@ -539,13 +591,18 @@ StarfishFit StarfishCalibration::Fit(const StarfishRecording& rec, const Starfis
   solver_options.parameter_tolerance = 1e-5;
   solver_options.logging_type = ceres::SILENT;
   solver_options.update_state_every_iteration = true;
-  FitTable table(log, u, guess.density);
+  FitTable table(log, u, guess.density, arms);
   if (log) solver_options.callbacks.push_back(&table);
   ceres::GradientProblemSolver::Summary summary;
   ceres::Solve(solver_options, problem, u, &summary);
   StarfishFit fit;
   fit.material = FromCoordinates(u, guess.density);
   fit.actuation = ActuationFromCoordinates(u + 2);
+  if (arms) {
+    MaterialParameters arms_material = fit.material;
+    arms_material.youngs_modulus = FromCoordinates(u + 5, guess.density).youngs_modulus;
+    fit.region_materials = {arms_material};
+  }
   fit.initial_cost = summary.initial_cost;
   fit.final_cost = summary.final_cost;
   fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
@@ -593,6 +650,13 @@ void StarfishCalibration::ActuationToCoordinates(const StarfishActuation& a, dou
 }
 
 int StarfishCalibration::Run(const CommandArgs& args) const {
+  if (!args.regions.empty()) {  // a copy with the regions, run without the option
+    StarfishCalibration with_regions = *this;
+    with_regions.set_regions(ParseStarfishRegions(args.regions));
+    CommandArgs rest = args;
+    rest.regions.clear();
+    return with_regions.Run(rest);
+  }
   if (args.steps > 0 || args.dt > 0)
     throw InvalidInputError("--steps and --dt are fixed by the recordings of " + name() +
                             " (60 Hz camera frames, " + std::to_string(substeps_) + " steps per frame)");
@@ -643,9 +707,14 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
   // The fit.
   const MaterialParameters guess = scene.material;
   const StarfishActuation actuation_guess = ActuationGuess();
-  std::fprintf(log, "# fit: Ceres L-BFGS on (log E, log nu, slack, log lag, log length) mapped into E in [1e4, 5e6] "
+  std::fprintf(log, "# fit: Ceres L-BFGS on (log E, log nu, slack, log lag, log length%s) mapped into E in [1e4, 5e6] "
                "Pa, nu in [0.2, 0.45], tendon slack in [0, 15] mm, servo lag in [1, 500] ms, tendon length in [30, 130] mm; "
-               "loss = 1/2 weighted mean squared marker error / (2 mm)^2\n");
+               "loss = 1/2 weighted mean squared marker error / (2 mm)^2\n",
+               regions_ == StarfishRegions::kBodyArms ? ", log E_arms" : "");
+  if (regions_ == StarfishRegions::kBodyArms)
+    std::fprintf(log, "# regions: body-arms: E of the %zu arm elements (centroid beyond |y|, |z| < 18 mm) fitted apart "
+                 "from the body's %zu; nu and density shared\n", scene.material_regions[0].elements.size(),
+                 scene.mesh.num_elements() - scene.material_regions[0].elements.size());
   const StarfishFit fit = Fit(calibration, fit_window, options, guess, actuation_guess,
                               args.max_iterations >= 0 ? args.max_iterations : kDefaultIterations, log);
   const MaterialParameters& fitted = fit.material;
@@ -657,6 +726,9 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                fit.final_cost);
   std::fprintf(log, "# fit: %d rollouts (%.2f s forward), %d gradients (%.2f s backward), %d failed\n", stats.rollouts,
                stats.forward_seconds, stats.gradients, stats.backward_seconds, stats.failures);
+  if (!fit.region_materials.empty())
+    std::fprintf(log, "# fit: arms E = %.6g Pa (body E = %.6g Pa, ratio %.3g)\n", fit.region_materials[0].youngs_modulus,
+                 fitted.youngs_modulus, fit.region_materials[0].youngs_modulus / fitted.youngs_modulus);
   if (stats.failures > 0) std::fprintf(log, "# last failure: %s\n", stats.last_error.c_str());
 
   // Predictions.
@@ -669,6 +741,7 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
     if (!w.note.empty()) std::fprintf(log, "# note: %s\n", w.note.c_str());
     Scene s = scene;
     s.material = fitted;
+    for (size_t r = 0; r < fit.region_materials.size(); ++r) s.material_regions[r].material = fit.region_materials[r];
     SolverOptions o = options;
     o.time_step = WindowTimeStep(rec, w, substeps_);
     Simulator sim(s, o);
@@ -730,6 +803,8 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                                            {"marker_weights", kMarkerWeights}}},
                           {"files", files},
                           {"total_seconds", total}};
+    out["regions"] = ToString(regions_);
+    if (!fit.region_materials.empty()) out["arms_youngs_modulus"] = fit.region_materials[0].youngs_modulus;
     std::printf("%s\n", out.dump(2).c_str());
   }
   return fit.usable ? 0 : 5;

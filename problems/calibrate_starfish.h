@@ -123,9 +123,25 @@ std::vector<double> StarfishActivations(const std::vector<double>& contraction, 
                                         const StarfishActuation& actuation,
                                         std::vector<std::array<double, 3>>* derivatives);
 
+// Material regions of the starfish fit.
+enum class StarfishRegions {
+  kNone,      // one material
+  kBodyArms,  // material region 0: the four arms (element centroid beyond
+              // the central square |y|, |z| < 18 mm), with its own E; the
+              // central body keeps the base material; nu and density shared
+};
+// "none", "body-arms".
+const char* ToString(StarfishRegions regions);
+// Throws InvalidInputError for other names:
+//   "--regions = 'legs' is invalid: calibrate-starfish knows 'body-arms'".
+StarfishRegions ParseStarfishRegions(const std::string& name);
+
 // The outcome of a fit (StarfishCalibration::Fit).
 struct StarfishFit {
-  MaterialParameters material;   // fitted
+  MaterialParameters material;   // fitted (the body's with kBodyArms)
+  // kBodyArms: the arms' fitted material (E fitted; nu = material's,
+  // density = material's); empty otherwise.
+  std::vector<MaterialParameters> region_materials;
   StarfishActuation actuation;   // fitted
   double initial_cost = 0;       // loss 1/2 |r|^2 (see WindowMotion) at the start
   double final_cost = 0;
@@ -144,7 +160,8 @@ class StarfishCalibration : public Problem {
 
   std::string name() const override { return "calibrate-starfish"; }
   std::string description() const override;
-  // The scene at the starting material E = 5e5 Pa, nu = 0.4, rho = 400.
+  // The scene at the starting material E = 5e5 Pa, nu = 0.4, rho = 400
+  // (with kBodyArms also as the arms' material region).
   Scene MakeScene() const override;
   int default_steps() const override { return static_cast<int>(substeps_ * kFrameRate); }  // 1 s
   double default_time_step() const override { return 1.0 / (kFrameRate * substeps_); }
@@ -152,6 +169,9 @@ class StarfishCalibration : public Problem {
   // Simulation steps per camera frame (default 2, h = 8.3 ms).
   int substeps() const { return substeps_; }
   void set_substeps(int substeps);
+  // Material regions of the scene and the fit (default kNone).
+  StarfishRegions regions() const { return regions_; }
+  void set_regions(StarfishRegions regions) { regions_ = regions; }
 
   // The mesh of the file comment (tetgen must be on PATH).
   static Mesh StarfishMesh();
@@ -189,8 +209,9 @@ class StarfishCalibration : public Problem {
 
   // The calibration model of a window (reverse-mode gradients of the scalar
   // loss 1/2 |r|^2) at `material` and `actuation`. Parameter blocks: {E, nu}
-  // (Pa, 1) and {slack, lag, length} (m, s, m; the activations are an input
-  // block). The initial state is WindowInitialState at `actuation` and is
+  // (Pa, 1; with kBodyArms {E, nu, E_arms, nu_arms}, the arms region starting
+  // at `material` too) and {slack, lag, length} (m, s, m; the activations are
+  // an input block). The initial state is WindowInitialState at `actuation` and is
   // held fixed, so the gradient is exact when the window starts with the
   // tendon slack (a = 1, as in the default fit window from rest).
   std::unique_ptr<solvers::CalibrationModel> MakeModel(const StarfishRecording& recording,
@@ -200,7 +221,9 @@ class StarfishCalibration : public Problem {
 
   // Fits E, nu, slack, lag and length on a window with Ceres' L-BFGS
   // (GradientProblem) on the bounded coordinates below (u = 2 material then
-  // 3 actuation coordinates), starting from `guess` and `actuation_guess`,
+  // 3 actuation coordinates; with kBodyArms a sixth, the arms' E mapped like
+  // E, and the arms' nu tied to the body's), starting from `guess` (both
+  // regions) and `actuation_guess`,
   // at most `max_iterations` iterations; the iteration table goes to `log`
   // (nullptr: silent). Throws what MakeModel throws; a failed rollout makes Ceres
   // shorten its step (the failure is counted in statistics).
@@ -225,7 +248,8 @@ class StarfishCalibration : public Problem {
   static StarfishActuation ActuationGuess() { return StarfishActuation{0.003, 0.05, kTendonRest}; }
 
   // `diffpd run calibrate-starfish [--calibrate FILE] [--predict FILE ...]
-  // [--seconds S] [--json] [--threads T] [--max-iterations N] [--out DIR]`:
+  // [--seconds S] [--json] [--threads T] [--max-iterations N] [--out DIR]
+  // [--regions body-arms]`:
   // fits E, nu, tendon slack, lag and length on the calibration file's window
   // [1 s, 3 s] (the tendon first moves at 1.18 s in cyclic1) with Ceres'
   // L-BFGS on the scalar loss (at most 10 iterations unless
@@ -238,10 +262,12 @@ class StarfishCalibration : public Problem {
   // M1..M4 (mm) per camera frame.
   // Method: pd-lbfgs, or the first of --methods, or a --method other than
   // the command line's default pd. --threads as for every problem.
+  // --regions body-arms fits the arms' E apart from the body's (kBodyArms).
   int Run(const CommandArgs& args) const override;
 
  private:
   int substeps_ = 2;
+  StarfishRegions regions_ = StarfishRegions::kNone;
 };
 
 }  // namespace diffpd::problems

@@ -35,14 +35,17 @@ struct CommandArgs {
   // Calibration problems (calibrate-*): the captured-motion file (default:
   // the problem's file in data/), the methods to fit with and compare
   // (default: the problem's), a cap on Ceres iterations (-1: the problem's);
-  // calibrate-starfish: the recording to fit, those to predict, and the
-  // seconds of each recording to evaluate (-1: the problem's default).
+  // calibrate-starfish: the recording to fit, those to predict, the
+  // seconds of each recording to evaluate (-1: the problem's default) and
+  // the material regions ("": one material; "body-arms": separate E for the
+  // central body and the four arms).
   std::string data_file;
   std::vector<std::string> methods;
   int max_iterations = -1;
   std::string calibrate_file;
   std::vector<std::string> predict_files;
   double seconds = -1;
+  std::string regions;
 };
 
 int ListCommand(bool json);

@@ -54,6 +54,8 @@ int main(int argc, char** argv) {
   run->add_option("--calibrate", run_args.calibrate_file, "calibrate-starfish: the recording to fit");
   run->add_option("--predict", run_args.predict_files, "calibrate-starfish: recordings to predict (repeatable)");
   run->add_option("--seconds", run_args.seconds, "calibrate-starfish: seconds of each recording to evaluate");
+  run->add_option("--regions", run_args.regions,
+                  "calibrate-starfish: material regions, 'body-arms' (separate E for the body and the arms)");
 
   CLI::App* grad = app.add_subcommand("gradcheck", "compare rollout gradients with central finite differences");
   AddCommonOptions(grad, &grad_args, &grad_method);

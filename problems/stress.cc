@@ -231,6 +231,7 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
 
     Rollout rollout;
     rollout.material = scene.material;
+    for (const MaterialRegion& region : scene.material_regions) rollout.region_materials.push_back(region.material);
     rollout.options = so;
     rollout.inputs = p->Inputs(sim, steps);
     rollout.reports.resize(steps);

@@ -2,12 +2,14 @@
 #pragma once
 
 #include <array>
+#include <random>
 #include <vector>
 
 #include <Eigen/LU>
 
 #include "diffpd/box_mesh.h"
 #include "diffpd/scene.h"
+#include "diffpd/simulator.h"
 
 namespace diffpd::testing {
 
@@ -60,6 +62,65 @@ inline Scene SmallBeamScene(bool tets = false, std::vector<ElasticEnergy> energi
   scene.energies = std::move(energies);
   scene.gravity = Vec3(0, 0, -9.81);
   FixNodes(&scene, NodesAtXMin(scene.mesh));
+  return scene;
+}
+
+// Tightly converged settings for derivative tests against finite
+// differences: h = 0.01 s (2e-4 s for semi-implicit), one thread.
+inline SolverOptions TightOptions(Method method) {
+  SolverOptions options;
+  options.method = method;
+  options.time_step = method == Method::kSemiImplicit ? 2e-4 : 0.01;
+  options.rel_tolerance = 1e-12;
+  options.abs_tolerance = 1e-11;
+  options.backward_rel_tolerance = 1e-13;
+  options.max_iterations = 20000;
+  options.num_threads = 1;
+  return options;
+}
+
+// A deformed, moving start so that every term is exercised.
+inline State MovingStart(const Simulator& sim) {
+  State s = sim.RestState();
+  for (int i = 0; i < s.x.size() / 3; ++i) {
+    s.x(3 * i + 2) += 0.05 * s.x(3 * i) * s.x(3 * i);
+    s.v(3 * i + 1) = 0.2 * s.x(3 * i);
+  }
+  return s;
+}
+
+// n values uniform in [-scale, scale].
+inline VectorXd RandomVector(int n, std::mt19937_64* rng, double scale) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  VectorXd v(n);
+  for (int i = 0; i < n; ++i) v(i) = scale * u(*rng);
+  return v;
+}
+
+// Elements whose centroid has lo <= x < hi.
+inline std::vector<int> ElementsWithCentroidX(const Mesh& mesh, double lo, double hi) {
+  std::vector<int> out;
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    double cx = 0;
+    for (int a = 0; a < mesh.elements.rows(); ++a) cx += mesh.vertices(0, mesh.elements(a, e));
+    cx /= mesh.elements.rows();
+    if (cx >= lo && cx < hi) out.push_back(e);
+  }
+  return out;
+}
+
+// SmallBeamScene with two material regions: region 0 the middle third of the
+// beam (softer, E / 5, other nu and density), region 1 the tip third (stiffer,
+// other nu and density); the clamped third keeps the base material.
+inline Scene TwoRegionBeamScene(bool tets = false) {
+  Scene scene = SmallBeamScene(tets);
+  const double length = scene.mesh.vertices.row(0).maxCoeff();
+  MaterialRegion middle, tip;
+  middle.elements = ElementsWithCentroidX(scene.mesh, length / 3, 2 * length / 3);
+  middle.material = MaterialParameters{scene.material.youngs_modulus / 5, 0.3, 1.4e3};
+  tip.elements = ElementsWithCentroidX(scene.mesh, 2 * length / 3, 2 * length);
+  tip.material = MaterialParameters{scene.material.youngs_modulus * 1.5, 0.35, 0.8e3};
+  scene.material_regions = {middle, tip};
   return scene;
 }
 

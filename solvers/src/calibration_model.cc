@@ -41,6 +41,24 @@ void CheckBasis(const MatrixXd& basis, const char* name, int* columns) {
   *columns = static_cast<int>(basis.cols());
 }
 
+double& Field(MaterialParameters* m, MaterialParameter p) {
+  switch (p) {
+    case MaterialParameter::kYoungsModulus: return m->youngs_modulus;
+    case MaterialParameter::kPoissonsRatio: return m->poissons_ratio;
+    case MaterialParameter::kDensity: return m->density;
+  }
+  DIFFPD_CHECK(false, "unknown MaterialParameter " << static_cast<int>(p));
+}
+
+double Field(const MaterialComponents& c, MaterialParameter p) {
+  switch (p) {
+    case MaterialParameter::kYoungsModulus: return c.youngs_modulus;
+    case MaterialParameter::kPoissonsRatio: return c.poissons_ratio;
+    case MaterialParameter::kDensity: return c.density;
+  }
+  DIFFPD_CHECK(false, "unknown MaterialParameter " << static_cast<int>(p));
+}
+
 }  // namespace
 
 const char* ToString(MaterialParameter parameter) {
@@ -124,9 +142,25 @@ CalibrationModel::CalibrationModel(CalibrationSetup setup)
   for (MaterialParameter p : setup_.fitted)
     if (!seen.insert(p).second)
       throw InvalidInputError(std::string("fitted lists ") + ToString(p) + " twice");
-  if (!setup_.fitted.empty()) {
+  const int regions = static_cast<int>(setup_.scene.material_regions.size());
+  std::set<std::pair<int, MaterialParameter>> seen_regions;
+  for (size_t i = 0; i < setup_.fitted_regions.size(); ++i) {
+    const RegionParameter& rp = setup_.fitted_regions[i];
+    if (rp.region < 0 || rp.region >= regions) {
+      std::ostringstream msg;
+      msg << "fitted_regions[" << i << "]: region " << rp.region << " is out of range [0, " << regions << ")";
+      throw InvalidInputError(msg.str());
+    }
+    if (!seen_regions.insert({rp.region, rp.parameter}).second) {
+      std::ostringstream msg;
+      msg << "fitted_regions lists " << ToString(rp.parameter) << " of region " << rp.region << " twice";
+      throw InvalidInputError(msg.str());
+    }
+  }
+  const int material_size = static_cast<int>(setup_.fitted.size() + setup_.fitted_regions.size());
+  if (material_size > 0) {
     material_block_ = static_cast<int>(block_sizes_.size());
-    block_sizes_.push_back(static_cast<int>(setup_.fitted.size()));
+    block_sizes_.push_back(material_size);
   }
   if (setup_.input_parameters) {
     if (setup_.input_parameters->size() < 1) throw InvalidInputError("input_parameters has no parameter");
@@ -134,7 +168,8 @@ CalibrationModel::CalibrationModel(CalibrationSetup setup)
     block_sizes_.push_back(setup_.input_parameters->size());
   }
   if (block_sizes_.empty())
-    throw InvalidInputError("nothing to fit: `fitted` is empty and there are no input_parameters");
+    throw InvalidInputError(
+        "nothing to fit: `fitted` and `fitted_regions` are empty and there are no input_parameters");
   for (int s : block_sizes_) num_parameters_ += s;
   if (setup_.initial) {
     if (setup_.initial->x.size() != n || setup_.initial->v.size() != n) {
@@ -156,25 +191,33 @@ CalibrationModel::CalibrationModel(CalibrationSetup setup)
 }
 
 void CalibrationModel::InitialMaterialBlock(double* block) const {
-  const MaterialParameters& m = setup_.scene.material;
-  for (size_t i = 0; i < setup_.fitted.size(); ++i) {
-    switch (setup_.fitted[i]) {
-      case MaterialParameter::kYoungsModulus: block[i] = m.youngs_modulus; break;
-      case MaterialParameter::kPoissonsRatio: block[i] = m.poissons_ratio; break;
-      case MaterialParameter::kDensity: block[i] = m.density; break;
-    }
+  MaterialParameters base = setup_.scene.material;
+  const size_t nb = setup_.fitted.size();
+  for (size_t i = 0; i < nb; ++i) block[i] = Field(&base, setup_.fitted[i]);
+  for (size_t i = 0; i < setup_.fitted_regions.size(); ++i) {
+    const RegionParameter& rp = setup_.fitted_regions[i];
+    MaterialParameters m = setup_.scene.material_regions[rp.region].material;
+    block[nb + i] = Field(&m, rp.parameter);
   }
 }
 
 MaterialParameters CalibrationModel::MaterialAt(const double* block) const {
   MaterialParameters m = setup_.scene.material;
-  for (size_t i = 0; i < setup_.fitted.size(); ++i) {
-    switch (setup_.fitted[i]) {
-      case MaterialParameter::kYoungsModulus: m.youngs_modulus = block[i]; break;
-      case MaterialParameter::kPoissonsRatio: m.poissons_ratio = block[i]; break;
-      case MaterialParameter::kDensity: m.density = block[i]; break;
-    }
+  for (size_t i = 0; i < setup_.fitted.size(); ++i) Field(&m, setup_.fitted[i]) = block[i];
+  return m;
+}
+
+MaterialParameters CalibrationModel::RegionMaterialAt(const double* block, int region) const {
+  const int regions = static_cast<int>(setup_.scene.material_regions.size());
+  if (region < 0 || region >= regions) {
+    std::ostringstream msg;
+    msg << "RegionMaterialAt: region " << region << " is out of range [0, " << regions << ")";
+    throw InvalidInputError(msg.str());
   }
+  MaterialParameters m = setup_.scene.material_regions[region].material;
+  const size_t nb = setup_.fitted.size();
+  for (size_t i = 0; i < setup_.fitted_regions.size(); ++i)
+    if (setup_.fitted_regions[i].region == region) Field(&m, setup_.fitted_regions[i].parameter) = block[nb + i];
   return m;
 }
 
@@ -205,7 +248,11 @@ bool CalibrationModel::Prepare(const double* const* parameters) {
   try {
     for (double v : point)
       if (!std::isfinite(v)) throw InvalidInputError("a parameter is not finite");
-    if (material_block_ >= 0) sim_->SetMaterial(MaterialAt(parameters[material_block_]));
+    if (material_block_ >= 0) {
+      sim_->SetMaterial(MaterialAt(parameters[material_block_]));
+      for (const RegionParameter& rp : setup_.fitted_regions)
+        sim_->SetRegionMaterial(rp.region, RegionMaterialAt(parameters[material_block_], rp.region));
+    }
     State initial = *setup_.initial;
     std::vector<StepInput> inputs = setup_.inputs;
     input_directions_.clear();
@@ -265,6 +312,18 @@ void CalibrationModel::ForwardJacobian() {
       case MaterialParameter::kDensity: dirs.push_back(InputDirection::Density()); break;
     }
   }
+  const int regions = static_cast<int>(setup_.scene.material_regions.size());
+  for (const RegionParameter& rp : setup_.fitted_regions) {
+    switch (rp.parameter) {
+      case MaterialParameter::kYoungsModulus:
+        dirs.push_back(InputDirection::RegionYoungsModulus(rp.region, regions));
+        break;
+      case MaterialParameter::kPoissonsRatio:
+        dirs.push_back(InputDirection::RegionPoissonsRatio(rp.region, regions));
+        break;
+      case MaterialParameter::kDensity: dirs.push_back(InputDirection::RegionDensity(rp.region, regions)); break;
+    }
+  }
   dirs.insert(dirs.end(), input_directions_.begin(), input_directions_.end());
   const TangentRollout t = sim_->Tangents(rollout_, dirs);
   MatrixXd j = MatrixXd::Zero(num_residuals(), num_parameters_);
@@ -283,13 +342,12 @@ void CalibrationModel::ForwardJacobian() {
 VectorXd CalibrationModel::ParameterGradient(const RolloutGradient& g, int last_step) const {
   VectorXd out(num_parameters_);
   int column = 0;
-  for (MaterialParameter p : setup_.fitted) {
-    switch (p) {
-      case MaterialParameter::kYoungsModulus: out(column++) = g.youngs_modulus; break;
-      case MaterialParameter::kPoissonsRatio: out(column++) = g.poissons_ratio; break;
-      case MaterialParameter::kDensity: out(column++) = g.density; break;
-    }
-  }
+  MaterialComponents base;
+  base.youngs_modulus = g.youngs_modulus;
+  base.poissons_ratio = g.poissons_ratio;
+  base.density = g.density;
+  for (MaterialParameter p : setup_.fitted) out(column++) = Field(base, p);
+  for (const RegionParameter& rp : setup_.fitted_regions) out(column++) = Field(g.region_materials[rp.region], rp.parameter);
   for (const InputDirection& d : input_directions_) {
     double v = 0;
     if (d.x0.size()) v += g.x0.dot(d.x0);
@@ -313,6 +371,7 @@ void CalibrationModel::ReverseJacobian() {
     part.inputs.assign(rollout_.inputs.begin(), rollout_.inputs.begin() + last);
     part.reports.assign(rollout_.reports.begin(), rollout_.reports.begin() + last);
     part.material = rollout_.material;
+    part.region_materials = rollout_.region_materials;
     part.options = rollout_.options;
     for (int d = 0; d < 3; ++d) {
       const double w = observations_.weight(s)(d);

@@ -29,6 +29,7 @@ Rollout Truncated(const Rollout& full, int last) {
   r.inputs.assign(full.inputs.begin(), full.inputs.begin() + last);
   r.reports.assign(full.reports.begin(), full.reports.begin() + last);
   r.material = full.material;
+  r.region_materials = full.region_materials;
   r.options = full.options;
   return r;
 }

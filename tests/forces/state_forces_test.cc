@@ -73,20 +73,25 @@ TEST(BoundaryTrianglesTest, CoverTheBoundaryOnceAndPointOutward) {
 TEST(StateForcesTest, VectorJacobianProductsMatchFiniteDifferences) {
   const Scene scene = SwimmerScene();
   internal::FemModel fem(scene.mesh);
-  internal::StateForces forces(scene, fem.unit_lumped_mass());
+  internal::StateForces forces(scene);
   const int n = scene.mesh.num_dofs();
   std::mt19937_64 rng(4);
+  VectorXd unit_mass(n);
+  for (int i = 0; i < n / 3; ++i) unit_mass.segment<3>(3 * i).setConstant(fem.unit_lumped_mass()(i));
   const double rho = scene.material.density;
+  const VectorXd mass = rho * unit_mass;
   for (int trial = 0; trial < 3; ++trial) {
     VectorXd x = Eigen::Map<const VectorXd>(scene.mesh.vertices.data(), n) + Random(n, &rng, 0.003);
     const VectorXd v = Random(n, &rng, 0.2);
     const VectorXd w = Random(n, &rng);
     VectorXd gx = VectorXd::Zero(n), gv = VectorXd::Zero(n);
     StateForceGradient grad;
-    const double drho = forces.AddVjp(x, v, rho, w, &gx, &gv, &grad);
+    VectorXd dmass = VectorXd::Zero(n);
+    forces.AddVjp(x, v, mass, w, &gx, &gv, &grad, &dmass);
+    const double drho = dmass.dot(unit_mass);  // M = rho m
     auto wf = [&](const VectorXd& xx, const VectorXd& vv, double r) {
       VectorXd f = VectorXd::Zero(n);
-      forces.Add(xx, vv, r, &f);
+      forces.Add(xx, vv, r * unit_mass, &f);
       return w.dot(f);
     };
     const VectorXd dx = Random(n, &rng), dv = Random(n, &rng);
@@ -103,8 +108,8 @@ TEST(StateForcesTest, VectorJacobianProductsMatchFiniteDifferences) {
       perturb(&p, 1e-6);
       perturb(&m, -1e-6);
       VectorXd fp = VectorXd::Zero(n), fm = VectorXd::Zero(n);
-      internal::StateForces(p, fem.unit_lumped_mass()).Add(x, v, rho, &fp);
-      internal::StateForces(m, fem.unit_lumped_mass()).Add(x, v, rho, &fm);
+      internal::StateForces(p).Add(x, v, mass, &fp);
+      internal::StateForces(m).Add(x, v, mass, &fm);
       return w.dot(fp - fm) / 2e-6;
     };
     auto near = [](double fd, double an) { EXPECT_NEAR(fd, an, 1e-6 * std::abs(an) + 1e-10); };

@@ -5,6 +5,8 @@
 
 #include <Eigen/Dense>
 
+#include <random>
+
 #include "diffpd/simulator.h"
 #include "fem/fem_model.h"
 #include "solver/pd_system.h"
@@ -44,6 +46,75 @@ TEST(PdSystemTest, FactorisesOncePerTimeStepAndMaterialAcrossStepsAndRollouts) {
   EXPECT_EQ(sim.num_pd_factorizations(), 3);
   sim.Step(sim.RestState(), StepInput());
   EXPECT_EQ(sim.num_pd_factorizations(), 3);
+}
+
+TEST(PdSystemTest, WithMaterialRegionsFactorisesOncePerTimeStepAndMaterials) {
+  const Scene scene = testing::TwoRegionBeamScene();
+  for (Method method : {Method::kPd, Method::kPdLbfgs}) {
+    SolverOptions o;
+    o.method = method;
+    o.max_iterations = 5000;  // PD needs ~800 iterations per step here
+    Simulator sim(scene, o);
+    const Rollout r = sim.Simulate(sim.RestState(), std::vector<StepInput>(4));
+    EXPECT_EQ(sim.num_pd_factorizations(), 1);
+    LossGradient dl(4);
+    dl.dx[4] = VectorXd::Ones(sim.num_dofs());
+    sim.Backward(r, dl);
+    sim.Tangents(r, {InputDirection::RegionYoungsModulus(1, 2)});
+    EXPECT_EQ(sim.num_pd_factorizations(), 1);
+    sim.SetRegionMaterial(0, scene.material_regions[0].material);  // unchanged values
+    sim.SetMaterial(scene.material);
+    sim.Step(sim.RestState(), StepInput());
+    EXPECT_EQ(sim.num_pd_factorizations(), 1);
+    MaterialParameters m = scene.material_regions[1].material;
+    m.youngs_modulus *= 2;
+    sim.SetRegionMaterial(1, m);
+    sim.Step(sim.RestState(), StepInput());
+    EXPECT_EQ(sim.num_pd_factorizations(), 2);
+    m.density *= 2;  // a density alone changes A too
+    sim.SetRegionMaterial(1, m);
+    sim.Step(sim.RestState(), StepInput());
+    sim.Step(sim.RestState(), StepInput());
+    EXPECT_EQ(sim.num_pd_factorizations(), 3);
+  }
+}
+
+TEST(PdSystemTest, PartsWeightTheirOwnElementsAndMasses) {
+  const Scene scene = testing::TwoRegionBeamScene();
+  internal::FemModel fem(scene.mesh);
+  const int nodes = fem.num_nodes();
+  const std::vector<char> free_dofs(3 * nodes, 0);
+  std::vector<int> part(fem.num_elements(), 0);
+  for (size_t r = 0; r < scene.material_regions.size(); ++r)
+    for (const int e : scene.material_regions[r].elements) part[e] = static_cast<int>(r) + 1;
+  const double h = 0.01;
+  internal::PdSystem one(fem, free_dofs), equal(fem, free_dofs, part, 3), mixed(fem, free_dofs, part, 3);
+  one.Update(h, 1e3, 5e5);
+  equal.Update(h, {1e3, 1e3, 1e3}, {5e5, 5e5, 5e5});
+  const std::vector<double> rho = {1e3, 2e3, 0.5e3}, w = {5e5, 1e5, 2e6};
+  mixed.Update(h, rho, w);
+  // Dense reference: A_s = sum_p (rho_p / h^2) diag(m_p) + sum_e w_p(e) L_e.
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(nodes, nodes);
+  const int k = fem.nodes_per_element();
+  for (int e = 0; e < fem.num_elements(); ++e)
+    for (int q = 0; q < fem.samples_per_element(); ++q) {
+      const int s = e * fem.samples_per_element() + q;
+      const Eigen::Map<const Eigen::MatrixXd> g(fem.grad(s), k, 3);
+      const Eigen::MatrixXd le = w[part[e]] * fem.sample_volume(s) * g * g.transpose();
+      for (int i = 0; i < k; ++i)
+        for (int j = 0; j < k; ++j) a(scene.mesh.elements(i, e), scene.mesh.elements(j, e)) += le(i, j);
+    }
+  for (int p = 0; p < 3; ++p) a.diagonal() += (rho[p] / (h * h)) * fem.UnitLumpedMass(part, p);
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> u(-1, 1);
+  VectorXd x(3 * nodes);
+  for (int i = 0; i < x.size(); ++i) x(i) = u(rng);
+  EXPECT_EQ((one.Apply(x) - equal.Apply(x)).norm(), 0.0);
+  const Eigen::Map<const Eigen::MatrixXd> xm(x.data(), 3, nodes);
+  const Eigen::MatrixXd expected = xm * a;  // A_s symmetric: (A_s x_axis) per row
+  const VectorXd y = mixed.Apply(x);
+  EXPECT_LT((y - Eigen::Map<const VectorXd>(expected.data(), x.size())).norm(), 1e-12 * y.norm());
+  EXPECT_LT((mixed.Apply(mixed.Solve(x)) - x).norm(), 1e-10 * x.norm());
 }
 
 TEST(PdSystemTest, AxesWithTheSameDirichletSetShareOneFactorAndSolvesMatchDense) {

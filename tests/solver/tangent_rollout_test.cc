@@ -14,39 +14,15 @@
 namespace diffpd {
 namespace {
 
+using testing::MovingStart;
+using testing::RandomVector;
+using testing::TightOptions;
+
 struct Case {
   Method method;
   bool tets;
 };
 
-SolverOptions TightOptions(Method method) {
-  SolverOptions options;
-  options.method = method;
-  options.time_step = method == Method::kSemiImplicit ? 2e-4 : 0.01;
-  options.rel_tolerance = 1e-12;
-  options.abs_tolerance = 1e-11;
-  options.backward_rel_tolerance = 1e-13;
-  options.max_iterations = 20000;
-  options.num_threads = 1;
-  return options;
-}
-
-// A deformed, moving start so that every term is exercised.
-State MovingStart(const Simulator& sim) {
-  State s = sim.RestState();
-  for (int i = 0; i < s.x.size() / 3; ++i) {
-    s.x(3 * i + 2) += 0.05 * s.x(3 * i) * s.x(3 * i);
-    s.v(3 * i + 1) = 0.2 * s.x(3 * i);
-  }
-  return s;
-}
-
-VectorXd RandomVector(int n, std::mt19937_64* rng, double scale) {
-  std::uniform_real_distribution<double> u(-1, 1);
-  VectorXd v(n);
-  for (int i = 0; i < n; ++i) v(i) = scale * u(*rng);
-  return v;
-}
 
 // Directions: E, nu, rho (scaled to the parameter), x0, v0, forces, and a mix.
 std::vector<InputDirection> TestDirections(const Scene& scene, int n, int steps) {

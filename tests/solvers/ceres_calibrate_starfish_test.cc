@@ -262,6 +262,63 @@ TEST_F(StarfishFitTest, LossGradientMatchesCentralDifferences) {
   }
 }
 
+TEST_F(StarfishFitTest, BodyArmsRegionsGiveTheArmsTheirOwnYoungsModulus) {
+  EXPECT_EQ(ParseStarfishRegions("body-arms"), StarfishRegions::kBodyArms);
+  try {
+    ParseStarfishRegions("legs");
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInputError& e) {
+    EXPECT_EQ(std::string(e.what()), "--regions = 'legs' is invalid: calibrate-starfish knows 'body-arms'");
+  }
+  starfish_.set_regions(StarfishRegions::kBodyArms);
+  const Scene scene = starfish_.MakeScene();
+  ASSERT_EQ(scene.material_regions.size(), 1u);
+  const size_t arms = scene.material_regions[0].elements.size();
+  EXPECT_GT(arms, scene.mesh.num_elements() / 2u);  // the arms are most of the body
+  EXPECT_LT(arms, static_cast<size_t>(scene.mesh.num_elements()));
+  for (const Muscle& m : scene.muscles)  // every muscle lies in an arm
+    for (const int e : m.elements)
+      EXPECT_TRUE(std::count(scene.material_regions[0].elements.begin(), scene.material_regions[0].elements.end(), e));
+  // The model's material block {E, nu, E_arms, nu_arms}: the arms' gradient.
+  SolverOptions options = starfish_.Options(Method::kPdLbfgs, 1);
+  options.rel_tolerance = 1e-10;
+  options.abs_tolerance = 1e-10;
+  options.backward_rel_tolerance = 1e-11;
+  auto model = starfish_.MakeModel(recording_, window_, options, MaterialParameters{2e5, 0.35, 400},
+                                   StarfishActuation{0.004, 0.03, 0.05});
+  ASSERT_EQ(model->parameter_block_sizes(), (std::vector<int>{4, 3}));
+  auto loss = [&](const double* material, double* gradient) {
+    const double actuation[3] = {0.004, 0.03, 0.05};
+    const double* blocks[2] = {material, actuation};
+    double cost = 0;
+    EXPECT_TRUE(model->EvaluateLoss(blocks, {}, &cost, gradient)) << model->statistics().last_error;
+    return cost;
+  };
+  const double p0[4] = {2e5, 0.35, 1e5, 0.35};
+  double g[7];
+  loss(p0, g);
+  for (const int i : {2, 3}) {
+    const double step = i == 2 ? 1e5 * 1e-4 : 1e-4;
+    double pp[4], pm[4];
+    std::copy(p0, p0 + 4, pp);
+    std::copy(p0, p0 + 4, pm);
+    pp[i] += step;
+    pm[i] -= step;
+    const double fd = (loss(pp, nullptr) - loss(pm, nullptr)) / (2 * step);
+    EXPECT_NEAR(g[i], fd, 1e-4 * std::abs(fd)) << "material block entry " << i;
+  }
+  // The fit: the arms' E moves apart from the body's and the loss drops.
+  const StarfishFit fit =
+      starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
+                    StarfishCalibration::ActuationGuess(), 2, nullptr);
+  EXPECT_TRUE(fit.usable) << fit.termination;
+  ASSERT_EQ(fit.region_materials.size(), 1u);
+  EXPECT_NE(fit.region_materials[0].youngs_modulus, fit.material.youngs_modulus);
+  EXPECT_EQ(fit.region_materials[0].poissons_ratio, fit.material.poissons_ratio);
+  EXPECT_LT(fit.final_cost, fit.initial_cost);
+  EXPECT_EQ(fit.statistics.failures, 0) << fit.statistics.last_error;
+}
+
 TEST_F(StarfishFitTest, CoordinatesMapIntoTheBoundsAndBack) {
   double u[2];
   StarfishCalibration::ToCoordinates(MaterialParameters{5e5, 0.4, 400}, u);

@@ -6,9 +6,13 @@
 
 #include <vector>
 
+#include <ceres/ceres.h>
+
 #include "diffpd/captured_motion.h"
 #include "diffpd/simulator.h"
 #include "diffpd/solvers/calibration_model.h"
+#include "diffpd/solvers/coordinate_manifold.h"
+#include "diffpd/solvers/marker_cost_function.h"
 #include "test_scenes.h"
 
 namespace diffpd::testing {
@@ -17,15 +21,49 @@ namespace diffpd::testing {
 inline MaterialParameters TrueMaterial() { return MaterialParameters{2e5, 0.4, 1e3}; }
 
 inline SolverOptions CalibrationSolverOptions(Method method) {
-  SolverOptions options;
-  options.method = method;
+  SolverOptions options = TightOptions(method);
   options.time_step = 0.01;
-  options.rel_tolerance = 1e-12;
-  options.abs_tolerance = 1e-11;
   options.backward_rel_tolerance = 1e-12;
-  options.max_iterations = 20000;
-  options.num_threads = 1;
   return options;
+}
+
+// Ceres settings of the noise-free recovery tests: converged far below the
+// recovery tolerances (1e-6 relative).
+inline ceres::Solver::Options TightRecoveryOptions() {
+  ceres::Solver::Options options;
+  options.max_num_iterations = 50;
+  options.function_tolerance = 1e-14;
+  options.parameter_tolerance = 1e-12;
+  options.gradient_tolerance = 1e-16;
+  return options;
+}
+
+// Fits the material block of `setup` (from its starting values) with
+// TightRecoveryOptions: marker residuals in one block, E and density in log
+// space, Poisson's ratios linear within [0.05, 0.49]. Returns the block.
+inline std::vector<double> FitMaterialBlock(const solvers::CalibrationSetup& setup, ceres::Solver::Summary* summary) {
+  solvers::CalibrationModel model(setup);
+  std::vector<double> material(model.parameter_block_sizes()[0]);
+  model.InitialMaterialBlock(material.data());
+  std::vector<solvers::MaterialParameter> kinds = setup.fitted;
+  for (const solvers::RegionParameter& rp : setup.fitted_regions) kinds.push_back(rp.parameter);
+  std::vector<solvers::CoordinateMap> maps;
+  for (const solvers::MaterialParameter p : kinds)
+    maps.push_back(p == solvers::MaterialParameter::kPoissonsRatio ? solvers::CoordinateMap::Linear()
+                                                                   : solvers::CoordinateMap::Log());
+  solvers::RolloutEvaluationCallback callback(&model, {material.data()});
+  ceres::Problem::Options po;
+  po.evaluation_callback = &callback;
+  ceres::Problem problem(po);
+  solvers::AddMarkerResidualBlocks(&problem, &model, {material.data()}, solvers::ResidualBlocks::kSingle);
+  problem.SetManifold(material.data(), new solvers::CoordinateManifold(maps));
+  for (size_t i = 0; i < kinds.size(); ++i)
+    if (kinds[i] == solvers::MaterialParameter::kPoissonsRatio) {
+      problem.SetParameterLowerBound(material.data(), static_cast<int>(i), 0.05);
+      problem.SetParameterUpperBound(material.data(), static_cast<int>(i), 0.49);
+    }
+  ceres::Solve(TightRecoveryOptions(), &problem, summary);
+  return material;
 }
 
 // Initial state: rest, with a sideways velocity growing along the beam.
@@ -35,13 +73,13 @@ inline State SwingStart(const Simulator& sim) {
   return s;
 }
 
-// Setup with motion synthesised from TrueMaterial() over `steps` steps of
-// 0.01 s, frames every 0.015 s, noise-free unless `noise` (m) > 0, and the
-// scene's material set to `start`.
-inline solvers::CalibrationSetup SyntheticSetup(Method method, bool tets, const MaterialParameters& start,
-                                                int steps = 8, double noise = 0) {
-  Scene scene = SmallBeamScene(tets);
-  scene.material = TrueMaterial();
+// Setup with motion synthesised from the scene `truth` (its materials, base
+// and regions, are the truth) over `steps` steps of 0.01 s, frames every
+// 0.015 s, noise-free unless `noise` (m) > 0. setup.scene is `truth`: set
+// the starting materials on it.
+inline solvers::CalibrationSetup SyntheticSetupFromScene(const Scene& truth_scene, Method method, int steps = 8,
+                                                         double noise = 0) {
+  const Scene& scene = truth_scene;
   const SolverOptions options = CalibrationSolverOptions(method);
   Simulator truth(scene, options);
   const State start_state = SwingStart(truth);
@@ -50,6 +88,7 @@ inline solvers::CalibrationSetup SyntheticSetup(Method method, bool tets, const 
   int far = 0;
   for (int v = 0; v < scene.mesh.num_vertices(); ++v)
     if (scene.mesh.vertices(0, v) > scene.mesh.vertices(0, far) + 1e-9) far = v;
+  const bool tets = scene.mesh.type == ElementType::kTet4;
   markers.push_back(Marker{0, far, -1, Vec3::Zero(), 0});
   markers.push_back(Marker{1, far - 1, -1, Vec3::Zero(), 0});
   markers.push_back(Marker{5, scene.mesh.num_vertices() / 2, -1, Vec3::Zero(), 0});
@@ -61,11 +100,21 @@ inline solvers::CalibrationSetup SyntheticSetup(Method method, bool tets, const 
   setup.motion = SampleMarkers(scene.mesh, rollout.states, options.time_step, markers, times, noise, 2021);
   // Per-axis weights: mm-scale residuals, the y axis (the swing) counted twice.
   for (MarkerSample& s : setup.motion.samples) s.weight = Vec3(1e3, 2e3, 1e3);
-  scene.material = start;
   setup.scene = scene;
   setup.solver = options;
   setup.initial = start_state;
   setup.num_steps = steps;
+  return setup;
+}
+
+// Setup with motion synthesised from TrueMaterial() on SmallBeamScene(tets)
+// (see SyntheticSetupFromScene), and the scene's material set to `start`.
+inline solvers::CalibrationSetup SyntheticSetup(Method method, bool tets, const MaterialParameters& start,
+                                                int steps = 8, double noise = 0) {
+  Scene scene = SmallBeamScene(tets);
+  scene.material = TrueMaterial();
+  solvers::CalibrationSetup setup = SyntheticSetupFromScene(scene, method, steps, noise);
+  setup.scene.material = start;
   return setup;
 }
 

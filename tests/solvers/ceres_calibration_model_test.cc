@@ -95,7 +95,7 @@ TEST(CalibrationModelTest, RejectsInvalidSetupsWithMessages) {
   EXPECT_EQ(message(good), "no exception");
   CalibrationSetup s = good;
   s.fitted = {};
-  EXPECT_EQ(message(s), "nothing to fit: `fitted` is empty and there are no input_parameters");
+  EXPECT_EQ(message(s), "nothing to fit: `fitted` and `fitted_regions` are empty and there are no input_parameters");
   s.fitted = {MaterialParameter::kDensity, MaterialParameter::kDensity};
   EXPECT_EQ(message(s), "fitted lists density twice");
   s = good;

@@ -19,24 +19,8 @@ struct RecoveryResult {
 };
 
 RecoveryResult Recover(const CalibrationSetup& setup) {
-  CalibrationModel model(setup);
-  double material[2];
-  model.InitialMaterialBlock(material);
-  RolloutEvaluationCallback callback(&model, {material});
-  ceres::Problem::Options po;
-  po.evaluation_callback = &callback;
-  ceres::Problem problem(po);
-  AddMarkerResidualBlocks(&problem, &model, {material}, ResidualBlocks::kSingle);
-  problem.SetManifold(material, new CoordinateManifold({CoordinateMap::Log(), CoordinateMap::Linear()}));
-  problem.SetParameterLowerBound(material, 1, 0.05);
-  problem.SetParameterUpperBound(material, 1, 0.49);
-  ceres::Solver::Options options;
-  options.max_num_iterations = 50;
-  options.function_tolerance = 1e-14;
-  options.parameter_tolerance = 1e-12;
-  options.gradient_tolerance = 1e-16;
   RecoveryResult out;
-  ceres::Solve(options, &problem, &out.summary);
+  const std::vector<double> material = testing::FitMaterialBlock(setup, &out.summary);
   out.youngs_modulus = material[0];
   out.poissons_ratio = material[1];
   return out;

@@ -174,11 +174,7 @@ TEST(MarkerCostFunctionTest, PerFrameBlocksShareOneRolloutPerPointThroughTheCall
   problem.SetManifold(material, new CoordinateManifold({CoordinateMap::Log(), CoordinateMap::Linear()}));
   problem.SetParameterLowerBound(material, 1, 0.1);
   problem.SetParameterUpperBound(material, 1, 0.49);
-  ceres::Solver::Options options;
-  options.max_num_iterations = 50;
-  options.function_tolerance = 1e-14;
-  options.parameter_tolerance = 1e-12;
-  options.gradient_tolerance = 1e-16;
+  const ceres::Solver::Options options = testing::TightRecoveryOptions();
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();

@@ -23,3 +23,4 @@ diffpd_add_test(ipopt_trajectory_constraint_test ${CMAKE_CURRENT_LIST_DIR}/ipopt
 diffpd_add_test(ipopt_trajectory_optimization_test ${CMAKE_CURRENT_LIST_DIR}/ipopt_trajectory_optimization_test.cc LIBS diffpd_problems diffpd_solvers)
 diffpd_add_test(ceres_calibrate_bouncing_ball_test ${CMAKE_CURRENT_LIST_DIR}/ceres_calibrate_bouncing_ball_test.cc LIBS diffpd_problems)
 diffpd_add_test(ceres_calibrate_starfish_test ${CMAKE_CURRENT_LIST_DIR}/ceres_calibrate_starfish_test.cc LIBS diffpd_problems)
+diffpd_add_test(ceres_region_calibration_test ${CMAKE_CURRENT_LIST_DIR}/ceres_region_calibration_test.cc LIBS diffpd_solvers)

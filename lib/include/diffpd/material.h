@@ -36,6 +36,16 @@ struct MaterialParameters {
                        double* dlambda_dnu) const;
 };
 
+// One number per material parameter, in the parameters' units: a direction
+// (dE in Pa, dnu, drho in kg/m^3) or a gradient (dL/dE per Pa, dL/dnu,
+// dL/drho per kg/m^3). Used per material region (scene.h) by
+// RolloutGradient (rollout.h) and InputDirection (tangent_rollout.h).
+struct MaterialComponents {
+  double youngs_modulus = 0;
+  double poissons_ratio = 0;
+  double density = 0;
+};
+
 // The elastic energy densities a scene may declare (a scene declares one or
 // more; their densities add up).
 enum class ElasticEnergy {

@@ -41,14 +41,16 @@ struct StepReport {
 
 // A recorded trajectory: states[0..K], inputs[0..K-1]. It stores exactly what
 // the backward pass needs: per step 2 x 3n doubles of state plus the step's
-// inputs (16 * 3n bytes + inputs per step), and the material and options it
+// inputs (16 * 3n bytes + inputs per step), and the materials and options it
 // was made with. Nothing per iteration is kept. With frictional contact the
 // backward pass reads each step's active set from `reports`.
 struct Rollout {
   std::vector<State> states;
   std::vector<StepInput> inputs;
   std::vector<StepReport> reports;
-  MaterialParameters material;
+  MaterialParameters material;  // the base material (Scene::material)
+  // One per Scene::material_regions entry, in order (empty without regions).
+  std::vector<MaterialParameters> region_materials;
   SolverOptions options;
 
   int num_steps() const { return static_cast<int>(inputs.size()); }
@@ -76,9 +78,13 @@ struct RolloutGradient {
   std::vector<VectorXd> external_force;     // per step, 3n
   std::vector<VectorXd> activation;         // per step, one per muscle (empty if none)
   StateForceGradient state_forces;          // declared state-force parameters
+  // The base material's parameters (Scene::material; elements in no region).
   double youngs_modulus = 0;                // dL/dE, per Pa
   double poissons_ratio = 0;                // dL/dnu
   double density = 0;                       // dL/drho, per kg/m^3
+  // One per Scene::material_regions entry, in order (empty without regions):
+  // dL/dE_r (per Pa), dL/dnu_r, dL/drho_r (per kg/m^3) of region r.
+  std::vector<MaterialComponents> region_materials;
   BackwardReport report;
 };
 

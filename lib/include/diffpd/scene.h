@@ -23,9 +23,26 @@ struct DirichletBoundary {
   VectorXd values;        // same length as dofs, metres
 };
 
+// A set of elements with a material of their own. Regions are numbered by
+// their position in Scene::material_regions (0, 1, ...); an element listed in
+// no region has the base material Scene::material.
+struct MaterialRegion {
+  // Element indices in [0, mesh.num_elements()), no repetition; non-empty.
+  // An element may belong to at most one region.
+  std::vector<int> elements;
+  MaterialParameters material;
+};
+
 struct Scene {
   Mesh mesh;
+  // The base material: that of every element in no material region.
   MaterialParameters material;
+  // Optional per-region materials (Young's modulus, Poisson's ratio and
+  // density per region). Empty: the whole body has `material` and costs
+  // nothing extra. Simulator::SetRegionMaterial changes one region's values;
+  // RolloutGradient::region_materials and InputDirection::region_materials
+  // hold the derivatives, one entry per region in this order.
+  std::vector<MaterialRegion> material_regions;
   // Elastic energy densities, summed. PD solvers need all of them projective
   // (kPdCorotated, kPdVolume); Newton and PD-LBFGS accept any.
   std::vector<ElasticEnergy> energies = {ElasticEnergy::kPdCorotated, ElasticEnergy::kPdVolume};
@@ -47,7 +64,13 @@ struct Scene {
   std::optional<double> linear_damping;
 
   // Throws InvalidInputError naming the first problem: invalid mesh or
-  // material, no energy, Dirichlet DoF out of range or not increasing, a
+  // material; a material region that is empty ("scene: material region 1 has
+  // no element"), lists an element out of range ("scene: material region 1
+  // lists element 40, out of range [0, 32)") or twice ("scene: material
+  // region 1 lists element 5 twice"), shares an element with an earlier
+  // region ("scene: element 5 is in material regions 0 and 1") or has an
+  // invalid material ("scene: material region 1: youngs_modulus = 0 is
+  // invalid: ..."); no energy, Dirichlet DoF out of range or not increasing, a
   // size mismatch, or a non-finite gravity/Dirichlet value; then the optional
   // terms (messages listed in muscle.h, contact.h and state_forces.h).
   void Validate() const;

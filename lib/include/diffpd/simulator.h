@@ -6,8 +6,8 @@
 //   RolloutGradient g = sim.Backward(r, dl);
 //
 // The simulator owns a copy of the scene, its FEM data and its solver caches
-// (the PD factor is computed once per (h, density, stiffness) and reused for
-// every step, iteration and rollout). It is not thread-safe; use one per thread.
+// (the PD factor is computed once per (h, densities, stiffnesses) and reused
+// for every step, iteration and rollout). It is not thread-safe; use one per thread.
 #pragma once
 
 #include <memory>
@@ -38,8 +38,14 @@ class Simulator {
   // Replaces the options (validated). The PD factor is recomputed lazily,
   // only if the time step changed.
   void SetOptions(const SolverOptions& options);
-  // Replaces the material (validated); the PD factor follows lazily.
+  // Replaces the base material (validated); the PD factor follows lazily.
   void SetMaterial(const MaterialParameters& material);
+  // Replaces the material of Scene::material_regions[region] (validated);
+  // the PD factor follows lazily. Throws InvalidInputError for a region out
+  // of range ("SetRegionMaterial: region 2 is out of range [0, 2)") or an
+  // invalid material ("SetRegionMaterial: region 0: youngs_modulus = -1 is
+  // invalid: ...").
+  void SetRegionMaterial(int region, const MaterialParameters& material);
 
   // Rest positions (Dirichlet DoFs at their prescribed values), zero velocity.
   State RestState() const;
@@ -55,8 +61,10 @@ class Simulator {
   // K = inputs.size() steps from `initial`, recorded for Backward().
   Rollout Simulate(const State& initial, const std::vector<StepInput>& inputs);
   // Reverse mode: gradients of a loss L(x_0..x_K, v_0..v_K) w.r.t. every
-  // differentiable input, given dL/dx_k and dL/dv_k. The rollout must come
-  // from this simulator with the same material and options.
+  // differentiable input, given dL/dx_k and dL/dv_k (material parameters:
+  // the base material's and, per region, RolloutGradient::region_materials).
+  // The rollout must come from this simulator with the same materials (base
+  // and regions), time step and method.
   RolloutGradient Backward(const Rollout& rollout, const LossGradient& loss);
   // Forward mode: tangents of every state of the rollout along each of the
   // P directions (tangent_rollout.h), all P solved together per step with the

@@ -24,14 +24,24 @@ struct InputDirection {
   VectorXd v0;                          // 3n, m/s: initial velocities
   std::vector<VectorXd> external_force; // empty, or one per step (each 3n or empty), N
   std::vector<VectorXd> activation;     // empty, or one per step (each one per muscle or empty)
+  // The base material (Scene::material; elements in no region).
   double youngs_modulus = 0;            // Pa
   double poissons_ratio = 0;            // dimensionless
   double density = 0;                   // kg/m^3
+  // Empty (zero), or one per Scene::material_regions entry, in order: the
+  // direction's components for region r's E (Pa), nu and rho (kg/m^3).
+  std::vector<MaterialComponents> region_materials;
 
-  // The unit direction of one material parameter.
+  // The unit direction of one base-material parameter.
   static InputDirection YoungsModulus();
   static InputDirection PoissonsRatio();
   static InputDirection Density();
+  // The unit direction of one parameter of material region `region` of a
+  // scene with `num_regions` regions. Throws InvalidInputError unless
+  // 0 <= region < num_regions.
+  static InputDirection RegionYoungsModulus(int region, int num_regions);
+  static InputDirection RegionPoissonsRatio(int region, int num_regions);
+  static InputDirection RegionDensity(int region, int num_regions);
 };
 
 // Tangents of a rollout with K steps along P directions.

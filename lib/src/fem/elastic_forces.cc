@@ -101,26 +101,32 @@ void ElasticForces::GatherElementBuffer(VectorXd* out, int threads) const {
 }
 
 template <int K>
-double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, double mu, double lambda, VectorXd* grad,
+void ElasticForces::SampleDecompositions(const Eigen::Matrix<double, 3, K>& xe, int e, Mat3* F, Svd3* svd) {
+  const int q_per = fem_.samples_per_element();
+  DIFFPD_CHECK(q_per <= kSvdBatch, "more samples per element than an SVD batch");
+  const int s0 = e * q_per;
+  for (int q = 0; q < q_per; ++q) F[q] = DeformationGradient<K>(xe, fem_.grad(s0 + q));
+  if (!needs_svd_) return;
+  // All samples' SVDs together, warm started from the last ones.
+  ComputeSvd3Batch(q_per, F, &v_cache_[s0], svd);
+  for (int q = 0; q < q_per; ++q) v_cache_[s0 + q] = svd[q].V;
+}
+
+template <int K>
+double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, const LameField& lame, VectorXd* grad,
                                             int threads) {
   if (!x.allFinite()) throw SolverError(SolverStatus::kNonFinite, "positions are not finite");
   const Mesh& mesh = fem_.mesh();
   const int q_per = fem_.samples_per_element();
-  DIFFPD_CHECK(q_per <= kSvdBatch, "more samples per element than an SVD batch");
   ParallelForElements(fem_.num_elements(), threads, [&](int e) {
+    const double mu = lame.mu_of(e), lambda = lame.lambda_of(e);
     const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(mesh, x, e);
     Eigen::Matrix<double, 3, K> fe = Eigen::Matrix<double, 3, K>::Zero();
     double energy = 0;
-    // All samples' SVDs together (warm started from the last ones), then
-    // the densities sample by sample.
     Mat3 F[kSvdBatch];
     Svd3 svd[kSvdBatch];
     const int s0 = e * q_per;
-    for (int q = 0; q < q_per; ++q) F[q] = DeformationGradient<K>(xe, fem_.grad(s0 + q));
-    if (needs_svd_) {
-      ComputeSvd3Batch(q_per, F, &v_cache_[s0], svd);
-      for (int q = 0; q < q_per; ++q) v_cache_[s0 + q] = svd[q].V;
-    }
+    SampleDecompositions<K>(xe, e, F, svd);
     for (int q = 0; q < q_per; ++q) {
       const int s = s0 + q;
       const double* g = fem_.grad(s);
@@ -140,19 +146,67 @@ double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, double mu, double
   return total;
 }
 
-double ElasticForces::EnergyAndGradient(const VectorXd& x, double mu, double lambda, VectorXd* grad,
-                                        int threads) {
-  return fem_.nodes_per_element() == 4 ? EnergyAndGradientImpl<4>(x, mu, lambda, grad, threads)
-                                       : EnergyAndGradientImpl<8>(x, mu, lambda, grad, threads);
+double ElasticForces::EnergyAndGradient(const VectorXd& x, const LameField& lame, VectorXd* grad, int threads) {
+  return fem_.nodes_per_element() == 4 ? EnergyAndGradientImpl<4>(x, lame, grad, threads)
+                                       : EnergyAndGradientImpl<8>(x, lame, grad, threads);
 }
 
 template <int K>
-void ElasticForces::StressDifferentialsImpl(const VectorXd& x, double mu, double lambda, std::vector<Mat9>* d,
+void ElasticForces::PartLameDotsImpl(const VectorXd& x, const VectorXd& z, const std::vector<int>& part_of_element,
+                                     int num_parts, VectorXd* dmu, VectorXd* dlambda, int threads) {
+  if (!x.allFinite()) throw SolverError(SolverStatus::kNonFinite, "positions are not finite");
+  const Mesh& mesh = fem_.mesh();
+  const int q_per = fem_.samples_per_element();
+  element_dot_.resize(fem_.num_elements());
+  ParallelForElements(fem_.num_elements(), threads, [&](int e) {
+    const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(mesh, x, e);
+    const Eigen::Matrix<double, 3, K> ze = GatherElement<K>(mesh, z, e);
+    Eigen::Matrix<double, 3, K> f_mu = Eigen::Matrix<double, 3, K>::Zero(), f_lambda = f_mu;
+    Mat3 F[kSvdBatch];
+    Svd3 svd[kSvdBatch];
+    const int s0 = e * q_per;
+    SampleDecompositions<K>(xe, e, F, svd);
+    for (int q = 0; q < q_per; ++q) {
+      const int s = s0 + q;
+      const double* g = fem_.grad(s);
+      Mat3 p_mu, p_lambda;  // one SVD serves both unit-parameter stresses
+      EvaluateDensity(energies_, F[q], svd[q], 1.0, 0.0, &p_mu, nullptr);
+      EvaluateDensity(energies_, F[q], svd[q], 0.0, 1.0, &p_lambda, nullptr);
+      const auto gt = Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
+      const double vol = fem_.sample_volume(s);
+      f_mu.noalias() += (vol * p_mu) * gt;
+      f_lambda.noalias() += (vol * p_lambda) * gt;
+    }
+    element_energy_[e] = ze.cwiseProduct(f_mu).sum();
+    element_dot_[e] = ze.cwiseProduct(f_lambda).sum();
+  });
+  *dmu = VectorXd::Zero(num_parts);
+  *dlambda = VectorXd::Zero(num_parts);
+  for (int e = 0; e < fem_.num_elements(); ++e) {
+    const int p = part_of_element.empty() ? 0 : part_of_element[e];
+    (*dmu)(p) += element_energy_[e];
+    (*dlambda)(p) += element_dot_[e];
+  }
+  if (!dmu->allFinite() || !dlambda->allFinite())
+    throw SolverError(SolverStatus::kNonFinite, "the elastic Lame-parameter derivatives are not finite");
+}
+
+void ElasticForces::PartLameDots(const VectorXd& x, const VectorXd& z, const std::vector<int>& part_of_element,
+                                 int num_parts, VectorXd* dmu, VectorXd* dlambda, int threads) {
+  DIFFPD_CHECK(part_of_element.empty() || static_cast<int>(part_of_element.size()) == fem_.num_elements(),
+               "part_of_element has " << part_of_element.size() << " entries");
+  if (fem_.nodes_per_element() == 4) PartLameDotsImpl<4>(x, z, part_of_element, num_parts, dmu, dlambda, threads);
+  else PartLameDotsImpl<8>(x, z, part_of_element, num_parts, dmu, dlambda, threads);
+}
+
+template <int K>
+void ElasticForces::StressDifferentialsImpl(const VectorXd& x, const LameField& lame, std::vector<Mat9>* d,
                                             int threads) {
   const Mesh& mesh = fem_.mesh();
   const int q_per = fem_.samples_per_element();
   d->resize(fem_.num_samples());
   ParallelForElements(fem_.num_elements(), threads, [&](int e) {
+    const double mu = lame.mu_of(e), lambda = lame.lambda_of(e);
     const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(mesh, x, e);
     for (int q = 0; q < q_per; ++q) {
       const int s = e * q_per + q;
@@ -163,10 +217,10 @@ void ElasticForces::StressDifferentialsImpl(const VectorXd& x, double mu, double
   });
 }
 
-void ElasticForces::StressDifferentials(const VectorXd& x, double mu, double lambda, std::vector<Mat9>* d,
+void ElasticForces::StressDifferentials(const VectorXd& x, const LameField& lame, std::vector<Mat9>* d,
                                         int threads) {
-  if (fem_.nodes_per_element() == 4) StressDifferentialsImpl<4>(x, mu, lambda, d, threads);
-  else StressDifferentialsImpl<8>(x, mu, lambda, d, threads);
+  if (fem_.nodes_per_element() == 4) StressDifferentialsImpl<4>(x, lame, d, threads);
+  else StressDifferentialsImpl<8>(x, lame, d, threads);
 }
 
 template <int K>
@@ -194,13 +248,14 @@ void ElasticForces::ApplyHessian(const std::vector<Mat9>& d, const VectorXd& z, 
 }
 
 template <int K>
-void ElasticForces::ElementHessiansImpl(const VectorXd& x, double mu, double lambda, bool project_spd,
+void ElasticForces::ElementHessiansImpl(const VectorXd& x, const LameField& lame, bool project_spd,
                                         std::vector<double>* blocks, int threads) {
   constexpr int N = 3 * K;
   const Mesh& mesh = fem_.mesh();
   const int q_per = fem_.samples_per_element();
   blocks->resize(static_cast<size_t>(fem_.num_elements()) * N * N);
   ParallelForElements(fem_.num_elements(), threads, [&](int e) {
+    const double mu = lame.mu_of(e), lambda = lame.lambda_of(e);
     const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(mesh, x, e);
     Eigen::Map<Eigen::Matrix<double, N, N>> ke(blocks->data() + static_cast<size_t>(e) * N * N);
     ke.setZero();
@@ -228,10 +283,10 @@ void ElasticForces::ElementHessiansImpl(const VectorXd& x, double mu, double lam
   });
 }
 
-void ElasticForces::ElementHessians(const VectorXd& x, double mu, double lambda, bool project_spd,
+void ElasticForces::ElementHessians(const VectorXd& x, const LameField& lame, bool project_spd,
                                     std::vector<double>* blocks, int threads) {
-  if (fem_.nodes_per_element() == 4) ElementHessiansImpl<4>(x, mu, lambda, project_spd, blocks, threads);
-  else ElementHessiansImpl<8>(x, mu, lambda, project_spd, blocks, threads);
+  if (fem_.nodes_per_element() == 4) ElementHessiansImpl<4>(x, lame, project_spd, blocks, threads);
+  else ElementHessiansImpl<8>(x, lame, project_spd, blocks, threads);
 }
 
 }  // namespace diffpd::internal

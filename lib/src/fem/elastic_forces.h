@@ -1,8 +1,11 @@
 // Elastic energy of a discretised body and its derivatives (internal).
 //
-// E(x) = sum_s vol_s * sum_{energies} Psi(F_s(x)), with F_s the deformation
-// gradient at sample s (see fem_model.h). Every density is linear in the Lame
-// parameters, so d grad E / d mu is grad E evaluated with (mu, lambda) = (1, 0).
+// E(x) = sum_s vol_s * sum_{energies} Psi(F_s(x); mu_e, lambda_e), with F_s
+// the deformation gradient at sample s (see fem_model.h) and (mu_e, lambda_e)
+// the Lame parameters of its element e (a LameField: uniform or per element).
+// Every density is linear in the Lame parameters, so d grad E / d mu is grad E
+// evaluated with (mu, lambda) = (1, 0), and the derivative along a field of
+// Lame directions (dmu_e, dlambda_e) is grad E evaluated with that field.
 // All loops run over elements in parallel (OpenMP, `threads` threads, 0 means
 // the OpenMP default); results are gathered per node, so they are
 // deterministic for a given thread count.
@@ -13,6 +16,7 @@
 #include "diffpd/material.h"
 #include "diffpd/types.h"
 #include "fem/fem_model.h"
+#include "fem/lame_field.h"
 #include "material/svd3.h"
 
 namespace diffpd::internal {
@@ -33,31 +37,47 @@ class ElasticForces {
   // Returns E(x) (J) and, if grad != nullptr, sets *grad = dE/dx (3n, N).
   // Throws SolverError(kInvertedElement) for neo-Hookean with det F <= 0 and
   // SolverError(kNonFinite) when x produces a non-finite value.
-  double EnergyAndGradient(const VectorXd& x, double mu, double lambda, VectorXd* grad, int threads);
+  double EnergyAndGradient(const VectorXd& x, const LameField& lame, VectorXd* grad, int threads);
+
+  // For every part p of the elements (part_of_element: num_elements entries
+  // in [0, num_parts), or empty: all in part 0), the derivatives of z . grad E(x)
+  // w.r.t. the part's Lame parameters (one pass over the elements):
+  //   (*dmu)(p)     = sum_{e in p} z_e . d(grad_e E)/d mu_e,
+  //   (*dlambda)(p) = sum_{e in p} z_e . d(grad_e E)/d lambda_e.
+  // Per-element values are summed in element order: deterministic.
+  void PartLameDots(const VectorXd& x, const VectorXd& z, const std::vector<int>& part_of_element, int num_parts,
+                    VectorXd* dmu, VectorXd* dlambda, int threads);
 
   // Per-sample exact stress differentials dP/dF (summed over energies) at x.
-  void StressDifferentials(const VectorXd& x, double mu, double lambda, std::vector<Mat9>* d,
-                           int threads);
+  void StressDifferentials(const VectorXd& x, const LameField& lame, std::vector<Mat9>* d, int threads);
   // out = (d^2 E / dx^2) z using stress differentials from StressDifferentials.
   void ApplyHessian(const std::vector<Mat9>& d, const VectorXd& z, VectorXd* out, int threads);
 
   // Element Hessians (3K x 3K each, column-major, concatenated) at x; with
   // project_spd each is replaced by its projection onto the PSD cone
   // (negative eigenvalues clamped to zero), the definiteness fix of Newton.
-  void ElementHessians(const VectorXd& x, double mu, double lambda, bool project_spd,
-                       std::vector<double>* blocks, int threads);
+  void ElementHessians(const VectorXd& x, const LameField& lame, bool project_spd, std::vector<double>* blocks,
+                       int threads);
 
 
  private:
   template <int K>
-  double EnergyAndGradientImpl(const VectorXd& x, double mu, double lambda, VectorXd* grad, int threads);
+  double EnergyAndGradientImpl(const VectorXd& x, const LameField& lame, VectorXd* grad, int threads);
   template <int K>
-  void StressDifferentialsImpl(const VectorXd& x, double mu, double lambda, std::vector<Mat9>* d, int threads);
+  void PartLameDotsImpl(const VectorXd& x, const VectorXd& z, const std::vector<int>& part_of_element,
+                        int num_parts, VectorXd* dmu, VectorXd* dlambda, int threads);
+  template <int K>
+  void StressDifferentialsImpl(const VectorXd& x, const LameField& lame, std::vector<Mat9>* d, int threads);
   template <int K>
   void ApplyHessianImpl(const std::vector<Mat9>& d, const VectorXd& z, VectorXd* out, int threads);
   template <int K>
-  void ElementHessiansImpl(const VectorXd& x, double mu, double lambda, bool project_spd,
-                           std::vector<double>* blocks, int threads);
+  void ElementHessiansImpl(const VectorXd& x, const LameField& lame, bool project_spd, std::vector<double>* blocks,
+                           int threads);
+  // Deformation gradients F[q] of element e's samples (nodal positions xe)
+  // and, when an energy needs them, their SVDs (svd[q]), computed as one
+  // batch warm started from and written back to v_cache_.
+  template <int K>
+  void SampleDecompositions(const Eigen::Matrix<double, 3, K>& xe, int e, Mat3* F, Svd3* svd);
   // Sums the per-element 3 x K buffer into a 3n vector, in parallel over nodes.
   void GatherElementBuffer(VectorXd* out, int threads) const;
 
@@ -67,6 +87,7 @@ class ElasticForces {
   bool needs_svd_ = false;
   std::vector<double> element_buffer_;  // 3 * K per element
   std::vector<double> element_energy_;  // per element
+  std::vector<double> element_dot_;     // per element (PartLameDots' lambda dots)
   // Per-sample V of the last SVD: warm start of the next one (see svd3.h).
   std::vector<Mat3> v_cache_;
 };

@@ -23,6 +23,7 @@ FemModel::FemModel(const Mesh& mesh) : mesh_(mesh) {
   grad_.assign(static_cast<size_t>(m) * q_ * k_ * 3, 0.0);
   volume_.assign(static_cast<size_t>(m) * q_, 0.0);
   unit_mass_ = VectorXd::Zero(n);
+  element_unit_mass_.assign(static_cast<size_t>(m) * k_, 0.0);
   shape_values_.assign(q_, std::vector<double>(k_, 0.0));
 
   if (mesh_.type == ElementType::kTet4) {
@@ -36,7 +37,10 @@ FemModel::FemModel(const Mesh& mesh) : mesh_(mesh) {
       g.row(0) = -inv.colwise().sum();
       g.bottomRows<3>() = inv;
       volume_[e] = dm.determinant() / 6.0;
-      for (int a = 0; a < 4; ++a) unit_mass_(mesh_.elements(a, e)) += volume_[e] / 4.0;
+      for (int a = 0; a < 4; ++a) {
+        unit_mass_(mesh_.elements(a, e)) += volume_[e] / 4.0;
+        element_unit_mass_[4 * static_cast<size_t>(e) + a] = volume_[e] / 4.0;
+      }
     }
   } else {
     const double gp = 1.0 / std::sqrt(3.0);
@@ -63,7 +67,10 @@ FemModel::FemModel(const Mesh& mesh) : mesh_(mesh) {
         Eigen::Map<Eigen::Matrix<double, 8, 3>> g(grad_.data() + s * 24);
         g = dn_dxi[q] * jac.inverse();
         volume_[s] = det;  // Gauss weight 1
-        for (int a = 0; a < 8; ++a) unit_mass_(mesh_.elements(a, e)) += det * shape_values_[q][a];
+        for (int a = 0; a < 8; ++a) {
+          unit_mass_(mesh_.elements(a, e)) += det * shape_values_[q][a];
+          element_unit_mass_[8 * static_cast<size_t>(e) + a] += det * shape_values_[q][a];
+        }
       }
     }
   }
@@ -76,6 +83,17 @@ FemModel::FemModel(const Mesh& mesh) : mesh_(mesh) {
   std::vector<int> fill(node_offsets_.begin(), node_offsets_.end() - 1);
   for (int e = 0; e < m; ++e)
     for (int a = 0; a < k_; ++a) node_incidence_[fill[mesh_.elements(a, e)]++] = e * k_ + a;
+}
+
+VectorXd FemModel::UnitLumpedMass(const std::vector<int>& part_of_element, int part) const {
+  DIFFPD_CHECK(static_cast<int>(part_of_element.size()) == num_elements(),
+               "part_of_element has " << part_of_element.size() << " entries for " << num_elements() << " elements");
+  VectorXd out = VectorXd::Zero(num_nodes());
+  for (int e = 0; e < num_elements(); ++e) {
+    if (part_of_element[e] != part) continue;
+    for (int a = 0; a < k_; ++a) out(mesh_.elements(a, e)) += element_unit_mass_[static_cast<size_t>(e) * k_ + a];
+  }
+  return out;
 }
 
 double FemModel::element_volume(int e) const {

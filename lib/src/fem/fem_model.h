@@ -35,6 +35,10 @@ class FemModel {
   double element_volume(int e) const;
   // Lumped mass per node for unit density: integral of N_a over the mesh (m^3).
   const VectorXd& unit_lumped_mass() const { return unit_mass_; }
+  // The same restricted to the elements e with part_of_element[e] == part
+  // (num_elements entries; see scene/material_regions.h), summed in element
+  // order (n, m^3). The parts' vectors add up to unit_lumped_mass().
+  VectorXd UnitLumpedMass(const std::vector<int>& part_of_element, int part) const;
 
   // Node -> (element, local index) adjacency in CSR form, for parallel gathers.
   const std::vector<int>& node_offsets() const { return node_offsets_; }
@@ -50,6 +54,7 @@ class FemModel {
   std::vector<double> grad_;
   std::vector<double> volume_;
   VectorXd unit_mass_;
+  std::vector<double> element_unit_mass_;  // K per element: element e's share of node a's unit mass
   std::vector<int> node_offsets_;
   std::vector<int> node_incidence_;
   std::vector<std::vector<double>> shape_values_;

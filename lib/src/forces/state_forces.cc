@@ -20,7 +20,7 @@ Vec3 MeanVelocity(const VectorXd& v, int a, int b, int c) {
 
 }  // namespace
 
-StateForces::StateForces(const Scene& scene, const VectorXd& unit_node_mass)
+StateForces::StateForces(const Scene& scene)
     : damping_(scene.linear_damping), hydro_(scene.hydrodynamics),
       num_penalty_contacts_(static_cast<int>(scene.penalty_contacts.size())) {
   for (size_t c = 0; c < scene.penalty_contacts.size(); ++c) {
@@ -30,15 +30,11 @@ StateForces::StateForces(const Scene& scene, const VectorXd& unit_node_mass)
       friction_.push_back(FrictionNode{static_cast<int>(c), i, pc.normal.normalized(), pc.offset, pc.stiffness,
                                        pc.friction, pc.friction_velocity});
   }
-  if (damping_) {
-    unit_mass_.resize(3 * unit_node_mass.size());
-    for (Eigen::Index i = 0; i < unit_node_mass.size(); ++i) unit_mass_.segment<3>(3 * i).setConstant(unit_node_mass(i));
-  }
 }
 
-void StateForces::Add(const VectorXd& x, const VectorXd& v, double rho, VectorXd* f) const {
+void StateForces::Add(const VectorXd& x, const VectorXd& v, const VectorXd& mass, VectorXd* f) const {
   if (empty()) return;
-  if (damping_) f->array() -= (*damping_ * rho) * unit_mass_.array() * v.array();
+  if (damping_) f->array() -= *damping_ * mass.array() * v.array();
   if (hydro_) {
     const Eigen::Matrix3Xi& tri = hydro_->triangles;
     for (int t = 0; t < tri.cols(); ++t) {
@@ -60,15 +56,14 @@ void StateForces::Add(const VectorXd& x, const VectorXd& v, double rho, VectorXd
   }
 }
 
-double StateForces::AddVjp(const VectorXd& x, const VectorXd& v, double rho, const VectorXd& w, VectorXd* gx,
-                           VectorXd* gv, StateForceGradient* grad) const {
-  if (empty()) return 0.0;
-  double drho = 0;
+void StateForces::AddVjp(const VectorXd& x, const VectorXd& v, const VectorXd& mass, const VectorXd& w,
+                         VectorXd* gx, VectorXd* gv, StateForceGradient* grad, VectorXd* dmass) const {
+  if (empty()) return;
   if (damping_) {
-    const VectorXd mw = unit_mass_.cwiseProduct(w);
-    gv->noalias() -= (*damping_ * rho) * mw;
-    grad->linear_damping -= rho * mw.dot(v);
-    drho -= *damping_ * mw.dot(v);
+    const VectorXd mw = mass.cwiseProduct(w);
+    gv->noalias() -= *damping_ * mw;
+    grad->linear_damping -= mw.dot(v);
+    if (dmass) dmass->noalias() -= *damping_ * w.cwiseProduct(v);
   }
   if (hydro_) {
     const Eigen::Matrix3Xi& tri = hydro_->triangles;
@@ -106,7 +101,6 @@ double StateForces::AddVjp(const VectorXd& x, const VectorXd& v, double rho, con
     gv->segment<3>(3 * fn.node) -= fn.mu * fn_mag * (pw / s - (wvt / (s * s * s)) * vt);
     grad->penalty_friction[fn.contact] -= fn_mag * wvt / s;
   }
-  return drho;
 }
 
 }  // namespace diffpd::internal

@@ -16,19 +16,19 @@ namespace diffpd::internal {
 
 class StateForces {
  public:
-  // `unit_node_mass` is the lumped mass per node at unit density (n, m^3);
-  // the scene must be valid. Copies what it needs.
-  StateForces(const Scene& scene, const VectorXd& unit_node_mass);
+  // The scene must be valid. Copies what it needs.
+  explicit StateForces(const Scene& scene);
 
   bool empty() const { return !damping_ && !hydro_ && friction_.empty(); }
 
-  // *f += F(x, v) (3n) for body density rho (kg/m^3).
-  void Add(const VectorXd& x, const VectorXd& v, double rho, VectorXd* f) const;
+  // *f += F(x, v; M) (3n) for the lumped mass M (3n, kg; enters damping's
+  // -c M v).
+  void Add(const VectorXd& x, const VectorXd& v, const VectorXd& mass, VectorXd* f) const;
   // Given w = dL/dF (3n): *gx += (dF/dx)^T w, *gv += (dF/dv)^T w, the
-  // parameter gradients into *grad (penalty_friction sized on first use);
-  // returns w . dF/drho.
-  double AddVjp(const VectorXd& x, const VectorXd& v, double rho, const VectorXd& w, VectorXd* gx, VectorXd* gv,
-                StateForceGradient* grad) const;
+  // parameter gradients into *grad (penalty_friction sized on first use) and,
+  // if dmass is not nullptr, *dmass += (dF/dM)^T w (3n, per DoF's mass).
+  void AddVjp(const VectorXd& x, const VectorXd& v, const VectorXd& mass, const VectorXd& w, VectorXd* gx,
+              VectorXd* gv, StateForceGradient* grad, VectorXd* dmass) const;
 
  private:
   struct FrictionNode {
@@ -41,7 +41,6 @@ class StateForces {
   std::optional<Hydrodynamics> hydro_;
   std::vector<FrictionNode> friction_;
   int num_penalty_contacts_ = 0;
-  VectorXd unit_mass_;
 };
 
 }  // namespace diffpd::internal

@@ -6,12 +6,14 @@
 
 #include "diffpd/error.h"
 #include "forces/optional_terms_validation.h"
+#include "scene/material_regions.h"
 
 namespace diffpd {
 
 void Scene::Validate() const {
   ValidateMesh(mesh);
   material.Validate();
+  internal::ValidateMaterialRegions(*this);
   if (energies.empty()) throw InvalidInputError("scene: no elastic energy declared (energies is empty)");
   if (gravity && !gravity->allFinite()) throw InvalidInputError("scene: gravity has a non-finite component");
   const int n = mesh.num_dofs();

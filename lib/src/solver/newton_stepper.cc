@@ -53,7 +53,7 @@ VectorXd NewtonSolve(StepObjective& objective, const VectorXd& x0, StepReport* r
   SparseMatrix h;
   for (int it = 0;; ++it) {
     if (IterationConverged(sim.options, it, grad.norm(), report)) return x;
-    sim.elastic.ElementHessians(x, sim.mu(), sim.lambda(), /*project_spd=*/true, &blocks, sim.threads());
+    sim.elastic.ElementHessians(x, sim.lame(), /*project_spd=*/true, &blocks, sim.threads());
     sim.aux.AddElementHessians(x, sim.activation, /*project_spd=*/true, &blocks);
     sim.hessian_assembler().Assemble(blocks, objective.inertia_diagonal(), sim.fixed, &h);
     VectorXd rhs = -grad;

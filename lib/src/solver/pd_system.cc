@@ -6,7 +6,12 @@
 
 namespace diffpd::internal {
 
-PdSystem::PdSystem(const FemModel& fem, const std::vector<char>& fixed) : fem_(fem) {
+namespace {
+
+// sum_{e : keep(e)} L_e in the pattern of the whole mesh's Laplacian (the
+// other elements' entries present as explicit zeros).
+template <class Keep>
+SparseMatrix Laplacian(const FemModel& fem, Keep keep) {
   const int n = fem.num_nodes();
   const int k = fem.nodes_per_element();
   const Mesh& mesh = fem.mesh();
@@ -14,17 +19,45 @@ PdSystem::PdSystem(const FemModel& fem, const std::vector<char>& fixed) : fem_(f
   triplets.reserve(static_cast<size_t>(fem.num_elements()) * k * k);
   for (int e = 0; e < fem.num_elements(); ++e) {
     Eigen::MatrixXd le = Eigen::MatrixXd::Zero(k, k);
-    for (int q = 0; q < fem.samples_per_element(); ++q) {
-      const int s = e * fem.samples_per_element() + q;
-      const Eigen::Map<const Eigen::MatrixXd> g(fem.grad(s), k, 3);
-      le.noalias() += fem.sample_volume(s) * g * g.transpose();
+    if (keep(e)) {
+      for (int q = 0; q < fem.samples_per_element(); ++q) {
+        const int s = e * fem.samples_per_element() + q;
+        const Eigen::Map<const Eigen::MatrixXd> g(fem.grad(s), k, 3);
+        le.noalias() += fem.sample_volume(s) * g * g.transpose();
+      }
     }
     for (int a = 0; a < k; ++a)
       for (int b = 0; b < k; ++b) triplets.emplace_back(mesh.elements(a, e), mesh.elements(b, e), le(a, b));
   }
-  laplacian_.resize(n, n);
-  laplacian_.setFromTriplets(triplets.begin(), triplets.end());
-  laplacian_.makeCompressed();
+  SparseMatrix l(n, n);
+  l.setFromTriplets(triplets.begin(), triplets.end());
+  l.makeCompressed();
+  return l;
+}
+
+bool AllEqual(const std::vector<double>& v) {
+  for (const double x : v)
+    if (x != v[0]) return false;
+  return true;
+}
+
+}  // namespace
+
+PdSystem::PdSystem(const FemModel& fem, const std::vector<char>& fixed, const std::vector<int>& part_of_element,
+                   int num_parts)
+    : fem_(fem), num_parts_(num_parts) {
+  const int n = fem.num_nodes();
+  DIFFPD_CHECK(num_parts >= 1 && (num_parts == 1 || static_cast<int>(part_of_element.size()) == fem.num_elements()),
+               num_parts << " parts need one part per element (got " << part_of_element.size() << ")");
+  laplacian_ = Laplacian(fem, [](int) { return true; });
+  if (num_parts > 1) {
+    for (int p = 0; p < num_parts; ++p) {
+      const SparseMatrix lp = Laplacian(fem, [&](int e) { return part_of_element[e] == p; });
+      DIFFPD_CHECK(lp.nonZeros() == laplacian_.nonZeros(), "part Laplacian pattern differs from the mesh's");
+      part_laplacian_values_.emplace_back(lp.valuePtr(), lp.valuePtr() + lp.nonZeros());
+      part_unit_mass_.push_back(fem.UnitLumpedMass(part_of_element, p));
+    }
+  }
 
   for (int d = 0; d < 3; ++d) {
     std::vector<char> mask(n);
@@ -41,11 +74,35 @@ PdSystem::PdSystem(const FemModel& fem, const std::vector<char>& fixed) : fem_(f
   }
 }
 
+SparseMatrix PdSystem::WeightedLaplacian(const std::vector<double>& weights) const {
+  if (AllEqual(weights)) return weights[0] * laplacian_;
+  SparseMatrix a = laplacian_;
+  Eigen::Map<VectorXd> values(a.valuePtr(), a.nonZeros());
+  values.setZero();
+  for (int p = 0; p < num_parts_; ++p)
+    values += weights[p] * Eigen::Map<const VectorXd>(part_laplacian_values_[p].data(), a.nonZeros());
+  return a;
+}
+
+VectorXd PdSystem::MassDiagonal(double h, const std::vector<double>& densities) const {
+  if (AllEqual(densities)) return (densities[0] / (h * h)) * fem_.unit_lumped_mass();
+  VectorXd diag = VectorXd::Zero(fem_.num_nodes());
+  for (int p = 0; p < num_parts_; ++p) diag += (densities[p] / (h * h)) * part_unit_mass_[p];
+  return diag;
+}
+
 bool PdSystem::Update(double h, double rho, double w) {
-  if (h == h_ && rho == rho_ && w == w_) return false;
-  const VectorXd diag = (rho / (h * h)) * fem_.unit_lumped_mass();
+  return Update(h, std::vector<double>(num_parts_, rho), std::vector<double>(num_parts_, w));
+}
+
+bool PdSystem::Update(double h, const std::vector<double>& densities, const std::vector<double>& weights) {
+  DIFFPD_CHECK(static_cast<int>(densities.size()) == num_parts_ && static_cast<int>(weights.size()) == num_parts_,
+               densities.size() << " densities and " << weights.size() << " weights for " << num_parts_ << " parts");
+  if (h == h_ && densities == densities_ && weights == weights_) return false;
+  const SparseMatrix weighted = WeightedLaplacian(weights);
+  const VectorXd diag = MassDiagonal(h, densities);
   for (Group& g : groups_) {
-    g.matrix = w * laplacian_;
+    g.matrix = weighted;
     if (auxiliary_.size() > 0) g.matrix += auxiliary_;
     g.matrix.diagonal() += diag;
     double* values = g.matrix.valuePtr();
@@ -57,14 +114,16 @@ bool PdSystem::Update(double h, double rho, double w) {
       h_ = -1;
       std::ostringstream msg;
       msg << "projective dynamics: the matrix A = M/h^2 + w L is not positive definite (h = " << h
-          << " s, density = " << rho << ", w = " << w << ")";
+          << " s, density = " << densities[0] << ", w = " << weights[0];
+      if (num_parts_ > 1) msg << " for the base material; " << num_parts_ - 1 << " material regions";
+      msg << ")";
       throw SolverError(SolverStatus::kFactorizationFailed, msg.str());
     }
   }
   ++num_factorizations_;
   h_ = h;
-  rho_ = rho;
-  w_ = w;
+  densities_ = densities;
+  weights_ = weights;
   if (!erasures_.empty() || !active_nodes_.empty()) {  // the factor changed: rebuild the erasure on it
     for (ActiveSetErasure& e : erasures_) e.Reset();
     SetActiveNodes(std::vector<int>(active_nodes_), active_mode_);

@@ -1,13 +1,19 @@
 // The constant matrix of projective dynamics and its factorisation (internal).
 //
-//   A = M / h^2 + w sum_s vol_s G_s^T G_s  =  A_s (x) I_3,
-//   A_s = (rho / h^2) diag(m_unit) + w L,   L_ab = sum_s vol_s grad_a(s) . grad_b(s),
+//   A = M / h^2 + sum_s w_s vol_s G_s^T G_s  =  A_s (x) I_3,
+//   A_s = sum_p [(rho_p / h^2) diag(m_p) + w_p L_p],
+//   L_p,ab = sum_{s in part p} vol_s grad_a(s) . grad_b(s),
 //
-// a scalar n x n matrix acting identically on x, y and z. Dirichlet DoFs erase
-// rows and columns per axis; axes whose fixed-node sets agree share one
-// CHOLMOD factor and are solved together as several right-hand sides.
-// The factor is recomputed exactly when (h, rho, w) changes (the mesh and the
-// Dirichlet set are fixed for the object's lifetime).
+// a scalar n x n matrix acting identically on x, y and z; p runs over the
+// material parts of the elements (scene/material_regions.h; one part without
+// regions), m_p is part p's unit-density lumped mass. When all parts share
+// rho and w, A_s = (rho / h^2) diag(m) + w L with the whole mesh's m and L,
+// the arithmetic of a single part. Dirichlet DoFs erase rows and columns per
+// axis; axes whose fixed-node sets agree share one CHOLMOD factor and are
+// solved together as several right-hand sides. The weighted Laplacian is
+// reassembled and the factor recomputed exactly when (h, rho_p, w_p) changes
+// (the mesh, the parts and the Dirichlet set are fixed for the object's
+// lifetime).
 #pragma once
 
 #include <array>
@@ -24,11 +30,18 @@ namespace diffpd::internal {
 
 class PdSystem {
  public:
-  // `fixed` has 3n flags (DoF 3i + d fixed). Does not take ownership of fem.
-  PdSystem(const FemModel& fem, const std::vector<char>& fixed);
+  // `fixed` has 3n flags (DoF 3i + d fixed). `part_of_element` has one part
+  // in [0, num_parts) per element, or is empty (one part). Does not take
+  // ownership of fem.
+  PdSystem(const FemModel& fem, const std::vector<char>& fixed, const std::vector<int>& part_of_element = {},
+           int num_parts = 1);
 
-  // Makes the factor current for (h, rho, w); returns true if it refactorised.
-  // Throws SolverError(kFactorizationFailed) if A is not positive definite.
+  // Makes the factor current for h (s) and every part's density rho_p
+  // (kg/m^3) and weight w_p (Pa), num_parts values each; returns true if it
+  // refactorised. Throws SolverError(kFactorizationFailed) if A is not
+  // positive definite.
+  bool Update(double h, const std::vector<double>& densities, const std::vector<double>& weights);
+  // The same with rho and w for every part.
   bool Update(double h, double rho, double w);
 
   // Solves A dx = r over the free DoFs: returns dx (3n) with zero fixed DoFs.
@@ -61,11 +74,20 @@ class PdSystem {
     SparseMatrix matrix;
     std::unique_ptr<CholmodSolver> solver;
   };
+  // sum_p w_p L_p, and the diagonal sum_p (rho_p / h^2) m_p (n).
+  SparseMatrix WeightedLaplacian(const std::vector<double>& weights) const;
+  VectorXd MassDiagonal(double h, const std::vector<double>& densities) const;
+
   const FemModel& fem_;
   SparseMatrix laplacian_;
+  // With several parts: L_p's values in laplacian_'s pattern, and m_p (n).
+  std::vector<std::vector<double>> part_laplacian_values_;
+  std::vector<VectorXd> part_unit_mass_;
+  int num_parts_ = 1;
   std::vector<Group> groups_;
   std::array<int, 3> group_of_axis_{};
-  double h_ = -1, rho_ = -1, w_ = -1;
+  double h_ = -1;
+  std::vector<double> densities_, weights_;
   int num_factorizations_ = 0;
   SparseMatrix auxiliary_;                 // 0 x 0 when none
   std::vector<int> active_nodes_;

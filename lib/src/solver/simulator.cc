@@ -50,7 +50,24 @@ void Simulator::SetOptions(const SolverOptions& options) {
 
 void Simulator::SetMaterial(const MaterialParameters& material) {
   material.Validate();
-  impl_->scene.material = material;
+  impl_->SetMaterial(material);
+}
+
+void Simulator::SetRegionMaterial(int region, const MaterialParameters& material) {
+  const int regions = static_cast<int>(impl_->scene.material_regions.size());
+  if (region < 0 || region >= regions) {
+    std::ostringstream msg;
+    msg << "SetRegionMaterial: region " << region << " is out of range [0, " << regions << ")";
+    throw InvalidInputError(msg.str());
+  }
+  try {
+    material.Validate();
+  } catch (const InvalidInputError& e) {
+    std::ostringstream msg;
+    msg << "SetRegionMaterial: region " << region << ": " << e.what();
+    throw InvalidInputError(msg.str());
+  }
+  impl_->SetRegionMaterial(region, material);
 }
 
 State Simulator::RestState() const {
@@ -66,7 +83,7 @@ VectorXd Simulator::LumpedMass() const { return impl_->Mass(); }
 
 double Simulator::ElasticEnergy(const VectorXd& x) {
   CheckVector(x, impl_->num_dofs(), "positions", false);
-  return impl_->elastic.EnergyAndGradient(x, impl_->mu(), impl_->lambda(), nullptr, impl_->threads());
+  return impl_->elastic.EnergyAndGradient(x, impl_->lame(), nullptr, impl_->threads());
 }
 
 int Simulator::num_pd_factorizations() const {
@@ -88,14 +105,14 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
   *rep = StepReport();
   const double h = sim.h();
   VectorXd f = sim.ExplicitForce(input);
-  sim.state_forces.Add(state.x, state.v, sim.rho(), &f);
+  sim.state_forces.Add(state.x, state.v, sim.Mass(), &f);
   State next;
   if (sim.options.method == Method::kSemiImplicit) {
     if (!sim.scene.frictional_contacts.empty())
       throw InvalidInputError("semi-implicit: frictional contact needs an implicit method (newton-cholesky, "
                               "newton-pcg, pd, pd-lbfgs); use penalty contact instead");
     VectorXd grad;
-    sim.elastic.EnergyAndGradient(state.x, sim.mu(), sim.lambda(), &grad, sim.threads());
+    sim.elastic.EnergyAndGradient(state.x, sim.lame(), &grad, sim.threads());
     sim.aux.AddEnergyAndGradient(state.x, sim.activation, &grad);
     next.v = state.v + h * ((f - grad).array() / sim.Mass().array()).matrix();
     next.x = state.x + h * next.v;
@@ -140,6 +157,7 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
 Rollout Simulator::Simulate(const State& initial, const std::vector<StepInput>& inputs) {
   Rollout r;
   r.material = impl_->scene.material;
+  for (const MaterialRegion& region : impl_->scene.material_regions) r.region_materials.push_back(region.material);
   r.options = impl_->options;
   r.inputs = inputs;
   r.states.reserve(inputs.size() + 1);
@@ -162,10 +180,7 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
         << " and " << loss.dv.size() << ")";
     throw InvalidInputError(msg.str());
   }
-  const MaterialParameters& mat = sim.scene.material;
-  if (rollout.material.youngs_modulus != mat.youngs_modulus || rollout.material.poissons_ratio != mat.poissons_ratio ||
-      rollout.material.density != mat.density || rollout.options.time_step != sim.h() ||
-      rollout.options.method != sim.options.method)
+  if (!internal::MadeWithCurrentSettings(sim, rollout))
     throw InvalidInputError(
         "Backward: the rollout was made with another material, time step or method than the simulator's current ones");
   for (int k = 0; k <= steps; ++k) {
@@ -173,7 +188,7 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
     CheckVector(loss.dv[k], n, "loss.dv", true);
   }
   const double h = sim.h();
-  const VectorXd mass = sim.Mass();
+  const VectorXd& mass = sim.Mass();
   const bool contact = !sim.scene.frictional_contacts.empty() && IsImplicit(sim.options.method);
   if (contact && static_cast<int>(rollout.reports.size()) != steps)
     throw InvalidInputError("Backward: a rollout with frictional contact needs its step reports (active sets)");
@@ -182,11 +197,13 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
   out.activation.assign(steps, VectorXd());
   VectorXd gx = loss.dx[steps].size() ? loss.dx[steps] : VectorXd::Zero(n);
   VectorXd gv = loss.dv[steps].size() ? loss.dv[steps] : VectorXd::Zero(n);
-  double dmu = 0, dlambda = 0, drho = 0;
-  VectorXd grad_mu, grad_lambda;
-  VectorXd gravity_unit = VectorXd::Zero(n);
-  if (sim.scene.gravity)
-    for (int i = 0; i < n / 3; ++i) gravity_unit.segment<3>(3 * i) = sim.unit_mass(3 * i) * (*sim.scene.gravity);
+  // Material adjoints per part (0: base, r + 1: region r): Lame parameters,
+  // and dL/dM (3n), turned into densities at the end (M = sum_p rho_p m_p).
+  const int parts = sim.num_parts();
+  VectorXd dmu = VectorXd::Zero(parts), dlambda = VectorXd::Zero(parts);
+  VectorXd part_mu, part_lambda;
+  VectorXd dmass = VectorXd::Zero(n);
+  const VectorXd gravity = internal::GravityPerDof(sim);
 
   for (int i = steps - 1; i >= 0; --i) {
     const State& s0 = rollout.states[i];
@@ -200,13 +217,11 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
       if (contact) pins.emplace(sim, rollout.reports[i].contact_nodes, s1.x);
       internal::StepLinearization lin(sim, s1.x);
       const VectorXd z = lin.Solve(b, &out.report);  // zero at fixed DoFs
-      sim.elastic.EnergyAndGradient(s1.x, 1.0, 0.0, &grad_mu, sim.threads());
-      sim.elastic.EnergyAndGradient(s1.x, 0.0, 1.0, &grad_lambda, sim.threads());
-      dmu -= z.dot(grad_mu);
-      dlambda -= z.dot(grad_lambda);
-      const VectorXd dgrad_drho =
-          sim.unit_mass.cwiseProduct(s1.x - s0.x - h * s0.v) / (h * h) - gravity_unit;
-      drho -= z.dot(dgrad_drho);
+      sim.elastic.PartLameDots(s1.x, z, sim.part_of_element, parts, &part_mu, &part_lambda, sim.threads());
+      dmu -= part_mu;
+      dlambda -= part_lambda;
+      // grad g depends on M through M (x_{i+1} - x_i - h v_i) / h^2 - M g.
+      dmass -= z.cwiseProduct((s1.x - s0.x - h * s0.v) / (h * h) - gravity);
       out.external_force[i] = z;
       if (sim.aux.num_muscles() > 0) out.activation[i] = sim.aux.muscles().ActivationGradient(s1.x, sim.activation, z);
       gx_prev = mass.cwiseProduct(z) / (h * h) - gv / h;
@@ -218,7 +233,7 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
       sim.ZeroFixed(&gvt);
       const VectorXd w = h * gvt.cwiseQuotient(mass);  // dL/d(force) = h M^-1 gvt
       std::vector<Mat9> dstress;
-      sim.elastic.StressDifferentials(s0.x, sim.mu(), sim.lambda(), &dstress, sim.threads());
+      sim.elastic.StressDifferentials(s0.x, sim.lame(), &dstress, sim.threads());
       VectorXd hw;
       sim.elastic.ApplyHessian(dstress, w, &hw, sim.threads());
       sim.aux.AddHessianProduct(s0.x, sim.activation, w, &hw);
@@ -229,22 +244,24 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
       for (int d = 0; d < n; ++d)
         if (sim.fixed[d]) gx_prev(d) -= gv(d) / h;
       gv_prev = gvt;
-      sim.elastic.EnergyAndGradient(s0.x, 1.0, 0.0, &grad_mu, sim.threads());
-      sim.elastic.EnergyAndGradient(s0.x, 0.0, 1.0, &grad_lambda, sim.threads());
-      dmu -= w.dot(grad_mu);
-      dlambda -= w.dot(grad_lambda);
-      // M^-1 (f_user - grad E) scales as 1/rho; gravity's acceleration does not.
+      sim.elastic.PartLameDots(s0.x, w, sim.part_of_element, parts, &part_mu, &part_lambda, sim.threads());
+      dmu -= part_mu;
+      dlambda -= part_lambda;
+      // M^-1 (f_user + f_state - grad E) varies with M as -M^-2 (...) dM
+      // (f_state's explicit dependence on M is added below); gravity's
+      // acceleration M^-1 M g does not vary.
       VectorXd grad_e;
-      sim.elastic.EnergyAndGradient(s0.x, sim.mu(), sim.lambda(), &grad_e, sim.threads());
+      sim.elastic.EnergyAndGradient(s0.x, sim.lame(), &grad_e, sim.threads());
       sim.aux.AddEnergyAndGradient(s0.x, sim.activation, &grad_e);
-      VectorXd user = rollout.inputs[i].external_force.size() ? rollout.inputs[i].external_force : VectorXd::Zero(n);
-      sim.state_forces.Add(s0.x, s0.v, sim.rho(), &user);  // M^-1 f scales as 1/rho for these too
-      drho -= w.dot(user - grad_e) / sim.rho();
+      VectorXd net = rollout.inputs[i].external_force.size() ? rollout.inputs[i].external_force : VectorXd::Zero(n);
+      sim.state_forces.Add(s0.x, s0.v, mass, &net);
+      net -= grad_e;
+      dmass -= w.cwiseProduct(net).cwiseQuotient(mass);
       out.external_force[i] = w;
     }
-    // Explicit state forces f(x_i, v_i): dL/df = out.external_force[i].
-    drho += sim.state_forces.AddVjp(s0.x, s0.v, sim.rho(), out.external_force[i], &gx_prev, &gv_prev,
-                                    &out.state_forces);
+    // Explicit state forces f(x_i, v_i; M): dL/df = out.external_force[i].
+    sim.state_forces.AddVjp(s0.x, s0.v, mass, out.external_force[i], &gx_prev, &gv_prev, &out.state_forces,
+                            &dmass);
     if (loss.dx[i].size()) gx_prev += loss.dx[i];
     if (loss.dv[i].size()) gv_prev += loss.dv[i];
     gx = std::move(gx_prev);
@@ -252,11 +269,22 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
   }
   out.x0 = gx;
   out.v0 = gv;
-  double dmu_dE, dmu_dnu, dl_dE, dl_dnu;
-  mat.LameDerivatives(&dmu_dE, &dmu_dnu, &dl_dE, &dl_dnu);
-  out.youngs_modulus = dmu * dmu_dE + dlambda * dl_dE;
-  out.poissons_ratio = dmu * dmu_dnu + dlambda * dl_dnu;
-  out.density = drho;
+  const VectorXd drho = sim.mass_model.DensityGradient(dmass);
+  for (int p = 0; p < parts; ++p) {
+    double dmu_dE, dmu_dnu, dl_dE, dl_dnu;
+    sim.part_material(p).LameDerivatives(&dmu_dE, &dmu_dnu, &dl_dE, &dl_dnu);
+    MaterialComponents g;
+    g.youngs_modulus = dmu(p) * dmu_dE + dlambda(p) * dl_dE;
+    g.poissons_ratio = dmu(p) * dmu_dnu + dlambda(p) * dl_dnu;
+    g.density = drho(p);
+    if (p == 0) {
+      out.youngs_modulus = g.youngs_modulus;
+      out.poissons_ratio = g.poissons_ratio;
+      out.density = g.density;
+    } else {
+      out.region_materials.push_back(g);
+    }
+  }
   out.report.seconds = Seconds(start);
   return out;
 }

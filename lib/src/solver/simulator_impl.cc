@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "diffpd/error.h"
+#include "scene/material_regions.h"
 
 namespace diffpd::internal {
 
@@ -12,9 +13,11 @@ SimulatorImpl::SimulatorImpl(const Scene& scene_in, const SolverOptions& options
     : scene((scene_in.Validate(), scene_in)),
       options((options_in.Validate(), options_in)),
       fem(scene.mesh),
+      part_of_element(PartOfElement(scene)),
+      mass_model(fem, part_of_element, num_parts()),
       elastic(fem, scene.energies),
       aux(fem, scene),
-      state_forces(scene, fem.unit_lumped_mass()) {
+      state_forces(scene) {
   const int n = scene.mesh.num_dofs();
   fixed.assign(n, 0);
   fixed_values = VectorXd::Zero(n);
@@ -22,15 +25,54 @@ SimulatorImpl::SimulatorImpl(const Scene& scene_in, const SolverOptions& options
     fixed[scene.dirichlet.dofs[k]] = 1;
     fixed_values(scene.dirichlet.dofs[k]) = scene.dirichlet.values(k);
   }
-  unit_mass.resize(n);
-  for (int i = 0; i < fem.num_nodes(); ++i) unit_mass.segment<3>(3 * i).setConstant(fem.unit_lumped_mass()(i));
+  MaterialsChanged();
+}
+
+void SimulatorImpl::SetMaterial(const MaterialParameters& material) {
+  scene.material = material;
+  MaterialsChanged();
+}
+
+void SimulatorImpl::SetRegionMaterial(int region, const MaterialParameters& material) {
+  DIFFPD_CHECK(region >= 0 && region < num_parts() - 1, "material region " << region << " out of range");
+  scene.material_regions[region].material = material;
+  MaterialsChanged();
+}
+
+void SimulatorImpl::MaterialsChanged() {
+  std::vector<double> densities;
+  for (int p = 0; p < num_parts(); ++p) densities.push_back(part_material(p).density);
+  mass_model.SetDensities(densities);
+  uniform_lame_ = true;
+  for (int p = 1; p < num_parts(); ++p)
+    uniform_lame_ = uniform_lame_ && part_material(p).mu() == scene.material.mu() &&
+                    part_material(p).lambda() == scene.material.lambda();
+  element_mu_.clear();
+  element_lambda_.clear();
+  if (uniform_lame_) return;
+  std::vector<double> part_mu, part_lambda;
+  for (int p = 0; p < num_parts(); ++p) {
+    part_mu.push_back(part_material(p).mu());
+    part_lambda.push_back(part_material(p).lambda());
+  }
+  element_mu_.resize(part_of_element.size());
+  element_lambda_.resize(part_of_element.size());
+  for (size_t e = 0; e < part_of_element.size(); ++e) {
+    element_mu_[e] = part_mu[part_of_element[e]];
+    element_lambda_[e] = part_lambda[part_of_element[e]];
+  }
+}
+
+LameField SimulatorImpl::lame() const {
+  if (uniform_lame_) return LameField::Uniform(scene.material.mu(), scene.material.lambda());
+  return LameField::PerElement(element_mu_.data(), element_lambda_.data());
 }
 
 VectorXd SimulatorImpl::ExplicitForce(const StepInput& input) const {
   const int n = num_dofs();
   VectorXd f = VectorXd::Zero(n);
   if (scene.gravity) {
-    for (int i = 0; i < n / 3; ++i) f.segment<3>(3 * i) = rho() * unit_mass(3 * i) * (*scene.gravity);
+    for (int i = 0; i < n / 3; ++i) f.segment<3>(3 * i) = Mass()(3 * i) * (*scene.gravity);
   }
   if (input.external_force.size() > 0) f += input.external_force;
   return f;
@@ -48,13 +90,44 @@ HessianAssembler& SimulatorImpl::hessian_assembler() {
 
 PdSystem& SimulatorImpl::pd_system() {
   if (!pd_) {
-    pd_ = std::make_unique<PdSystem>(fem, fixed);
+    pd_ = std::make_unique<PdSystem>(fem, fixed, part_of_element, num_parts());
     if (!aux.empty()) pd_->SetAuxiliaryMatrix(aux.PdMatrix());
   }
-  // PD-LBFGS preconditions with a softer A (SolverOptions::lbfgs_weight_scale).
+  // PD-LBFGS preconditions with a softer A (SolverOptions::lbfgs_weight_scale),
+  // every part's weight scaled alike.
   const double scale = options.method == Method::kPdLbfgs ? options.lbfgs_weight_scale : 1.0;
-  pd_->Update(h(), rho(), scale * elastic.PdWeight(mu(), lambda()));
+  std::vector<double> densities, weights;
+  for (int p = 0; p < num_parts(); ++p) {
+    const MaterialParameters& m = part_material(p);
+    densities.push_back(m.density);
+    weights.push_back(scale * elastic.PdWeight(m.mu(), m.lambda()));
+  }
+  pd_->Update(h(), densities, weights);
   return *pd_;
+}
+
+namespace {
+
+bool SameMaterial(const MaterialParameters& a, const MaterialParameters& b) {
+  return a.youngs_modulus == b.youngs_modulus && a.poissons_ratio == b.poissons_ratio && a.density == b.density;
+}
+
+}  // namespace
+
+bool MadeWithCurrentSettings(const SimulatorImpl& sim, const Rollout& rollout) {
+  if (!SameMaterial(rollout.material, sim.scene.material)) return false;
+  if (rollout.region_materials.size() != sim.scene.material_regions.size()) return false;
+  for (size_t r = 0; r < rollout.region_materials.size(); ++r)
+    if (!SameMaterial(rollout.region_materials[r], sim.scene.material_regions[r].material)) return false;
+  return rollout.options.time_step == sim.h() && rollout.options.method == sim.options.method;
+}
+
+VectorXd GravityPerDof(const SimulatorImpl& sim) {
+  const int n = sim.num_dofs();
+  VectorXd g = VectorXd::Zero(n);
+  if (sim.scene.gravity)
+    for (int i = 0; i < n / 3; ++i) g.segment<3>(3 * i) = *sim.scene.gravity;
+  return g;
 }
 
 StepObjective::StepObjective(SimulatorImpl& sim, VectorXd xhat, VectorXd force, bool static_problem)
@@ -63,7 +136,7 @@ StepObjective::StepObjective(SimulatorImpl& sim, VectorXd xhat, VectorXd force, 
 }
 
 double StepObjective::Evaluate(const VectorXd& x, VectorXd* grad) {
-  const double e = sim_.elastic.EnergyAndGradient(x, sim_.mu(), sim_.lambda(), grad, sim_.threads());
+  const double e = sim_.elastic.EnergyAndGradient(x, sim_.lame(), grad, sim_.threads());
   const VectorXd dx = x - xhat_;
   double value = e + sim_.aux.AddEnergyAndGradient(x, sim_.activation, grad);
   for (int d = 0; d < x.size(); ++d) {

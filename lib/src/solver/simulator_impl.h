@@ -10,6 +10,8 @@
 #include "fem/auxiliary_energies.h"
 #include "fem/elastic_forces.h"
 #include "fem/fem_model.h"
+#include "fem/lame_field.h"
+#include "fem/mass_model.h"
 #include "forces/state_forces.h"
 #include "solver/cholmod_solver.h"
 #include "solver/hessian_assembler.h"
@@ -24,6 +26,10 @@ class SimulatorImpl {
   Scene scene;
   SolverOptions options;
   FemModel fem;
+  // Material parts (scene/material_regions.h): part 0 the base material,
+  // part r + 1 material region r. Empty without regions (one part).
+  std::vector<int> part_of_element;
+  MassModel mass_model;       // M from every part's density
   ElasticForces elastic;
   AuxiliaryEnergies aux;      // muscles, penalty contact (empty: no cost)
   StateForces state_forces;   // damping, hydrodynamics, penalty friction
@@ -37,17 +43,28 @@ class SimulatorImpl {
   // (contact/contact_pin_scope.h), and removed after.
   std::vector<char> fixed;
   VectorXd fixed_values;    // 3n, Dirichlet positions (zero at free DoFs)
-  VectorXd unit_mass;       // 3n, lumped mass per DoF for unit density (m^3)
 
-  double mu() const { return scene.material.mu(); }
-  double lambda() const { return scene.material.lambda(); }
-  double rho() const { return scene.material.density; }
   double h() const { return options.time_step; }
   int threads() const { return options.num_threads; }
   int num_dofs() const { return fem.mesh().num_dofs(); }
 
+  // Material parts: 1 + number of material regions.
+  int num_parts() const { return 1 + static_cast<int>(scene.material_regions.size()); }
+  const MaterialParameters& part_material(int part) const {
+    return part == 0 ? scene.material : scene.material_regions[part - 1].material;
+  }
+  // Replace the base material / region r's material (both validated by the
+  // caller) and update the Lame field and the mass; the PD factor follows
+  // lazily.
+  void SetMaterial(const MaterialParameters& material);
+  void SetRegionMaterial(int region, const MaterialParameters& material);
+  // The Lame parameters of every element: uniform scalars when every part
+  // has the same (mu, lambda) (always without regions), else per element.
+  // Valid until the next material change.
+  LameField lame() const;
+
   // Mass per DoF (3n, kg).
-  VectorXd Mass() const { return rho() * unit_mass; }
+  const VectorXd& Mass() const { return mass_model.mass(); }
   // Explicit force of a step: gravity (if declared) plus the input's force.
   VectorXd ExplicitForce(const StepInput& input) const;
   // Sets fixed DoFs of v to zero.
@@ -60,10 +77,20 @@ class SimulatorImpl {
   int pd_factorizations() const { return pd_ ? pd_->num_factorizations() : 0; }
 
  private:
+  void MaterialsChanged();
+
+  bool uniform_lame_ = true;
+  std::vector<double> element_mu_, element_lambda_;  // per element when !uniform_lame_
   std::unique_ptr<HessianAssembler> hessian_;
   std::unique_ptr<PdSystem> pd_;
   CholmodSolver newton_llt_;
 };
+
+// True when `rollout` was made with the simulator's current materials (base
+// and regions), time step and method: the condition of Backward and Tangents.
+bool MadeWithCurrentSettings(const SimulatorImpl& sim, const Rollout& rollout);
+// Gravity's acceleration at every DoF (3n, m/s^2; zero without gravity).
+VectorXd GravityPerDof(const SimulatorImpl& sim);
 
 // The objective of one implicit Euler step over the free DoFs:
 //   g(x) = 1/(2 h^2) (x - xhat)^T M (x - xhat) - f^T x + E(x),

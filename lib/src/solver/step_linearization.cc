@@ -26,7 +26,7 @@ StepLinearization::StepLinearization(SimulatorImpl& sim, const VectorXd& x, bool
   inertia_ = static_problem ? VectorXd::Zero(sim.num_dofs()) : VectorXd(sim.Mass() / (sim.h() * sim.h()));
   const Method m = sim.options.method;
   if (m == Method::kPd || m == Method::kPdLbfgs)
-    sim.elastic.StressDifferentials(x_, sim.mu(), sim.lambda(), &dstress_, sim.threads());
+    sim.elastic.StressDifferentials(x_, sim.lame(), &dstress_, sim.threads());
 }
 
 VectorXd StepLinearization::Apply(const VectorXd& z) {
@@ -40,7 +40,7 @@ VectorXd StepLinearization::ApplyUnmasked(const VectorXd& z) {
   sim_.ZeroFixed(&zf);
   VectorXd out;
   if (dstress_.empty())
-    sim_.elastic.StressDifferentials(x_, sim_.mu(), sim_.lambda(), &dstress_, sim_.threads());
+    sim_.elastic.StressDifferentials(x_, sim_.lame(), &dstress_, sim_.threads());
   sim_.elastic.ApplyHessian(dstress_, zf, &out, sim_.threads());
   sim_.aux.AddHessianProduct(x_, sim_.activation, zf, &out);
   out.array() += inertia_.array() * zf.array();
@@ -50,7 +50,7 @@ VectorXd StepLinearization::ApplyUnmasked(const VectorXd& z) {
 bool StepLinearization::DirectSolve(const VectorXd& b, VectorXd* z) {
   if (!have_matrix_) {
     std::vector<double> blocks;
-    sim_.elastic.ElementHessians(x_, sim_.mu(), sim_.lambda(), /*project_spd=*/false, &blocks, sim_.threads());
+    sim_.elastic.ElementHessians(x_, sim_.lame(), /*project_spd=*/false, &blocks, sim_.threads());
     sim_.aux.AddElementHessians(x_, sim_.activation, /*project_spd=*/false, &blocks);
     sim_.hessian_assembler().Assemble(blocks, inertia_, sim_.fixed, &matrix_);
     have_matrix_ = true;
@@ -146,7 +146,7 @@ bool StepLinearization::IterativeSolve(const VectorXd& b, VectorXd* z, int* iter
 bool StepLinearization::PcgSolve(const VectorXd& b, VectorXd* z, int* iterations) {
   if (!have_matrix_) {
     std::vector<double> blocks;
-    sim_.elastic.ElementHessians(x_, sim_.mu(), sim_.lambda(), /*project_spd=*/false, &blocks, sim_.threads());
+    sim_.elastic.ElementHessians(x_, sim_.lame(), /*project_spd=*/false, &blocks, sim_.threads());
     sim_.aux.AddElementHessians(x_, sim_.activation, /*project_spd=*/false, &blocks);
     sim_.hessian_assembler().Assemble(blocks, inertia_, sim_.fixed, &matrix_);
     have_matrix_ = true;

@@ -3,14 +3,17 @@
 // Implicit methods: the step x_{i+1} = argmin g(x) satisfies
 //   grad g = M (x_{i+1} - x_i - h v_i) / h^2 - f + grad E(x_{i+1}; mu, lambda) = 0,
 // so, differentiating along a direction,
-//   H dx_{i+1} = M (dx_i + h dv_i) / h^2 + df - dmu grad_mu - dlambda grad_lambda
-//                - drho [m (x_{i+1} - x_i - h v_i) / h^2 - m g],
-// with grad_mu = grad E at (mu, lambda) = (1, 0), grad_lambda likewise, m the
-// unit-density lumped mass and g gravity (when declared). All directions share
-// the step's H (one StepLinearization, several right-hand sides).
+//   H dx_{i+1} = M (dx_i + h dv_i) / h^2 + df - grad E(x_{i+1}; dmu_e, dlambda_e)
+//                - dM [(x_{i+1} - x_i - h v_i) / h^2 - g],
+// with grad E(x; dmu_e, dlambda_e) the elastic gradient evaluated with the
+// direction's Lame components per element (E is linear in each element's
+// (mu_e, lambda_e); per material part p: dmu_p = dmu/dE_p dE_p + dmu/dnu_p dnu_p,
+// likewise lambda), dM = sum_p drho_p m_p the mass direction (m_p the part's
+// unit-density lumped mass) and g gravity (when declared). All directions
+// share the step's H (one StepLinearization, several right-hand sides).
 // Semi-implicit Euler: on free DoFs v_{i+1} = v_i + h M^{-1} (f - grad E(x_i)),
-//   dv_{i+1} = dv_i + h M^{-1} (df - hess E dx_i - dmu grad_mu - dlambda grad_lambda)
-//              - drho (h / rho) M^{-1} (f_user - grad E).
+//   dv_{i+1} = dv_i + h M^{-1} (df - hess E dx_i - grad E(x_i; dmu_e, dlambda_e))
+//              - h dM M^{-2} (f_user - grad E).
 // Both: x_{i+1} is the prescribed value at fixed DoFs (zero tangent there) and
 // v_{i+1} = (x_{i+1} - x_i) / h everywhere.
 // Muscles: grad E is affine in the activations (E = k/2 vol (|F m| - a)^2), so
@@ -53,6 +56,34 @@ InputDirection InputDirection::Density() {
 
 namespace {
 
+InputDirection RegionDirection(int region, int num_regions, double MaterialComponents::*component) {
+  if (region < 0 || region >= num_regions) {
+    std::ostringstream msg;
+    msg << "InputDirection: region " << region << " is out of range [0, " << num_regions << ")";
+    throw InvalidInputError(msg.str());
+  }
+  InputDirection d;
+  d.region_materials.assign(num_regions, MaterialComponents());
+  d.region_materials[region].*component = 1;
+  return d;
+}
+
+}  // namespace
+
+InputDirection InputDirection::RegionYoungsModulus(int region, int num_regions) {
+  return RegionDirection(region, num_regions, &MaterialComponents::youngs_modulus);
+}
+
+InputDirection InputDirection::RegionPoissonsRatio(int region, int num_regions) {
+  return RegionDirection(region, num_regions, &MaterialComponents::poissons_ratio);
+}
+
+InputDirection InputDirection::RegionDensity(int region, int num_regions) {
+  return RegionDirection(region, num_regions, &MaterialComponents::density);
+}
+
+namespace {
+
 using internal::SimulatorImpl;
 
 void CheckDirectionVector(const VectorXd& v, int n, int p, const char* name) {
@@ -70,7 +101,7 @@ void CheckDirectionVector(const VectorXd& v, int n, int p, const char* name) {
   }
 }
 
-void CheckDirections(const std::vector<InputDirection>& dirs, int n, int steps, int num_muscles) {
+void CheckDirections(const std::vector<InputDirection>& dirs, int n, int steps, int num_muscles, int num_regions) {
   if (dirs.empty()) throw InvalidInputError("Tangents: no direction given (need at least one)");
   for (size_t p = 0; p < dirs.size(); ++p) {
     const InputDirection& d = dirs[p];
@@ -108,7 +139,34 @@ void CheckDirections(const std::vector<InputDirection>& dirs, int n, int steps, 
       msg << "Tangents: direction " << p << " has a non-finite material component";
       throw InvalidInputError(msg.str());
     }
+    if (!d.region_materials.empty() && static_cast<int>(d.region_materials.size()) != num_regions) {
+      std::ostringstream msg;
+      msg << "Tangents: direction " << p << " has region_materials for " << d.region_materials.size()
+          << " regions, expected 0 or " << num_regions << " (one per material region)";
+      throw InvalidInputError(msg.str());
+    }
+    for (size_t r = 0; r < d.region_materials.size(); ++r) {
+      const MaterialComponents& c = d.region_materials[r];
+      if (!std::isfinite(c.youngs_modulus) || !std::isfinite(c.poissons_ratio) || !std::isfinite(c.density)) {
+        std::ostringstream msg;
+        msg << "Tangents: direction " << p << " has a non-finite material component for region " << r;
+        throw InvalidInputError(msg.str());
+      }
+    }
   }
+}
+
+// The material components of direction d for material part `part` (0: the
+// base material, r + 1: region r).
+MaterialComponents PartComponents(const InputDirection& d, int part) {
+  if (part == 0) {
+    MaterialComponents c;
+    c.youngs_modulus = d.youngs_modulus;
+    c.poissons_ratio = d.poissons_ratio;
+    c.density = d.density;
+    return c;
+  }
+  return d.region_materials.empty() ? MaterialComponents() : d.region_materials[part - 1];
 }
 
 }  // namespace
@@ -123,13 +181,10 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
   for (const State& s : rollout.states)
     if (s.x.size() != n || s.v.size() != n)
       throw InvalidInputError("Tangents: the rollout's states do not match the scene's number of DoFs");
-  const MaterialParameters& mat = sim.scene.material;
-  if (rollout.material.youngs_modulus != mat.youngs_modulus || rollout.material.poissons_ratio != mat.poissons_ratio ||
-      rollout.material.density != mat.density || rollout.options.time_step != sim.h() ||
-      rollout.options.method != sim.options.method)
+  if (!internal::MadeWithCurrentSettings(sim, rollout))
     throw InvalidInputError(
         "Tangents: the rollout was made with another material, time step or method than the simulator's current ones");
-  CheckDirections(directions, n, steps, sim.aux.num_muscles());
+  CheckDirections(directions, n, steps, sim.aux.num_muscles(), static_cast<int>(sim.scene.material_regions.size()));
   if (!sim.state_forces.empty())
     throw InvalidInputError(
         "Tangents: explicit state forces (linear damping, hydrodynamics, penalty friction) are not differentiated in "
@@ -143,21 +198,52 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
 
   const int num_dirs = static_cast<int>(directions.size());
   const double h = sim.h();
-  const double rho = sim.rho();
-  const VectorXd mass = sim.Mass();
-  double dmu_dE, dmu_dnu, dl_dE, dl_dnu;
-  mat.LameDerivatives(&dmu_dE, &dmu_dnu, &dl_dE, &dl_dnu);
-  VectorXd dmu(num_dirs), dlambda(num_dirs), drho(num_dirs);
-  for (int p = 0; p < num_dirs; ++p) {
-    const InputDirection& d = directions[p];
-    dmu(p) = dmu_dE * d.youngs_modulus + dmu_dnu * d.poissons_ratio;
-    dlambda(p) = dl_dE * d.youngs_modulus + dl_dnu * d.poissons_ratio;
-    drho(p) = d.density;
+  const VectorXd& mass = sim.Mass();
+  // Per direction and material part: Lame components and density component.
+  const int parts = sim.num_parts();
+  MatrixXd dmu(parts, num_dirs), dlambda(parts, num_dirs), drho(parts, num_dirs);
+  for (int q = 0; q < parts; ++q) {
+    double dmu_dE, dmu_dnu, dl_dE, dl_dnu;
+    sim.part_material(q).LameDerivatives(&dmu_dE, &dmu_dnu, &dl_dE, &dl_dnu);
+    for (int p = 0; p < num_dirs; ++p) {
+      const MaterialComponents c = PartComponents(directions[p], q);
+      dmu(q, p) = dmu_dE * c.youngs_modulus + dmu_dnu * c.poissons_ratio;
+      dlambda(q, p) = dl_dE * c.youngs_modulus + dl_dnu * c.poissons_ratio;
+      drho(q, p) = c.density;
+    }
   }
-  const bool need_lame = dmu.any() || dlambda.any();
-  VectorXd gravity_unit = VectorXd::Zero(n);
-  if (sim.scene.gravity)
-    for (int i = 0; i < n / 3; ++i) gravity_unit.segment<3>(3 * i) = sim.unit_mass(3 * i) * (*sim.scene.gravity);
+  // The Lame field of each direction (uniform with one part, else per
+  // element) and its mass direction dM (3n); skipped where zero.
+  std::vector<char> lame_dir(num_dirs), mass_dir(num_dirs);
+  std::vector<std::vector<double>> field_mu(num_dirs), field_lambda(num_dirs);
+  std::vector<VectorXd> dmass(num_dirs);
+  for (int p = 0; p < num_dirs; ++p) {
+    lame_dir[p] = dmu.col(p).any() || dlambda.col(p).any();
+    mass_dir[p] = drho.col(p).any();
+    if (mass_dir[p]) dmass[p] = sim.mass_model.Direction(drho.col(p));
+    if (lame_dir[p] && parts > 1) {
+      field_mu[p].resize(sim.part_of_element.size());
+      field_lambda[p].resize(sim.part_of_element.size());
+      for (size_t e = 0; e < sim.part_of_element.size(); ++e) {
+        field_mu[p][e] = dmu(sim.part_of_element[e], p);
+        field_lambda[p][e] = dlambda(sim.part_of_element[e], p);
+      }
+    }
+  }
+  auto lame_field = [&](int p) {
+    return parts > 1 ? internal::LameField::PerElement(field_mu[p].data(), field_lambda[p].data())
+                     : internal::LameField::Uniform(dmu(0, p), dlambda(0, p));
+  };
+  // *b.col(p) -= grad E(x; direction p's Lame field) for every direction with one.
+  VectorXd grad_dir;
+  auto subtract_lame_terms = [&](const VectorXd& x, MatrixXd* b) {
+    for (int p = 0; p < num_dirs; ++p) {
+      if (!lame_dir[p]) continue;
+      sim.elastic.EnergyAndGradient(x, lame_field(p), &grad_dir, sim.threads());
+      b->col(p) -= grad_dir;
+    }
+  };
+  const VectorXd gravity = internal::GravityPerDof(sim);
 
   TangentRollout out;
   out.dx.resize(steps + 1);
@@ -169,7 +255,6 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
     if (directions[p].v0.size()) out.dv[0].col(p) = directions[p].v0;
   }
 
-  VectorXd grad_mu, grad_lambda;
   const bool implicit = sim.options.method != Method::kSemiImplicit;
   // d(grad E)/da . da at x for every direction with an activation at step i
   // (muscle gradients are affine in the activations), subtracted from *b.
@@ -202,14 +287,11 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
     if (implicit) {
       // Right-hand sides: inertia through xhat, force directions, parameters.
       MatrixXd b = mass.asDiagonal() * (dx0 + h * dv0) / (h * h);
-      if (need_lame) {
-        sim.elastic.EnergyAndGradient(s1.x, 1.0, 0.0, &grad_mu, sim.threads());
-        sim.elastic.EnergyAndGradient(s1.x, 0.0, 1.0, &grad_lambda, sim.threads());
-        b -= grad_mu * dmu.transpose() + grad_lambda * dlambda.transpose();
-      }
+      subtract_lame_terms(s1.x, &b);
       if (drho.any()) {
-        const VectorXd dgrad_drho = sim.unit_mass.cwiseProduct(s1.x - s0.x - h * s0.v) / (h * h) - gravity_unit;
-        b -= dgrad_drho * drho.transpose();
+        const VectorXd dgrad_dmass = (s1.x - s0.x - h * s0.v) / (h * h) - gravity;
+        for (int p = 0; p < num_dirs; ++p)
+          if (mass_dir[p]) b.col(p) -= dmass[p].cwiseProduct(dgrad_dmass);
       }
       for (int p = 0; p < num_dirs; ++p)
         if (!directions[p].external_force.empty() && directions[p].external_force[i].size())
@@ -236,7 +318,7 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
     } else {
       // Acceleration tangent on free DoFs, then symplectic update.
       std::vector<Mat9> dstress;
-      sim.elastic.StressDifferentials(s0.x, sim.mu(), sim.lambda(), &dstress, sim.threads());
+      sim.elastic.StressDifferentials(s0.x, sim.lame(), &dstress, sim.threads());
       MatrixXd force(n, num_dirs);
       for (int p = 0; p < num_dirs; ++p) {
         VectorXd hdx;
@@ -246,20 +328,17 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
         if (!directions[p].external_force.empty() && directions[p].external_force[i].size())
           force.col(p) += directions[p].external_force[i];
       }
-      if (need_lame) {
-        sim.elastic.EnergyAndGradient(s0.x, 1.0, 0.0, &grad_mu, sim.threads());
-        sim.elastic.EnergyAndGradient(s0.x, 0.0, 1.0, &grad_lambda, sim.threads());
-        force -= grad_mu * dmu.transpose() + grad_lambda * dlambda.transpose();
-      }
+      subtract_lame_terms(s0.x, &force);
       subtract_activation_terms(i, s0.x, &force);
       MatrixXd dv1 = dv0 + h * mass.cwiseInverse().asDiagonal() * force;
       if (drho.any()) {
         VectorXd grad_e;
-        sim.elastic.EnergyAndGradient(s0.x, sim.mu(), sim.lambda(), &grad_e, sim.threads());
+        sim.elastic.EnergyAndGradient(s0.x, sim.lame(), &grad_e, sim.threads());
         sim.aux.AddEnergyAndGradient(s0.x, sim.activation, &grad_e);
         const VectorXd& user = rollout.inputs[i].external_force;
-        const VectorXd net = (user.size() ? user : VectorXd::Zero(n)) - grad_e;
-        dv1 -= (h / rho) * net.cwiseQuotient(mass) * drho.transpose();
+        const VectorXd net = ((user.size() ? user : VectorXd::Zero(n)) - grad_e).cwiseQuotient(mass.cwiseAbs2());
+        for (int p = 0; p < num_dirs; ++p)
+          if (mass_dir[p]) dv1.col(p) -= h * dmass[p].cwiseProduct(net);
       }
       dx1 = dx0 + h * dv1;
       for (int d = 0; d < n; ++d)

@@ -9,9 +9,11 @@
 //   // then MarkerCostFunction / RolloutEvaluationCallback / RolloutLossFunction
 //
 // Parameter blocks, in this order (a block is present only if non-empty):
-//  - the material block: the values of `setup.fitted` in physical units
-//    (Pa, 1, kg/m^3), e.g. {E, nu}; the parameters not listed stay at
-//    setup.scene.material. Positivity and log-space steps, intervals:
+//  - the material block: the values of `setup.fitted` (base material,
+//    Scene::material) then of `setup.fitted_regions` (per material region,
+//    Scene::material_regions) in physical units (Pa, 1, kg/m^3), e.g.
+//    {E, nu, E_region0}; the parameters not listed stay at their values in
+//    setup.scene. Positivity and log-space steps, intervals:
 //    CoordinateManifold (coordinate_manifold.h); ranges also by
 //    ceres::Problem::SetParameterLower/UpperBound.
 //  - the input block: `setup.input_parameters` (initial state, forces), e.g.
@@ -45,6 +47,12 @@ namespace diffpd::solvers {
 enum class MaterialParameter { kYoungsModulus, kPoissonsRatio, kDensity };
 // "youngs_modulus", "poissons_ratio", "density".
 const char* ToString(MaterialParameter parameter);
+
+// One parameter of one material region: Scene::material_regions[region].
+struct RegionParameter {
+  int region = 0;  // in [0, scene.material_regions.size())
+  MaterialParameter parameter = MaterialParameter::kYoungsModulus;
+};
 
 // Scene parameters that act through a rollout's differentiable inputs
 // (initial state, per-step external forces and muscle activations).
@@ -96,9 +104,12 @@ struct CalibrationSetup {
   Scene scene;
   SolverOptions solver;
   CapturedMotion motion;
-  // Material parameters in the material block, in this order (may be empty
-  // when input_parameters is set). No repetitions.
+  // Base-material parameters in the material block, in this order (may be
+  // empty when fitted_regions or input_parameters is set). No repetitions.
   std::vector<MaterialParameter> fitted = {MaterialParameter::kYoungsModulus, MaterialParameter::kPoissonsRatio};
+  // Per-region parameters appended to the material block after `fitted`, in
+  // this order (default: none). No repetitions; regions in range.
+  std::vector<RegionParameter> fitted_regions;
   // Base initial state (default: the scene's rest state) and per-step inputs
   // (empty: none; else num_steps entries).
   std::optional<State> initial;
@@ -129,7 +140,10 @@ class CalibrationModel {
  public:
   // Validates the setup (InvalidInputError: the scene, the options, the
   // markers against the mesh, samples beyond num_steps, sizes of initial
-  // state and inputs, an empty or repeated `fitted` without input block).
+  // state and inputs, a repeated `fitted` entry ("fitted lists density
+  // twice"), a region parameter out of range ("fitted_regions[1]: region 2
+  // is out of range [0, 2)") or repeated ("fitted_regions lists
+  // youngs_modulus of region 0 twice"), nothing to fit).
   explicit CalibrationModel(CalibrationSetup setup);
   CalibrationModel(const CalibrationModel&) = delete;
   CalibrationModel& operator=(const CalibrationModel&) = delete;
@@ -143,10 +157,15 @@ class CalibrationModel {
   // Index of the material / input block, or -1 if absent.
   int material_block() const { return material_block_; }
   int input_block() const { return input_block_; }
-  // Fills the material block with setup.scene.material's values.
+  // Fills the material block with setup.scene's values (base material, then
+  // regions).
   void InitialMaterialBlock(double* block) const;
-  // The material at a material block (the others from the setup).
+  // The base material at a material block (the others from the setup).
   MaterialParameters MaterialAt(const double* block) const;
+  // Material region `region`'s material at a material block (the parameters
+  // not in fitted_regions from the setup). Throws InvalidInputError for a
+  // region out of range.
+  MaterialParameters RegionMaterialAt(const double* block, int region) const;
   // Samples grouped by equal time, in order of time: one group per frame.
   std::vector<std::vector<int>> SamplesByFrame() const;
 

@@ -1,0 +1,1 @@
+diffpd_add_test(material_regions_test ${CMAKE_CURRENT_LIST_DIR}/material_regions_test.cc)
