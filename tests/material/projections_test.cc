@@ -188,6 +188,38 @@ TEST(VolumeProjectionTest, PositiveSpectraBelowProductTwoAreProjectedToRounding)
   }
 }
 
+// The batched projection solves the common case lane by lane and hands the
+// others (inverted, large expansion, non-finite) to the single call: every
+// lane must match ProjectSingularValuesToUnitDeterminant to rounding.
+TEST(VolumeProjectionTest, BatchMatchesSingleCallsLaneByLane) {
+  std::mt19937 rng(24);
+  std::uniform_real_distribution<double> strain(-0.3, 0.3);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int count = 1 + trial % kVolumeBatch;
+    Vec3 sigma[kVolumeBatch];
+    for (int l = 0; l < count; ++l) {
+      for (int i = 0; i < 3; ++i) sigma[l](i) = 1.0 + strain(rng) * (trial % 3 == 0 ? 1e-4 : 1.0);
+      std::sort(sigma[l].data(), sigma[l].data() + 3, std::greater<double>());
+    }
+    const int odd = count / 2;
+    if (trial % 5 == 1) sigma[odd](2) = -sigma[odd](2);  // inverted
+    if (trial % 5 == 2) sigma[odd] = Vec3(2.0, 1.9, 1.8);  // prod >= 2: general path
+    if (trial % 5 == 3) sigma[odd](0) = std::numeric_limits<double>::infinity();
+    VolumeProjection batch[kVolumeBatch];
+    ProjectSingularValuesToUnitDeterminantBatch(count, sigma, batch);
+    for (int l = 0; l < count; ++l) {
+      const VolumeProjection single = ProjectSingularValuesToUnitDeterminant(sigma[l]);
+      if (!sigma[l].allFinite()) {
+        EXPECT_TRUE(batch[l].d.array().isNaN().all());
+        continue;
+      }
+      EXPECT_LE((batch[l].d - single.d).norm(), 1e-14) << "trial " << trial << " lane " << l;
+      EXPECT_NEAR(batch[l].multiplier, single.multiplier, 1e-14) << "trial " << trial << " lane " << l;
+      EXPECT_NEAR(batch[l].d.prod(), 1.0, 4e-15);
+    }
+  }
+}
+
 TEST(VolumeProjectionTest, InSetIdempotentInvariantAndClosest) {
   std::mt19937 rng(22);
   std::normal_distribution<double> normal;

@@ -54,13 +54,13 @@ double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F
 }
 
 double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, const Svd3& svd,
-                       double mu, double lambda, Mat3* stress, Mat9* dstress) {
+                       double mu, double lambda, Mat3* stress, Mat9* dstress, const VolumeProjection* volume) {
   double psi = 0;
   if (stress) stress->setZero();
   if (dstress) dstress->setZero();
   Mat3 p;
   for (const ElasticEnergy energy : energies) {
-    psi += EnergyAndStress(energy, F, svd, mu, lambda, stress ? &p : nullptr);
+    psi += EnergyAndStress(energy, F, svd, mu, lambda, stress ? &p : nullptr, volume);
     if (stress) *stress += p;
     if (dstress) *dstress += internal::StressDifferential(energy, F, svd, mu, lambda);
   }
@@ -71,6 +71,7 @@ ElasticForces::ElasticForces(const FemModel& fem, std::vector<ElasticEnergy> ene
     : fem_(fem), energies_(std::move(energies)) {
   for (const ElasticEnergy e : energies_) all_projective_ = all_projective_ && IsProjective(e);
   needs_svd_ = AnyNeedsSvd(energies_);
+  for (const ElasticEnergy e : energies_) needs_volume_ = needs_volume_ || e == ElasticEnergy::kPdVolume;
   element_buffer_.assign(static_cast<size_t>(fem_.num_elements()) * 3 * fem_.nodes_per_element(), 0.0);
   element_energy_.assign(fem_.num_elements(), 0.0);
   v_cache_.assign(fem_.num_samples(), Mat3::Identity());
@@ -101,7 +102,8 @@ void ElasticForces::GatherElementBuffer(VectorXd* out, int threads) const {
 }
 
 template <int K>
-void ElasticForces::SampleDecompositions(const Eigen::Matrix<double, 3, K>& xe, int e, Mat3* F, Svd3* svd) {
+void ElasticForces::SampleDecompositions(const Eigen::Matrix<double, 3, K>& xe, int e, Mat3* F, Svd3* svd,
+                                         VolumeProjection* volume) {
   const int q_per = fem_.samples_per_element();
   DIFFPD_CHECK(q_per <= kSvdBatch, "more samples per element than an SVD batch");
   const int s0 = e * q_per;
@@ -110,6 +112,10 @@ void ElasticForces::SampleDecompositions(const Eigen::Matrix<double, 3, K>& xe, 
   // All samples' SVDs together, warm started from the last ones.
   ComputeSvd3Batch(q_per, F, &v_cache_[s0], svd);
   for (int q = 0; q < q_per; ++q) v_cache_[s0 + q] = svd[q].V;
+  if (!needs_volume_ || volume == nullptr) return;
+  Vec3 sigma[kSvdBatch];
+  for (int q = 0; q < q_per; ++q) sigma[q] = svd[q].sigma;
+  ProjectSingularValuesToUnitDeterminantBatch(q_per, sigma, volume);
 }
 
 template <int K>
@@ -126,13 +132,15 @@ double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, const LameField& 
     Mat3 F[kSvdBatch];
     Svd3 svd[kSvdBatch];
     const int s0 = e * q_per;
-    SampleDecompositions<K>(xe, e, F, svd);
+    VolumeProjection volume[kSvdBatch];
+    SampleDecompositions<K>(xe, e, F, svd, volume);
     for (int q = 0; q < q_per; ++q) {
       const int s = s0 + q;
       const double* g = fem_.grad(s);
       Mat3 P;
       const double vol = fem_.sample_volume(s);
-      energy += vol * EvaluateDensity(energies_, F[q], svd[q], mu, lambda, grad ? &P : nullptr, nullptr);
+      energy += vol * EvaluateDensity(energies_, F[q], svd[q], mu, lambda, grad ? &P : nullptr, nullptr,
+                                      needs_volume_ ? &volume[q] : nullptr);
       if (grad) fe.noalias() += (vol * P) * Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
     }
     element_energy_[e] = energy;
@@ -165,13 +173,15 @@ void ElasticForces::PartLameDotsImpl(const VectorXd& x, const VectorXd& z, const
     Mat3 F[kSvdBatch];
     Svd3 svd[kSvdBatch];
     const int s0 = e * q_per;
-    SampleDecompositions<K>(xe, e, F, svd);
+    VolumeProjection volume[kSvdBatch];
+    SampleDecompositions<K>(xe, e, F, svd, volume);
     for (int q = 0; q < q_per; ++q) {
       const int s = s0 + q;
       const double* g = fem_.grad(s);
-      Mat3 p_mu, p_lambda;  // one SVD serves both unit-parameter stresses
-      EvaluateDensity(energies_, F[q], svd[q], 1.0, 0.0, &p_mu, nullptr);
-      EvaluateDensity(energies_, F[q], svd[q], 0.0, 1.0, &p_lambda, nullptr);
+      Mat3 p_mu, p_lambda;  // one SVD and projection serve both unit-parameter stresses
+      const VolumeProjection* vq = needs_volume_ ? &volume[q] : nullptr;
+      EvaluateDensity(energies_, F[q], svd[q], 1.0, 0.0, &p_mu, nullptr, vq);
+      EvaluateDensity(energies_, F[q], svd[q], 0.0, 1.0, &p_lambda, nullptr, vq);
       const auto gt = Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
       const double vol = fem_.sample_volume(s);
       f_mu.noalias() += (vol * p_mu) * gt;

@@ -17,6 +17,7 @@
 #include "diffpd/types.h"
 #include "fem/fem_model.h"
 #include "fem/lame_field.h"
+#include "material/projections.h"
 #include "material/svd3.h"
 
 namespace diffpd::internal {
@@ -75,9 +76,12 @@ class ElasticForces {
                            int threads);
   // Deformation gradients F[q] of element e's samples (nodal positions xe)
   // and, when an energy needs them, their SVDs (svd[q]), computed as one
-  // batch warm started from and written back to v_cache_.
+  // batch warm started from and written back to v_cache_, and (pd-volume
+  // declared and volume != nullptr) the volume projections of their
+  // singular values, also as one batch.
   template <int K>
-  void SampleDecompositions(const Eigen::Matrix<double, 3, K>& xe, int e, Mat3* F, Svd3* svd);
+  void SampleDecompositions(const Eigen::Matrix<double, 3, K>& xe, int e, Mat3* F, Svd3* svd,
+                            VolumeProjection* volume);
   // Sums the per-element 3 x K buffer into a 3n vector, in parallel over nodes.
   void GatherElementBuffer(VectorXd* out, int threads) const;
 
@@ -85,6 +89,7 @@ class ElasticForces {
   std::vector<ElasticEnergy> energies_;
   bool all_projective_ = true;
   bool needs_svd_ = false;
+  bool needs_volume_ = false;  // pd-volume declared
   std::vector<double> element_buffer_;  // 3 * K per element
   std::vector<double> element_energy_;  // per element
   std::vector<double> element_dot_;     // per element (PartLameDots' lambda dots)
@@ -99,8 +104,10 @@ class ElasticForces {
 double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, double mu,
                        double lambda, Mat3* stress, Mat9* dstress, Mat3* v_cache = nullptr);
 // The same with the signed SVD of F given (ignored when no energy needs it).
+// `volume`, when given, is the pd-volume projection of svd.sigma precomputed.
 double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, const Svd3& svd,
-                       double mu, double lambda, Mat3* stress, Mat9* dstress);
+                       double mu, double lambda, Mat3* stress, Mat9* dstress,
+                       const VolumeProjection* volume = nullptr);
 // True when one of `energies` needs the SVD of F.
 bool AnyNeedsSvd(const std::vector<ElasticEnergy>& energies);
 

@@ -48,8 +48,8 @@ Mat9 CorotatedStressDifferential(const Svd3& svd, double mu, double lambda) {
   return AssembleIsotropicDifferential(svd, c);
 }
 
-double VolumeEnergyAndStress(const Svd3& svd, double lambda, Mat3* stress) {
-  const Vec3 residual = svd.sigma - ProjectSingularValuesToUnitDeterminant(svd.sigma).d;
+double VolumeEnergyAndStress(const Svd3& svd, double lambda, Mat3* stress, const VolumeProjection* volume) {
+  const Vec3 residual = svd.sigma - (volume ? volume->d : ProjectSingularValuesToUnitDeterminant(svd.sigma).d);
   if (stress != nullptr) {
     *stress = svd.U * (lambda * residual).asDiagonal() * svd.V.transpose();
   }
@@ -95,14 +95,14 @@ Mat9 StressDifferential(ElasticEnergy energy, const Mat3& F, double mu, double l
 }
 
 double EnergyAndStress(ElasticEnergy energy, const Mat3& F, const Svd3& svd, double mu,
-                       double lambda, Mat3* stress) {
+                       double lambda, Mat3* stress, const VolumeProjection* volume) {
   switch (energy) {
     case ElasticEnergy::kCorotated:
       return CorotatedEnergyAndStress(svd, mu, lambda, stress);
     case ElasticEnergy::kPdCorotated:
       return CorotatedEnergyAndStress(svd, mu, 0.0, stress);
     case ElasticEnergy::kPdVolume:
-      return VolumeEnergyAndStress(svd, lambda, stress);
+      return VolumeEnergyAndStress(svd, lambda, stress, volume);
     case ElasticEnergy::kLinear:
     case ElasticEnergy::kNeoHookean:
       break;

@@ -18,6 +18,7 @@
 
 #include "diffpd/material.h"
 #include "diffpd/types.h"
+#include "material/projections.h"
 #include "material/svd3.h"
 
 namespace diffpd::internal {
@@ -35,9 +36,10 @@ Mat9 StressDifferential(ElasticEnergy energy, const Mat3& F, double mu, double l
 
 // Combined kernels with svd = ComputeSvd3(F) precomputed (ignored by the
 // energies that do not need it): the energy density, and the stress into
-// *stress when stress != nullptr.
+// *stress when stress != nullptr. `volume`, when given, is
+// ProjectSingularValuesToUnitDeterminant(svd.sigma) precomputed (pd-volume).
 double EnergyAndStress(ElasticEnergy energy, const Mat3& F, const Svd3& svd, double mu,
-                       double lambda, Mat3* stress);
+                       double lambda, Mat3* stress, const VolumeProjection* volume = nullptr);
 Mat9 StressDifferential(ElasticEnergy energy, const Mat3& F, const Svd3& svd, double mu,
                         double lambda);
 

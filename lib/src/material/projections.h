@@ -26,6 +26,12 @@ struct VolumeProjection {
   double multiplier; // Lagrange multiplier of the determinant constraint
 };
 VolumeProjection ProjectSingularValuesToUnitDeterminant(const Vec3& sigma);
+// out[i] = ProjectSingularValuesToUnitDeterminant(sigma[i]) for i < count
+// (<= kVolumeBatch), the common case (all sigma > 0, prod < 2) solved for all
+// entries together lane by lane (OpenMP SIMD), the others one by one.
+// Results match the single calls to rounding.
+constexpr int kVolumeBatch = 8;
+void ProjectSingularValuesToUnitDeterminantBatch(int count, const Vec3* sigma, VolumeProjection* out);
 Mat3 ProjectToUnitDeterminant(const Svd3& svd);
 Mat9 UnitDeterminantProjectionDifferential(const Svd3& svd);
 

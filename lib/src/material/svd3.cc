@@ -35,6 +35,7 @@
 #include <Eigen/LU>
 
 #include "diffpd/error.h"
+#include "material/simd_dispatch.h"
 
 namespace diffpd::internal {
 namespace {
@@ -147,16 +148,6 @@ inline bool NeedsNoRescaling(const Mat3& F) {
 // lane by lane; a lane whose columns are already orthogonal gets c = 1,
 // s = 0, which leaves it unchanged exactly, so every lane ends as its own
 // scalar sweep would.
-// The batch kernels are forced inline into each target clone of BatchSvd:
-// a call from a wide-vector clone into a baseline (SSE) function would run it
-// with the upper vector halves dirty, which slows every later SSE instruction
-// of the process (measured: the whole local step 1.8x slower).
-#if defined(__GNUC__)
-#define DIFFPD_BATCH_INLINE inline __attribute__((always_inline))
-#else
-#define DIFFPD_BATCH_INLINE inline
-#endif
-
 struct alignas(64) BatchColumns {
   double b[9][kSvdBatch];
   double v[9][kSvdBatch];
@@ -165,7 +156,7 @@ struct alignas(64) BatchColumns {
   double det_sign_reference[kSvdBatch];
 };
 
-DIFFPD_BATCH_INLINE bool OrthogonalizeBatchColumns(BatchColumns& m, int i, int j) {
+DIFFPD_SIMD_INLINE bool OrthogonalizeBatchColumns(BatchColumns& m, int i, int j) {
   int any = 0;
   const double eps2 = kEps * kEps;
 #pragma omp simd reduction(| : any)
@@ -206,7 +197,7 @@ DIFFPD_BATCH_INLINE bool OrthogonalizeBatchColumns(BatchColumns& m, int i, int j
 
 // Swaps columns i and j of B and V (and their squared norms) in the lanes
 // where norm_i < norm_j, flipping those lanes' permutation parity.
-DIFFPD_BATCH_INLINE void BatchSortPair(BatchColumns& m, double (&norms)[3][kSvdBatch], double* odd, int i, int j) {
+DIFFPD_SIMD_INLINE void BatchSortPair(BatchColumns& m, double (&norms)[3][kSvdBatch], double* odd, int i, int j) {
 #pragma omp simd
   for (int l = 0; l < kSvdBatch; ++l) {
     const bool swap = norms[i][l] < norms[j][l];
@@ -227,7 +218,7 @@ DIFFPD_BATCH_INLINE void BatchSortPair(BatchColumns& m, double (&norms)[3][kSvdB
 
 // GivensZero lane by lane (rows p, q of B, zeroing B(q, col)); lanes with
 // a = b = 0 get c = 1, s = 0, i.e. no change, as the scalar code skips them.
-DIFFPD_BATCH_INLINE void BatchGivens(BatchColumns& m, int p, int q, int col) {
+DIFFPD_SIMD_INLINE void BatchGivens(BatchColumns& m, int p, int q, int col) {
 #pragma omp simd
   for (int l = 0; l < kSvdBatch; ++l) {
     const double a = m.b[p + 3 * col][l], b = m.b[q + 3 * col][l];
@@ -250,7 +241,7 @@ DIFFPD_BATCH_INLINE void BatchGivens(BatchColumns& m, int p, int q, int col) {
 
 // FinishSvd (steps 2 and 3) lane by lane, the same operations with selects
 // for branches; lanes are unscaled (exponent 0).
-DIFFPD_BATCH_INLINE void BatchFinish(BatchColumns& m) {
+DIFFPD_SIMD_INLINE void BatchFinish(BatchColumns& m) {
   double norms[3][kSvdBatch];
   double odd[kSvdBatch];
 #pragma omp simd
@@ -288,14 +279,8 @@ DIFFPD_BATCH_INLINE void BatchFinish(BatchColumns& m) {
   }
 }
 
-// The batch's sweeps and finish, compiled for the widest vector unit the machine has
-// (AVX-512: one instruction per 8 lanes; AVX2; else the build's baseline),
-// chosen once at load time. The rest of the library keeps the baseline
-// instruction set, so binaries stay portable and Eigen's alignment (an ABI
-// matter for code linking the library) does not depend on the machine.
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#endif
+// The batch's sweeps and finish, one clone per vector width (simd_dispatch.h).
+DIFFPD_SIMD_CLONES
 void BatchSvd(BatchColumns& m) {
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
     bool rotated = OrthogonalizeBatchColumns(m, 0, 1);

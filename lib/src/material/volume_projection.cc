@@ -30,7 +30,9 @@
 
 #include <Eigen/LU>
 
+#include "diffpd/error.h"
 #include "material/projections.h"
+#include "material/simd_dispatch.h"
 
 namespace diffpd::internal {
 namespace {
@@ -226,40 +228,92 @@ double SolvePositive(const Vec3& s, VolumeProjection* best) {
 // prod(sigma) < 2, where the minimiser is the unique root of the growing
 // branch (no shrinking-branch candidate exists, see above, and no sign flip
 // is considered): d_i = D(sigma_i, mu) for all i, with mu the root of
-//   h(mu) = sum_i log D(sigma_i, mu),   h' = sum_i 1 / (D_i r_i) > 0,
-//   h'' = -sum_i (1 + 2 D_i / r_i) / (D_i r_i)^2 < 0,   r_i = sqrt(sigma_i^2 + 4 mu),
-// on mu > -sigma_2^2 / 4. Halley's iteration from the first-order guess
-// mu_0 = -log(prod sigma) / sum_i sigma_i^-2 (exact for infinitesimal strain)
-// converges cubically: for the strains of a typical PD iteration two
-// evaluations of h suffice, against ~4 plus a cube root for the general path.
-// Returns false (the caller then takes the general path) if an iterate
-// leaves the domain or the iteration has not converged in a few steps.
+//   f(mu) = prod_i D(sigma_i, mu) - 1,  r_i = sqrt(sigma_i^2 + 4 mu),
+//   f' = P sum_i a_i,  f'' = P ((sum_i a_i)^2 - sum_i (1 + 2 D_i / r_i) a_i^2),
+//   a_i = 1 / (D_i r_i),  P = prod_i D_i,
+// on mu > -sigma_2^2 / 4 (f is increasing there). Halley's iteration from
+// the first-order guess mu_0 = -log(prod sigma) / sum_i sigma_i^-2 (with
+// log p ~ 2 (p - 1) / (p + 1)) converges cubically: two or three evaluations
+// of f for the strains of a typical PD iteration, against ~4 plus a cube
+// root and logarithms for the general path; no logarithm, so the batched
+// form below vectorises. The iteration stops when |P - 1| <= 4 eps.
+constexpr int kMaxHalleySteps = 8;
+DIFFPD_SIMD_INLINE bool FastPathApplies(const Vec3& s) { return s(2) > 0.0 && s.allFinite() && s.prod() < 2.0; }
+DIFFPD_SIMD_INLINE double FirstOrderMultiplier(double s0, double s1, double s2) {
+  const double p = s0 * s1 * s2;
+  const double inv0 = 1.0 / s0, inv1 = 1.0 / s1, inv2 = 1.0 / s2;
+  return -2.0 * (p - 1.0) / ((p + 1.0) * (inv0 * inv0 + inv1 * inv1 + inv2 * inv2));
+}
+// One Halley evaluation at mu: d_i, the residual f = P - 1 and the next mu.
+DIFFPD_SIMD_INLINE double HalleyStep(const double* s, double mu, double* d, double* residual) {
+  double product = 1.0, sum = 0.0, curvature = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const double r = std::sqrt(s[i] * s[i] + 4.0 * mu);
+    d[i] = 0.5 * (s[i] + r);
+    const double a = 1.0 / (d[i] * r);
+    product *= d[i];
+    sum += a;
+    curvature += (1.0 + 2.0 * d[i] / r) * a * a;
+  }
+  const double f = product - 1.0;
+  const double df = product * sum;
+  const double d2f = product * (sum * sum - curvature);
+  *residual = f;
+  return mu - 2.0 * f * df / (2.0 * df * df - f * d2f);
+}
+
 bool GrowingRootByMultiplier(const Vec3& s, VolumeProjection* out) {
-  const double log_product = std::log(s(0) * s(1) * s(2));
-  const Vec3 inv = s.cwiseInverse();
-  double mu = -log_product / inv.squaredNorm();
+  double mu = FirstOrderMultiplier(s(0), s(1), s(2));
   const double mu_floor = -0.25 * s(2) * s(2);
-  constexpr int kMaxHalleySteps = 6;
   for (int iteration = 0; iteration <= kMaxHalleySteps; ++iteration) {
     if (!(mu > mu_floor)) return false;
-    Vec3 d;
-    double dh = 0, d2h = 0;
-    for (int i = 0; i < 3; ++i) {
-      const double r = std::sqrt(s(i) * s(i) + 4.0 * mu);
-      d(i) = 0.5 * (s(i) + r);
-      const double dr = 1.0 / (d(i) * r);
-      dh += dr;
-      d2h -= (1.0 + 2.0 * d(i) / r) * dr * dr;
-    }
-    const double h = std::log(d(0) * d(1) * d(2));
-    if (std::abs(h) <= 4.0 * kEps) {
-      out->d = d;
+    double d[3], residual;
+    const double next = HalleyStep(s.data(), mu, d, &residual);
+    if (std::abs(residual) <= 4.0 * kEps) {
+      out->d = Vec3(d[0], d[1], d[2]);
       out->multiplier = mu;
       return true;
     }
-    mu -= 2.0 * h * dh / (2.0 * dh * dh - h * d2h);
+    mu = next;
   }
   return false;
+}
+
+// The fast path for kVolumeBatch targets at once, lane by lane (structure of
+// arrays, OpenMP SIMD). done[l] is set for the lanes that converged, whose
+// d and mu are then those of the scalar fast path up to rounding.
+struct alignas(64) VolumeBatch {
+  double s[3][kVolumeBatch];
+  double d[3][kVolumeBatch];
+  double mu[kVolumeBatch];
+  double done[kVolumeBatch];  // 1 when converged, else 0
+};
+
+// One clone per vector width (simd_dispatch.h).
+DIFFPD_SIMD_CLONES
+void BatchGrowingRoots(VolumeBatch& b) {
+#pragma omp simd
+  for (int l = 0; l < kVolumeBatch; ++l) {
+    b.mu[l] = FirstOrderMultiplier(b.s[0][l], b.s[1][l], b.s[2][l]);
+    b.done[l] = 0.0;
+  }
+  for (int iteration = 0; iteration <= kMaxHalleySteps; ++iteration) {
+    int pending = 0;
+#pragma omp simd reduction(+ : pending)
+    for (int l = 0; l < kVolumeBatch; ++l) {
+      const double s[3] = {b.s[0][l], b.s[1][l], b.s[2][l]};
+      const double mu = b.mu[l];
+      const bool active = b.done[l] == 0.0 && mu > -0.25 * s[2] * s[2];
+      double d[3], residual;
+      const double next = HalleyStep(s, active ? mu : 0.0, d, &residual);
+      const bool converged = active && std::abs(residual) <= 4.0 * kEps;
+      for (int i = 0; i < 3; ++i) b.d[i][l] = converged ? d[i] : b.d[i][l];
+      b.done[l] = converged ? 1.0 : b.done[l];
+      b.mu[l] = active && !converged ? next : mu;
+      pending += active && !converged ? 1 : 0;
+    }
+    if (pending == 0) break;
+  }
 }
 
 }  // namespace
@@ -270,7 +324,7 @@ VolumeProjection ProjectSingularValuesToUnitDeterminant(const Vec3& sigma) {
     return {Vec3::Constant(nan), nan};
   }
   VolumeProjection best{Vec3::Ones(), 0.0};
-  if (sigma(2) > 0.0 && sigma.prod() < 2.0 && GrowingRootByMultiplier(sigma, &best)) return best;
+  if (FastPathApplies(sigma) && GrowingRootByMultiplier(sigma, &best)) return best;
   const double distance = SolvePositive(sigma, &best);
   if (sigma(2) < 0.0) {
     // Signs (+, -, -): d = flip .* d', d' the all-positive solution for
@@ -329,6 +383,28 @@ IsotropicDifferentialCoefficients UnitDeterminantProjectionCoefficients(
     c.symmetric(k) = (d(i) - d(j)) / denominator;
   }
   return c;
+}
+
+void ProjectSingularValuesToUnitDeterminantBatch(int count, const Vec3* sigma, VolumeProjection* out) {
+  DIFFPD_CHECK(count >= 0 && count <= kVolumeBatch, "ProjectSingularValuesToUnitDeterminantBatch: count = " << count);
+  VolumeBatch b;
+  bool fast[kVolumeBatch];
+  for (int l = 0; l < kVolumeBatch; ++l) {
+    fast[l] = l < count && FastPathApplies(sigma[l]);
+    for (int i = 0; i < 3; ++i) {
+      b.s[i][l] = fast[l] ? sigma[l](i) : 1.0;  // idle lanes: sigma = (1, 1, 1)
+      b.d[i][l] = 1.0;
+    }
+  }
+  BatchGrowingRoots(b);
+  for (int l = 0; l < count; ++l) {
+    if (fast[l] && b.done[l] != 0.0) {
+      out[l].d = Vec3(b.d[0][l], b.d[1][l], b.d[2][l]);
+      out[l].multiplier = b.mu[l];
+    } else {
+      out[l] = ProjectSingularValuesToUnitDeterminant(sigma[l]);
+    }
+  }
 }
 
 }  // namespace diffpd::internal
