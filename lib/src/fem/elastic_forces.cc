@@ -1,5 +1,6 @@
 #include "fem/elastic_forces.h"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <mutex>
@@ -18,12 +19,12 @@ constexpr int kMinParallelElements = 256;
 // Runs body(e) for e in [0, m) in parallel and rethrows the first exception
 // after the loop (exceptions must not leave an OpenMP region).
 template <class Body>
-void ParallelForElements(int m, int threads, Body&& body) {
+void ParallelForElements(int m, int threads, Body&& body, int min_parallel = kMinParallelElements) {
   std::exception_ptr error;
   std::mutex error_mutex;
   // Small meshes run serially: a parallel region costs more than it saves.
   const int nt = threads > 0 ? threads : 0;
-#pragma omp parallel for schedule(static) num_threads(nt) if (nt != 1 && m >= kMinParallelElements)
+#pragma omp parallel for schedule(static) num_threads(nt) if (nt != 1 && m >= min_parallel)
   for (int e = 0; e < m; ++e) {
     try {
       body(e);
@@ -33,6 +34,18 @@ void ParallelForElements(int m, int threads, Body&& body) {
     }
   }
   if (error) std::rethrow_exception(error);
+}
+
+// Runs body(e0, count) over groups of consecutive elements whose quadrature
+// points fill one SVD batch (8 tetrahedra of 1 point, or 1 hexahedron of 8),
+// in parallel over groups.
+template <class Body>
+void ParallelForSampleBatches(int num_elements, int samples_per_element, int threads, Body&& body) {
+  const int per = std::max(1, kSvdBatch / samples_per_element);
+  const int groups = (num_elements + per - 1) / per;
+  ParallelForElements(
+      groups, threads, [&](int g) { body(g * per, std::min(per, num_elements - g * per)); },
+      std::max(1, kMinParallelElements / per));
 }
 
 }  // namespace
@@ -102,49 +115,53 @@ void ElasticForces::GatherElementBuffer(VectorXd* out, int threads) const {
 }
 
 template <int K>
-void ElasticForces::SampleDecompositions(const Eigen::Matrix<double, 3, K>& xe, int e, Mat3* F, Svd3* svd,
+void ElasticForces::SampleDecompositions(const VectorXd& x, int e0, int count, Mat3* F, Svd3* svd,
                                          VolumeProjection* volume) {
   const int q_per = fem_.samples_per_element();
-  DIFFPD_CHECK(q_per <= kSvdBatch, "more samples per element than an SVD batch");
-  const int s0 = e * q_per;
-  for (int q = 0; q < q_per; ++q) F[q] = DeformationGradient<K>(xe, fem_.grad(s0 + q));
+  const int n = count * q_per;
+  DIFFPD_CHECK(n <= kSvdBatch, "more samples than an SVD batch: " << n);
+  const int s0 = e0 * q_per;
+  for (int j = 0; j < count; ++j) {
+    const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(fem_.mesh(), x, e0 + j);
+    for (int q = 0; q < q_per; ++q) F[j * q_per + q] = DeformationGradient<K>(xe, fem_.grad(s0 + j * q_per + q));
+  }
   if (!needs_svd_) return;
   // All samples' SVDs together, warm started from the last ones.
-  ComputeSvd3Batch(q_per, F, &v_cache_[s0], svd);
-  for (int q = 0; q < q_per; ++q) v_cache_[s0 + q] = svd[q].V;
+  ComputeSvd3Batch(n, F, &v_cache_[s0], svd);
+  for (int i = 0; i < n; ++i) v_cache_[s0 + i] = svd[i].V;
   if (!needs_volume_ || volume == nullptr) return;
   Vec3 sigma[kSvdBatch];
-  for (int q = 0; q < q_per; ++q) sigma[q] = svd[q].sigma;
-  ProjectSingularValuesToUnitDeterminantBatch(q_per, sigma, volume);
+  for (int i = 0; i < n; ++i) sigma[i] = svd[i].sigma;
+  ProjectSingularValuesToUnitDeterminantBatch(n, sigma, volume);
 }
 
 template <int K>
 double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, const LameField& lame, VectorXd* grad,
                                             int threads) {
   if (!x.allFinite()) throw SolverError(SolverStatus::kNonFinite, "positions are not finite");
-  const Mesh& mesh = fem_.mesh();
   const int q_per = fem_.samples_per_element();
-  ParallelForElements(fem_.num_elements(), threads, [&](int e) {
-    const double mu = lame.mu_of(e), lambda = lame.lambda_of(e);
-    const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(mesh, x, e);
-    Eigen::Matrix<double, 3, K> fe = Eigen::Matrix<double, 3, K>::Zero();
-    double energy = 0;
+  ParallelForSampleBatches(fem_.num_elements(), q_per, threads, [&](int e0, int count) {
     Mat3 F[kSvdBatch];
     Svd3 svd[kSvdBatch];
-    const int s0 = e * q_per;
     VolumeProjection volume[kSvdBatch];
-    SampleDecompositions<K>(xe, e, F, svd, volume);
-    for (int q = 0; q < q_per; ++q) {
-      const int s = s0 + q;
-      const double* g = fem_.grad(s);
-      Mat3 P;
-      const double vol = fem_.sample_volume(s);
-      energy += vol * EvaluateDensity(energies_, F[q], svd[q], mu, lambda, grad ? &P : nullptr, nullptr,
-                                      needs_volume_ ? &volume[q] : nullptr);
-      if (grad) fe.noalias() += (vol * P) * Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
+    SampleDecompositions<K>(x, e0, count, F, svd, volume);
+    for (int j = 0; j < count; ++j) {
+      const int e = e0 + j;
+      const double mu = lame.mu_of(e), lambda = lame.lambda_of(e);
+      Eigen::Matrix<double, 3, K> fe = Eigen::Matrix<double, 3, K>::Zero();
+      double energy = 0;
+      for (int q = 0; q < q_per; ++q) {
+        const int i = j * q_per + q, s = e * q_per + q;
+        const double* g = fem_.grad(s);
+        Mat3 P;
+        const double vol = fem_.sample_volume(s);
+        energy += vol * EvaluateDensity(energies_, F[i], svd[i], mu, lambda, grad ? &P : nullptr, nullptr,
+                                        needs_volume_ ? &volume[i] : nullptr);
+        if (grad) fe.noalias() += (vol * P) * Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
+      }
+      element_energy_[e] = energy;
+      if (grad) Eigen::Map<Eigen::Matrix<double, 3, K>>(element_buffer_.data() + static_cast<size_t>(e) * 3 * K) = fe;
     }
-    element_energy_[e] = energy;
-    if (grad) Eigen::Map<Eigen::Matrix<double, 3, K>>(element_buffer_.data() + static_cast<size_t>(e) * 3 * K) = fe;
   });
   double total = 0;
   for (double v : element_energy_) total += v;
@@ -166,29 +183,30 @@ void ElasticForces::PartLameDotsImpl(const VectorXd& x, const VectorXd& z, const
   const Mesh& mesh = fem_.mesh();
   const int q_per = fem_.samples_per_element();
   element_dot_.resize(fem_.num_elements());
-  ParallelForElements(fem_.num_elements(), threads, [&](int e) {
-    const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(mesh, x, e);
-    const Eigen::Matrix<double, 3, K> ze = GatherElement<K>(mesh, z, e);
-    Eigen::Matrix<double, 3, K> f_mu = Eigen::Matrix<double, 3, K>::Zero(), f_lambda = f_mu;
+  ParallelForSampleBatches(fem_.num_elements(), q_per, threads, [&](int e0, int count) {
     Mat3 F[kSvdBatch];
     Svd3 svd[kSvdBatch];
-    const int s0 = e * q_per;
     VolumeProjection volume[kSvdBatch];
-    SampleDecompositions<K>(xe, e, F, svd, volume);
-    for (int q = 0; q < q_per; ++q) {
-      const int s = s0 + q;
-      const double* g = fem_.grad(s);
-      Mat3 p_mu, p_lambda;  // one SVD and projection serve both unit-parameter stresses
-      const VolumeProjection* vq = needs_volume_ ? &volume[q] : nullptr;
-      EvaluateDensity(energies_, F[q], svd[q], 1.0, 0.0, &p_mu, nullptr, vq);
-      EvaluateDensity(energies_, F[q], svd[q], 0.0, 1.0, &p_lambda, nullptr, vq);
-      const auto gt = Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
-      const double vol = fem_.sample_volume(s);
-      f_mu.noalias() += (vol * p_mu) * gt;
-      f_lambda.noalias() += (vol * p_lambda) * gt;
+    SampleDecompositions<K>(x, e0, count, F, svd, volume);
+    for (int j = 0; j < count; ++j) {
+      const int e = e0 + j;
+      const Eigen::Matrix<double, 3, K> ze = GatherElement<K>(mesh, z, e);
+      Eigen::Matrix<double, 3, K> f_mu = Eigen::Matrix<double, 3, K>::Zero(), f_lambda = f_mu;
+      for (int q = 0; q < q_per; ++q) {
+        const int i = j * q_per + q, s = e * q_per + q;
+        const double* g = fem_.grad(s);
+        Mat3 p_mu, p_lambda;  // one SVD and projection serve both unit-parameter stresses
+        const VolumeProjection* vq = needs_volume_ ? &volume[i] : nullptr;
+        EvaluateDensity(energies_, F[i], svd[i], 1.0, 0.0, &p_mu, nullptr, vq);
+        EvaluateDensity(energies_, F[i], svd[i], 0.0, 1.0, &p_lambda, nullptr, vq);
+        const auto gt = Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
+        const double vol = fem_.sample_volume(s);
+        f_mu.noalias() += (vol * p_mu) * gt;
+        f_lambda.noalias() += (vol * p_lambda) * gt;
+      }
+      element_energy_[e] = ze.cwiseProduct(f_mu).sum();
+      element_dot_[e] = ze.cwiseProduct(f_lambda).sum();
     }
-    element_energy_[e] = ze.cwiseProduct(f_mu).sum();
-    element_dot_[e] = ze.cwiseProduct(f_lambda).sum();
   });
   *dmu = VectorXd::Zero(num_parts);
   *dlambda = VectorXd::Zero(num_parts);

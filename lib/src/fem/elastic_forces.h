@@ -74,14 +74,14 @@ class ElasticForces {
   template <int K>
   void ElementHessiansImpl(const VectorXd& x, const LameField& lame, bool project_spd, std::vector<double>* blocks,
                            int threads);
-  // Deformation gradients F[q] of element e's samples (nodal positions xe)
-  // and, when an energy needs them, their SVDs (svd[q]), computed as one
-  // batch warm started from and written back to v_cache_, and (pd-volume
-  // declared and volume != nullptr) the volume projections of their
-  // singular values, also as one batch.
+  // Deformation gradients F[i] of the samples of elements e0 .. e0+count-1
+  // at positions x (count * samples_per_element <= kSvdBatch, in sample
+  // order) and, when an energy needs them, their SVDs (svd[i]), computed as
+  // one batch warm started from and written back to v_cache_, and (pd-volume
+  // declared and volume != nullptr) the volume projections of their singular
+  // values, also as one batch.
   template <int K>
-  void SampleDecompositions(const Eigen::Matrix<double, 3, K>& xe, int e, Mat3* F, Svd3* svd,
-                            VolumeProjection* volume);
+  void SampleDecompositions(const VectorXd& x, int e0, int count, Mat3* F, Svd3* svd, VolumeProjection* volume);
   // Sums the per-element 3 x K buffer into a 3n vector, in parallel over nodes.
   void GatherElementBuffer(VectorXd* out, int threads) const;
 
