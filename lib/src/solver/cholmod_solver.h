@@ -1,6 +1,12 @@
-// Sparse Cholesky by CHOLMOD's supernodal factorisation (internal). The
-// symbolic analysis (fill-reducing ordering) is done once per sparsity
-// pattern; Factorize() then only redoes the numeric factorisation.
+// Sparse Cholesky by CHOLMOD (internal). The symbolic analysis
+// (fill-reducing ordering) is done once per sparsity pattern; Factorize()
+// then only redoes the numeric factorisation.
+//
+// Two factor layouts: supernodal (dense BLAS blocks: the fastest
+// factorisation, used where a matrix is factorised every iteration, Newton)
+// and simplicial (column by column, no BLAS call per supernode, so each solve
+// is cheaper on meshes up to tens of thousands of nodes: the PD matrix,
+// factorised once and solved with at every iteration; see PdSystem).
 #pragma once
 
 #include <memory>
@@ -9,9 +15,11 @@
 
 namespace diffpd::internal {
 
+enum class CholmodLayout { kSupernodal, kSimplicial };
+
 class CholmodSolver {
  public:
-  CholmodSolver();
+  explicit CholmodSolver(CholmodLayout layout = CholmodLayout::kSupernodal);
   ~CholmodSolver();
   CholmodSolver(const CholmodSolver&) = delete;
   CholmodSolver& operator=(const CholmodSolver&) = delete;
@@ -25,6 +33,7 @@ class CholmodSolver {
   MatrixXd Solve(const MatrixXd& b) const;
   VectorXd Solve(const VectorXd& b) const;
 
+  CholmodLayout layout() const { return layout_; }
   int num_analyses() const { return num_analyses_; }
   int num_factorizations() const { return num_factorizations_; }
   bool factorized() const { return factorized_; }
@@ -32,6 +41,7 @@ class CholmodSolver {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  CholmodLayout layout_;
   Eigen::Index rows_ = -1;
   Eigen::Index nonzeros_ = -1;
   int num_analyses_ = 0;
