@@ -10,7 +10,7 @@ namespace {
 // The PD factor is computed once and solved with at every iteration, so its
 // layout is chosen for the solve. Simplicial solves (no BLAS call per
 // supernode) measured faster on the cantilever from 2 673 to 18 785 nodes
-// (bench --scaling, 2 threads: forward 5-16% and backward 18-25% faster per
+// (bench --scaling, 2 threads: forward 5-16% and backward 14-25% faster per
 // run); above that range the supernodal layout, measured up to 140 481 nodes,
 // is kept.
 constexpr int kSimplicialMaxNodes = 20000;
