@@ -135,10 +135,8 @@ void ElasticForces::SampleDecompositions(const VectorXd& x, int e0, int count, M
   ProjectSingularValuesToUnitDeterminantBatch(n, sigma, volume);
 }
 
-template <int K>
-double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, const LameField& lame, VectorXd* grad,
-                                            int threads) {
-  if (!x.allFinite()) throw SolverError(SolverStatus::kNonFinite, "positions are not finite");
+template <int K, class Body>
+void ElasticForces::ForEachDecomposedElement(const VectorXd& x, int threads, Body&& body) {
   const int q_per = fem_.samples_per_element();
   ParallelForSampleBatches(fem_.num_elements(), q_per, threads, [&](int e0, int count) {
     Mat3 F[kSvdBatch];
@@ -146,22 +144,32 @@ double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, const LameField& 
     VolumeProjection volume[kSvdBatch];
     SampleDecompositions<K>(x, e0, count, F, svd, volume);
     for (int j = 0; j < count; ++j) {
-      const int e = e0 + j;
-      const double mu = lame.mu_of(e), lambda = lame.lambda_of(e);
-      Eigen::Matrix<double, 3, K> fe = Eigen::Matrix<double, 3, K>::Zero();
-      double energy = 0;
-      for (int q = 0; q < q_per; ++q) {
-        const int i = j * q_per + q, s = e * q_per + q;
-        const double* g = fem_.grad(s);
-        Mat3 P;
-        const double vol = fem_.sample_volume(s);
-        energy += vol * EvaluateDensity(energies_, F[i], svd[i], mu, lambda, grad ? &P : nullptr, nullptr,
-                                        needs_volume_ ? &volume[i] : nullptr);
-        if (grad) fe.noalias() += (vol * P) * Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
-      }
-      element_energy_[e] = energy;
-      if (grad) Eigen::Map<Eigen::Matrix<double, 3, K>>(element_buffer_.data() + static_cast<size_t>(e) * 3 * K) = fe;
+      const int i = j * q_per;
+      body(e0 + j, F + i, svd + i, needs_volume_ ? volume + i : nullptr);
     }
+  });
+}
+
+template <int K>
+double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, const LameField& lame, VectorXd* grad,
+                                            int threads) {
+  if (!x.allFinite()) throw SolverError(SolverStatus::kNonFinite, "positions are not finite");
+  const int q_per = fem_.samples_per_element();
+  ForEachDecomposedElement<K>(x, threads, [&](int e, const Mat3* F, const Svd3* svd, const VolumeProjection* volume) {
+    const double mu = lame.mu_of(e), lambda = lame.lambda_of(e);
+    Eigen::Matrix<double, 3, K> fe = Eigen::Matrix<double, 3, K>::Zero();
+    double energy = 0;
+    for (int q = 0; q < q_per; ++q) {
+      const int s = e * q_per + q;
+      const double* g = fem_.grad(s);
+      Mat3 P;
+      const double vol = fem_.sample_volume(s);
+      energy += vol * EvaluateDensity(energies_, F[q], svd[q], mu, lambda, grad ? &P : nullptr, nullptr,
+                                      volume ? &volume[q] : nullptr);
+      if (grad) fe.noalias() += (vol * P) * Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
+    }
+    element_energy_[e] = energy;
+    if (grad) Eigen::Map<Eigen::Matrix<double, 3, K>>(element_buffer_.data() + static_cast<size_t>(e) * 3 * K) = fe;
   });
   double total = 0;
   for (double v : element_energy_) total += v;
@@ -183,30 +191,23 @@ void ElasticForces::PartLameDotsImpl(const VectorXd& x, const VectorXd& z, const
   const Mesh& mesh = fem_.mesh();
   const int q_per = fem_.samples_per_element();
   element_dot_.resize(fem_.num_elements());
-  ParallelForSampleBatches(fem_.num_elements(), q_per, threads, [&](int e0, int count) {
-    Mat3 F[kSvdBatch];
-    Svd3 svd[kSvdBatch];
-    VolumeProjection volume[kSvdBatch];
-    SampleDecompositions<K>(x, e0, count, F, svd, volume);
-    for (int j = 0; j < count; ++j) {
-      const int e = e0 + j;
-      const Eigen::Matrix<double, 3, K> ze = GatherElement<K>(mesh, z, e);
-      Eigen::Matrix<double, 3, K> f_mu = Eigen::Matrix<double, 3, K>::Zero(), f_lambda = f_mu;
-      for (int q = 0; q < q_per; ++q) {
-        const int i = j * q_per + q, s = e * q_per + q;
-        const double* g = fem_.grad(s);
-        Mat3 p_mu, p_lambda;  // one SVD and projection serve both unit-parameter stresses
-        const VolumeProjection* vq = needs_volume_ ? &volume[i] : nullptr;
-        EvaluateDensity(energies_, F[i], svd[i], 1.0, 0.0, &p_mu, nullptr, vq);
-        EvaluateDensity(energies_, F[i], svd[i], 0.0, 1.0, &p_lambda, nullptr, vq);
-        const auto gt = Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
-        const double vol = fem_.sample_volume(s);
-        f_mu.noalias() += (vol * p_mu) * gt;
-        f_lambda.noalias() += (vol * p_lambda) * gt;
-      }
-      element_energy_[e] = ze.cwiseProduct(f_mu).sum();
-      element_dot_[e] = ze.cwiseProduct(f_lambda).sum();
+  ForEachDecomposedElement<K>(x, threads, [&](int e, const Mat3* F, const Svd3* svd, const VolumeProjection* volume) {
+    const Eigen::Matrix<double, 3, K> ze = GatherElement<K>(mesh, z, e);
+    Eigen::Matrix<double, 3, K> f_mu = Eigen::Matrix<double, 3, K>::Zero(), f_lambda = f_mu;
+    for (int q = 0; q < q_per; ++q) {
+      const int s = e * q_per + q;
+      const double* g = fem_.grad(s);
+      Mat3 p_mu, p_lambda;  // one SVD and projection serve both unit-parameter stresses
+      const VolumeProjection* vq = volume ? &volume[q] : nullptr;
+      EvaluateDensity(energies_, F[q], svd[q], 1.0, 0.0, &p_mu, nullptr, vq);
+      EvaluateDensity(energies_, F[q], svd[q], 0.0, 1.0, &p_lambda, nullptr, vq);
+      const auto gt = Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
+      const double vol = fem_.sample_volume(s);
+      f_mu.noalias() += (vol * p_mu) * gt;
+      f_lambda.noalias() += (vol * p_lambda) * gt;
     }
+    element_energy_[e] = ze.cwiseProduct(f_mu).sum();
+    element_dot_[e] = ze.cwiseProduct(f_lambda).sum();
   });
   *dmu = VectorXd::Zero(num_parts);
   *dlambda = VectorXd::Zero(num_parts);

@@ -82,6 +82,12 @@ class ElasticForces {
   // values, also as one batch.
   template <int K>
   void SampleDecompositions(const VectorXd& x, int e0, int count, Mat3* F, Svd3* svd, VolumeProjection* volume);
+  // Runs body(e, F, svd, volume) for every element e, in parallel over SVD
+  // batches (SampleDecompositions): F, svd and volume point at e's
+  // samples_per_element() entries (volume is nullptr unless pd-volume is
+  // declared).
+  template <int K, class Body>
+  void ForEachDecomposedElement(const VectorXd& x, int threads, Body&& body);
   // Sums the per-element 3 x K buffer into a 3n vector, in parallel over nodes.
   void GatherElementBuffer(VectorXd* out, int threads) const;
 
