@@ -26,6 +26,10 @@ void AddCommonOptions(CLI::App* cmd, CommandArgs* args, std::string* method) {
   cmd->add_option("--lbfgs-scale", args->lbfgs_weight_scale,
                   "pd-lbfgs: elastic weight factor of its initial Hessian A, in (0, 1]")
       ->capture_default_str();
+  cmd->add_option("--verbosity", args->verbosity,
+                  "solver log on stderr: 0 none, 1 a line per step, 2 a line per iteration and contact pass")
+      ->check(CLI::Range(0, 2))
+      ->capture_default_str();
   cmd->add_flag("--json", args->json, "print one JSON document on stdout");
 }
 

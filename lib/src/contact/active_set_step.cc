@@ -26,15 +26,12 @@ std::vector<Candidate> Candidates(const Scene& scene) {
 }
 
 // For its lifetime: an absolute step tolerance `target` (if > 0), else the
-// relative tolerance `rel` (if > 0), else the options' own.
+// options' own.
 class ToleranceScope {
  public:
-  ToleranceScope(SimulatorImpl& sim, double target, double rel = -1.0)
+  ToleranceScope(SimulatorImpl& sim, double target)
       : sim_(sim), abs_(sim.options.abs_tolerance), rel_(sim.options.rel_tolerance) {
-    if (target <= 0) {
-      if (rel > 0) sim.options.rel_tolerance = rel;
-      return;
-    }
+    if (target <= 0) return;
     sim.options.abs_tolerance = target;
     sim.options.rel_tolerance = 0;
   }
@@ -77,10 +74,40 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
   };
   for (int c = 0; c < nc; ++c) active[c] = cand[c].surface->Gap(xhat.segment<3>(3 * cand[c].node)) <= kTouch;
 
+  // Applies the complementarity test at x (grad: grad g with the pinned rows
+  // kept, i.e. the contact forces there) to the set: releases pinned nodes
+  // pulled into the surface, adds free candidates below it. Returns whether
+  // the set changed; sets *cycled when a node released on a loose solve
+  // comes back on one.
+  auto update_set = [&](const VectorXd& xs, const VectorXd& grad, bool screening_pass, bool* cycled) {
+    bool changed = false;
+    for (int c = 0; c < nc; ++c) {
+      const int i = cand[c].node;
+      if (active[c]) {
+        const Vec3 normal = cand[c].surface->GapGradient(pin_of(c).position);
+        if (!locked[c] && normal.dot(grad.segment<3>(3 * i)) < 0) {
+          active[c] = 0;
+          (screening_pass ? screen_released : released)[c] = 1;
+          changed = true;
+        }
+      } else if (cand[c].surface->Gap(xs.segment<3>(3 * i)) < -opt.penetration_tolerance) {
+        active[c] = 1;
+        // Only converged passes lock a node (the lock makes the final set
+        // depend on the path; loose solves must not choose it). A node back
+        // in on a loose solve ends screening instead.
+        if (screening_pass) *cycled = *cycled || screen_released[c];
+        else if (released[c]) locked[c] = 1;
+        changed = true;
+      }
+    }
+    return changed;
+  };
+
   VectorXd x = xhat;
-  // Screening (contact.h): passes solve to screen_target until the set stops
-  // changing; then one refining pass to first_target (after it, no more
-  // screening).
+  // Screening (contact.h): while `screening`, each pass's solve stops at a
+  // checkpoint at the loose tolerance if the set changes there; if it does
+  // not, the same solve goes on to the step's tolerance (no restart) and
+  // screening ends.
   bool screening = opt.screening_rel_tolerance > sim.options.rel_tolerance;
   double first_target = 0, screen_target = 0;
   for (int pass = 1;; ++pass) {
@@ -96,26 +123,37 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
       pinned.segment<3>(3 * i) = pin_of(c).position;
     }
     StepReport pass_report;
+    bool screening_pass = false, cycled = false;
     {
       const ContactPinScope scope(sim, nodes, pinned);
       VectorXd x0 = x;
       for (int d = 0; d < n; ++d)
         if (sim.fixed[d]) x0(d) = sim.fixed_values(d);
       StepObjective objective(sim, xhat, force);
+      if (screening) {
+        StepObjective::Checkpoint checkpoint;
+        checkpoint.abs_tolerance = pass == 1 ? sim.options.abs_tolerance : screen_target;
+        checkpoint.rel_tolerance = pass == 1 ? opt.screening_rel_tolerance : 0.0;
+        checkpoint.stop = [&](const VectorXd& xs) {
+          VectorXd grad;
+          objective.Evaluate(xs, &grad, /*keep_fixed_rows=*/true);
+          if (update_set(xs, grad, /*screening_pass=*/true, &cycled)) return true;
+          screening = false;  // the set settled at the loose tolerance: refine it in this solve
+          return false;
+        };
+        objective.SetCheckpoint(std::move(checkpoint));
+      }
       // Later passes start from the previous solution; they must meet the
       // first pass's tolerance, not one relative to their smaller residual.
-      const ToleranceScope tolerance(sim, pass == 1 ? -1.0 : screening ? screen_target : first_target,
-                                     screening ? opt.screening_rel_tolerance : -1.0);
+      const ToleranceScope tolerance(sim, pass == 1 ? -1.0 : first_target);
       x = solve(objective, x0, &pass_report);
+      screening_pass = objective.checkpoint_stopped();
     }
     if (pass == 1) {
       first_target = sim.options.abs_tolerance + sim.options.rel_tolerance * pass_report.initial_residual;
       screen_target = sim.options.abs_tolerance + opt.screening_rel_tolerance * pass_report.initial_residual;
+      report->initial_residual = pass_report.initial_residual;
     }
-    // A screening solve that already meets the step's tolerance is final.
-    const bool final_pass = !screening || pass_report.final_residual <= first_target;
-    const bool screening_pass = !final_pass;
-    if (pass == 1) report->initial_residual = pass_report.initial_residual;
     report->iterations += pass_report.iterations;
     report->line_search_steps += pass_report.line_search_steps;
     report->final_residual = pass_report.final_residual;
@@ -123,42 +161,25 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
 
     // Contact forces f_c = grad g at the pinned nodes (the Dirichlet reaction).
     VectorXd grad;
-    if (!nodes.empty()) {
-      StepObjective objective(sim, xhat, force);
-      objective.Evaluate(x, &grad);
-    }
-    bool changed = false, cycled = false;
-    for (int c = 0; c < nc; ++c) {
-      const int i = cand[c].node;
-      if (active[c]) {
-        const Vec3 normal = cand[c].surface->GapGradient(pin_of(c).position);
-        if (!locked[c] && normal.dot(grad.segment<3>(3 * i)) < 0) {
-          active[c] = 0;
-          (screening_pass ? screen_released : released)[c] = 1;
-          changed = true;
-        }
-      } else if (cand[c].surface->Gap(x.segment<3>(3 * i)) < -opt.penetration_tolerance) {
-        active[c] = 1;
-        // Only converged passes lock a node (the lock makes the final set
-        // depend on the path; loose solves must not choose it). A node back
-        // in on a loose solve ends screening instead.
-        if (screening_pass) cycled = cycled || screen_released[c];
-        else if (released[c]) locked[c] = 1;
-        changed = true;
+    bool changed = true;  // a screening pass stopped because the set changed
+    if (!screening_pass) {
+      if (!nodes.empty()) {
+        StepObjective objective(sim, xhat, force);
+        objective.Evaluate(x, &grad);
       }
+      changed = update_set(x, grad, /*screening_pass=*/false, &cycled);
     }
     if (cycled) screening = false;
     if (sim.options.verbosity >= 2)
-      std::fprintf(stderr, "  contact pass %d%s: %zu pinned nodes%s\n", pass, final_pass ? "" : " (screening)",
+      std::fprintf(stderr, "  contact pass %d%s: %zu pinned nodes%s\n", pass, screening_pass ? " (screening)" : "",
                    nodes.size(), changed ? ", set changed" : "");
-    if (!changed && final_pass) {
+    if (!changed) {
       report->contact_nodes = nodes;
       report->contact_forces.resize(3, static_cast<Eigen::Index>(nodes.size()));
       for (size_t k = 0; k < nodes.size(); ++k)
         report->contact_forces.col(static_cast<Eigen::Index>(k)) = grad.segment<3>(3 * nodes[k]);
       return x;
     }
-    if (!changed) screening = false;  // the set settled at the screening tolerance: refine it
     if (pass >= opt.max_passes) {
       std::ostringstream msg;
       msg << "frictional contact: the active set did not settle in " << opt.max_passes

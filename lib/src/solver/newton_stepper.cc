@@ -52,7 +52,7 @@ VectorXd NewtonSolve(StepObjective& objective, const VectorXd& x0, StepReport* r
   std::vector<double> blocks;
   SparseMatrix h;
   for (int it = 0;; ++it) {
-    if (IterationConverged(sim.options, it, grad.norm(), report)) return x;
+    if (IterationConverged(objective, it, x, grad.norm(), report)) return x;
     sim.elastic.ElementHessians(x, sim.lame(), /*project_spd=*/true, &blocks, sim.threads());
     sim.aux.AddElementHessians(x, sim.activation, /*project_spd=*/true, &blocks);
     sim.hessian_assembler().Assemble(blocks, objective.inertia_diagonal(), sim.fixed, &h);

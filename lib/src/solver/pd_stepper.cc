@@ -24,7 +24,7 @@ VectorXd PdSolve(StepObjective& objective, const VectorXd& x0, StepReport* repor
   objective.Evaluate(x, &grad);
   report->initial_residual = grad.norm();
   for (int it = 0;; ++it) {
-    if (IterationConverged(sim.options, it, grad.norm(), report)) return x;
+    if (IterationConverged(objective, it, x, grad.norm(), report)) return x;
     x -= pd.Solve(grad);
     objective.Evaluate(x, &grad);
   }
@@ -42,7 +42,7 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
   report->initial_residual = grad.norm();
   std::vector<double> alpha(m);
   for (int it = 0;; ++it) {
-    if (IterationConverged(sim.options, it, grad.norm(), report)) return x;
+    if (IterationConverged(objective, it, x, grad.norm(), report)) return x;
     // Two-loop recursion with H0 = A^{-1}.
     VectorXd q = grad;
     const int k = static_cast<int>(s_list.size());

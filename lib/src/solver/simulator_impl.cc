@@ -135,7 +135,7 @@ StepObjective::StepObjective(SimulatorImpl& sim, VectorXd xhat, VectorXd force, 
   inertia_ = static_problem ? VectorXd::Zero(sim.num_dofs()) : VectorXd(sim.Mass() / (sim.h() * sim.h()));
 }
 
-double StepObjective::Evaluate(const VectorXd& x, VectorXd* grad) {
+double StepObjective::Evaluate(const VectorXd& x, VectorXd* grad, bool keep_fixed_rows) {
   const double e = sim_.elastic.EnergyAndGradient(x, sim_.lame(), grad, sim_.threads());
   const VectorXd dx = x - xhat_;
   double value = e + sim_.aux.AddEnergyAndGradient(x, sim_.activation, grad);
@@ -145,7 +145,7 @@ double StepObjective::Evaluate(const VectorXd& x, VectorXd* grad) {
   }
   if (grad) {
     grad->array() += inertia_.array() * dx.array() - force_.array();
-    sim_.ZeroFixed(grad);
+    if (!keep_fixed_rows) sim_.ZeroFixed(grad);
     CheckFinite(*grad, "grad g");
   }
   if (!std::isfinite(value)) throw SolverError(SolverStatus::kNonFinite, "the step objective g(x) is not finite");
@@ -156,12 +156,22 @@ bool Converged(const SolverOptions& options, double grad_norm, double initial_no
   return grad_norm <= options.abs_tolerance + options.rel_tolerance * initial_norm;
 }
 
-bool IterationConverged(const SolverOptions& options, int it, double grad_norm, StepReport* report) {
+bool IterationConverged(StepObjective& objective, int it, const VectorXd& x, double grad_norm, StepReport* report) {
+  const SolverOptions& options = objective.sim().options;
   report->iterations = it;
   report->final_residual = grad_norm;
   if (options.verbosity >= 2)
     std::fprintf(stderr, "  %s iteration %d |grad g| = %.3e\n", ToString(options.method), it, grad_norm);
   if (Converged(options, grad_norm, report->initial_residual)) return true;
+  StepObjective::Checkpoint& checkpoint = objective.checkpoint_;
+  if (checkpoint.stop && !objective.checkpoint_done_ &&
+      grad_norm <= checkpoint.abs_tolerance + checkpoint.rel_tolerance * report->initial_residual) {
+    objective.checkpoint_done_ = true;
+    if (checkpoint.stop(x)) {
+      objective.checkpoint_stopped_ = true;
+      return true;
+    }
+  }
   if (it >= options.max_iterations) ThrowNotConverged(options, it, grad_norm, report->initial_residual);
   return false;
 }

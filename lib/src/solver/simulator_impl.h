@@ -1,6 +1,7 @@
 // State shared by the simulator's steppers and adjoints (internal).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -100,17 +101,38 @@ VectorXd GravityPerDof(const SimulatorImpl& sim);
 class StepObjective {
  public:
   StepObjective(SimulatorImpl& sim, VectorXd xhat, VectorXd force, bool static_problem = false);
-  // g(x); if grad != nullptr also grad g (zero at fixed DoFs).
-  double Evaluate(const VectorXd& x, VectorXd* grad);
+  // g(x); if grad != nullptr also grad g, zero at fixed DoFs unless
+  // keep_fixed_rows (then the fixed rows hold the reaction, as in g with
+  // those DoFs free).
+  double Evaluate(const VectorXd& x, VectorXd* grad, bool keep_fixed_rows = false);
   // Diagonal of the inertia term (3n): M / h^2, or zero for a static problem.
   const VectorXd& inertia_diagonal() const { return inertia_; }
   SimulatorImpl& sim() { return sim_; }
 
+  // An optional checkpoint of the forward solve (frictional contact's
+  // screening): the first iterate with |grad g| <= abs_tolerance +
+  // rel_tolerance |grad g(x0)| that does not yet meet the step's own test is
+  // passed to stop(x); if it returns true the solver returns that iterate
+  // (checkpoint_stopped() is then true), else it goes on, its state (e.g.
+  // PD-LBFGS's curvature pairs) intact.
+  struct Checkpoint {
+    double abs_tolerance = 0;
+    double rel_tolerance = 0;
+    std::function<bool(const VectorXd& x)> stop;
+  };
+  void SetCheckpoint(Checkpoint checkpoint) { checkpoint_ = std::move(checkpoint); }
+  bool checkpoint_stopped() const { return checkpoint_stopped_; }
+
  private:
+  friend bool IterationConverged(StepObjective& objective, int it, const VectorXd& x, double grad_norm,
+                                 StepReport* report);
   SimulatorImpl& sim_;
   VectorXd xhat_;
   VectorXd force_;
   VectorXd inertia_;
+  Checkpoint checkpoint_;
+  bool checkpoint_done_ = false;
+  bool checkpoint_stopped_ = false;
 };
 
 // Exact Hessian of one step's objective at a point, over the free DoFs,
@@ -159,10 +181,11 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
 // True when ||grad|| meets the common convergence test.
 bool Converged(const SolverOptions& options, double grad_norm, double initial_norm);
 // The per-iteration bookkeeping every forward solver shares: records
-// iteration `it` and |grad| in the report, logs it (verbosity >= 2), and
-// returns true when converged; throws ThrowNotConverged's error when `it`
-// reached the iteration limit without converging.
-bool IterationConverged(const SolverOptions& options, int it, double grad_norm, StepReport* report);
+// iteration `it` (iterate x) and |grad| in the report, logs it (verbosity >=
+// 2), and returns true when converged or stopped at the objective's
+// checkpoint; throws ThrowNotConverged's error when `it` reached the
+// iteration limit without converging.
+bool IterationConverged(StepObjective& objective, int it, const VectorXd& x, double grad_norm, StepReport* report);
 // Throws SolverError(kMaxIterations) with a message naming method and residuals.
 [[noreturn]] void ThrowNotConverged(const SolverOptions& options, int iterations, double grad_norm,
                                     double initial_norm);
