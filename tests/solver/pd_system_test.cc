@@ -143,8 +143,11 @@ TEST(PdSystemTest, AxesWithTheSameDirichletSetShareOneFactorAndSolvesMatchDense)
   for (int d = 0; d < n; ++d)
     if (mixed[d]) r(d) = 0;
   EXPECT_LT((a * z - r).norm() / r.norm(), 1e-12);
-  for (int d = 0; d < n; ++d)
-    if (mixed[d]) EXPECT_EQ(z(d), 0.0);
+  for (int d = 0; d < n; ++d) {
+    if (mixed[d]) {
+      EXPECT_EQ(z(d), 0.0);
+    }
+  }
 }
 
 }  // namespace

@@ -159,7 +159,18 @@ struct alignas(64) BatchColumns {
 DIFFPD_SIMD_INLINE bool OrthogonalizeBatchColumns(BatchColumns& m, int i, int j) {
   int any = 0;
   const double eps2 = kEps * kEps;
+  // First only the test (the last sweep of a converged batch rotates no lane).
 #pragma omp simd reduction(| : any)
+  for (int l = 0; l < kSvdBatch; ++l) {
+    const double bi0 = m.b[3 * i][l], bi1 = m.b[3 * i + 1][l], bi2 = m.b[3 * i + 2][l];
+    const double bj0 = m.b[3 * j][l], bj1 = m.b[3 * j + 1][l], bj2 = m.b[3 * j + 2][l];
+    const double alpha = bi0 * bi0 + bi1 * bi1 + bi2 * bi2;
+    const double beta = bj0 * bj0 + bj1 * bj1 + bj2 * bj2;
+    const double gamma = bi0 * bj0 + bi1 * bj1 + bi2 * bj2;
+    any |= gamma * gamma > eps2 * alpha * beta ? 1 : 0;
+  }
+  if (any == 0) return false;
+#pragma omp simd
   for (int l = 0; l < kSvdBatch; ++l) {
     const double bi0 = m.b[3 * i][l], bi1 = m.b[3 * i + 1][l], bi2 = m.b[3 * i + 2][l];
     const double bj0 = m.b[3 * j][l], bj1 = m.b[3 * j + 1][l], bj2 = m.b[3 * j + 2][l];
@@ -176,7 +187,6 @@ DIFFPD_SIMD_INLINE bool OrthogonalizeBatchColumns(BatchColumns& m, int i, int j)
     const double signed_two = diff >= 0.0 ? 2.0 : -2.0;
     const double c = rotate ? q * w : 1.0;
     const double s = rotate ? signed_two * gamma * w : 0.0;
-    any |= rotate ? 1 : 0;
     m.b[3 * i][l] = c * bi0 - s * bj0;
     m.b[3 * i + 1][l] = c * bi1 - s * bj1;
     m.b[3 * i + 2][l] = c * bi2 - s * bj2;
@@ -192,7 +202,7 @@ DIFFPD_SIMD_INLINE bool OrthogonalizeBatchColumns(BatchColumns& m, int i, int j)
     m.v[3 * j + 1][l] = s * vi1 + c * vj1;
     m.v[3 * j + 2][l] = s * vi2 + c * vj2;
   }
-  return any != 0;
+  return true;
 }
 
 // Swaps columns i and j of B and V (and their squared norms) in the lanes

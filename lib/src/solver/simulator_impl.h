@@ -156,6 +156,10 @@ class StepLinearization {
   VectorXd ApplyUnmasked(const VectorXd& z);
 
  private:
+  // The elastic element Hessians at x_ (computed on first use).
+  const std::vector<double>& ElasticBlocks();
+  // Assembles matrix_ (elastic and auxiliary blocks, inertia) once.
+  void AssembleMatrix();
   bool DirectSolve(const VectorXd& b, VectorXd* z);
   bool IterativeSolve(const VectorXd& b, VectorXd* z, int* iterations);
   // Lockstep IterativeSolve of several columns; ok[c] tells which converged.
@@ -165,7 +169,9 @@ class StepLinearization {
   SimulatorImpl& sim_;
   VectorXd x_;
   VectorXd inertia_;
-  std::vector<Mat9> dstress_;
+  // Elastic element Hessians at x_ (ElasticForces::ElementHessians, not
+  // projected): PD methods apply H with them; direct solves assemble them.
+  std::vector<double> elastic_blocks_;
   SparseMatrix matrix_;  // assembled exact H (lazily)
   bool have_matrix_ = false;
   bool factored_ = false;

@@ -25,8 +25,21 @@ StepLinearization::StepLinearization(SimulatorImpl& sim, const VectorXd& x, bool
     : sim_(sim), x_(x) {
   inertia_ = static_problem ? VectorXd::Zero(sim.num_dofs()) : VectorXd(sim.Mass() / (sim.h() * sim.h()));
   const Method m = sim.options.method;
-  if (m == Method::kPd || m == Method::kPdLbfgs)
-    sim.elastic.StressDifferentials(x_, sim.lame(), &dstress_, sim.threads());
+  if (m == Method::kPd || m == Method::kPdLbfgs) ElasticBlocks();
+}
+
+const std::vector<double>& StepLinearization::ElasticBlocks() {
+  if (elastic_blocks_.empty())
+    sim_.elastic.ElementHessians(x_, sim_.lame(), /*project_spd=*/false, &elastic_blocks_, sim_.threads());
+  return elastic_blocks_;
+}
+
+void StepLinearization::AssembleMatrix() {
+  if (have_matrix_) return;
+  std::vector<double> blocks = ElasticBlocks();
+  sim_.aux.AddElementHessians(x_, sim_.activation, /*project_spd=*/false, &blocks);
+  sim_.hessian_assembler().Assemble(blocks, inertia_, sim_.fixed, &matrix_);
+  have_matrix_ = true;
 }
 
 VectorXd StepLinearization::Apply(const VectorXd& z) {
@@ -39,21 +52,15 @@ VectorXd StepLinearization::ApplyUnmasked(const VectorXd& z) {
   VectorXd zf = z;
   sim_.ZeroFixed(&zf);
   VectorXd out;
-  if (dstress_.empty())
-    sim_.elastic.StressDifferentials(x_, sim_.lame(), &dstress_, sim_.threads());
-  sim_.elastic.ApplyHessian(dstress_, zf, &out, sim_.threads());
+  sim_.elastic.ApplyElementMatrices(ElasticBlocks(), zf, &out, sim_.threads());
   sim_.aux.AddHessianProduct(x_, sim_.activation, zf, &out);
   out.array() += inertia_.array() * zf.array();
   return out;
 }
 
 bool StepLinearization::DirectSolve(const VectorXd& b, VectorXd* z) {
-  if (!have_matrix_) {
-    std::vector<double> blocks;
-    sim_.elastic.ElementHessians(x_, sim_.lame(), /*project_spd=*/false, &blocks, sim_.threads());
-    sim_.aux.AddElementHessians(x_, sim_.activation, /*project_spd=*/false, &blocks);
-    sim_.hessian_assembler().Assemble(blocks, inertia_, sim_.fixed, &matrix_);
-    have_matrix_ = true;
+  if (!llt_) {
+    AssembleMatrix();
     llt_ = std::make_unique<CholmodSolver>();
     factored_ = llt_->Factorize(matrix_);
   }
@@ -144,13 +151,7 @@ bool StepLinearization::IterativeSolve(const VectorXd& b, VectorXd* z, int* iter
 }
 
 bool StepLinearization::PcgSolve(const VectorXd& b, VectorXd* z, int* iterations) {
-  if (!have_matrix_) {
-    std::vector<double> blocks;
-    sim_.elastic.ElementHessians(x_, sim_.lame(), /*project_spd=*/false, &blocks, sim_.threads());
-    sim_.aux.AddElementHessians(x_, sim_.activation, /*project_spd=*/false, &blocks);
-    sim_.hessian_assembler().Assemble(blocks, inertia_, sim_.fixed, &matrix_);
-    have_matrix_ = true;
-  }
+  AssembleMatrix();
   VectorXd rhs = b;
   sim_.ZeroFixed(&rhs);
   Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>> cg;
