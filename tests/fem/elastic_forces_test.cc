@@ -171,7 +171,7 @@ TEST(ElasticForcesTest, PartLameDotsAreTheUnitParameterGradientsAlongZ) {
 }
 
 // The element Hessians (batched cold SVDs, structured accumulation) are the
-// derivative of the gradient: their assembled product with a direction
+// derivative of the gradient: their packed product with a direction
 // matches central differences of grad E, and it equals the per-sample
 // stress-differential product ApplyHessian.
 TEST(ElasticForcesTest, ElementHessiansAreTheGradientsDerivativeAndMatchTheSampleProduct) {
@@ -191,7 +191,9 @@ TEST(ElasticForcesTest, ElementHessiansAreTheGradientsDerivativeAndMatchTheSampl
     VectorXd dir(x.size());
     for (int i = 0; i < dir.size(); ++i) dir(i) = normal(rng);
     VectorXd h_blocks, h_samples, g_plus, g_minus;
-    forces.ApplyElementMatrices(blocks, dir, &h_blocks, 1);
+    std::vector<double> packed;
+    forces.PackElementMatrices(blocks, &packed);
+    forces.ApplyElementMatrices(packed, dir, &h_blocks, 1);
     forces.ApplyHessian(dstress, dir, &h_samples, 1);
     EXPECT_LE((h_blocks - h_samples).norm(), 1e-12 * h_samples.norm()) << "tets " << c.tets << " noise " << c.noise;
     const double eps = 1e-7;

@@ -294,27 +294,55 @@ void ElasticForces::ApplyHessian(const std::vector<Mat9>& d, const VectorXd& z, 
   else ApplyHessianImpl<8>(d, z, out, threads);
 }
 
+void ElasticForces::PackElementMatrices(const std::vector<double>& blocks, std::vector<double>* packed) const {
+  const int k = fem_.nodes_per_element(), n = 3 * k, m = fem_.num_elements();
+  DIFFPD_CHECK(blocks.size() == static_cast<size_t>(m) * n * n,
+               "PackElementMatrices: " << blocks.size() << " block entries for " << m << " elements");
+  const size_t per = static_cast<size_t>(9) * k * (k + 1) / 2;
+  packed->resize(static_cast<size_t>(m) * per);
+  for (int e = 0; e < m; ++e) {
+    const Eigen::Map<const MatrixXd> ke(blocks.data() + static_cast<size_t>(e) * n * n, n, n);
+    double* out = packed->data() + static_cast<size_t>(e) * per;
+    for (int b = 0; b < k; ++b)
+      for (int a = 0; a <= b; ++a, out += 9) {
+        Eigen::Map<Mat3> block(out);
+        block = ke.block<3, 3>(3 * a, 3 * b);
+      }
+  }
+}
+
 template <int K>
-void ElasticForces::ApplyElementMatricesImpl(const std::vector<double>& blocks, const VectorXd& z, VectorXd* out,
+void ElasticForces::ApplyElementMatricesImpl(const std::vector<double>& packed, const VectorXd& z, VectorXd* out,
                                              int threads) {
-  constexpr int N = 3 * K;
+  constexpr size_t kPer = 9 * K * (K + 1) / 2;
   const Mesh& mesh = fem_.mesh();
-  DIFFPD_CHECK(blocks.size() == static_cast<size_t>(fem_.num_elements()) * N * N,
-               "ApplyElementMatrices: " << blocks.size() << " block entries for " << fem_.num_elements()
+  DIFFPD_CHECK(packed.size() == static_cast<size_t>(fem_.num_elements()) * kPer,
+               "ApplyElementMatrices: " << packed.size() << " packed entries for " << fem_.num_elements()
                                         << " elements");
   ParallelForElements(fem_.num_elements(), threads, [&](int e) {
     const Eigen::Matrix<double, 3, K> ze = GatherElement<K>(mesh, z, e);
-    const Eigen::Map<const Eigen::Matrix<double, N, N>> ke(blocks.data() + static_cast<size_t>(e) * N * N);
-    Eigen::Map<Eigen::Matrix<double, N, 1>>(element_buffer_.data() + static_cast<size_t>(e) * N).noalias() =
-        ke.lazyProduct(Eigen::Map<const Eigen::Matrix<double, N, 1>>(ze.data()));
+    Eigen::Matrix<double, 3, K> ye = Eigen::Matrix<double, 3, K>::Zero();
+    const double* p = packed.data() + static_cast<size_t>(e) * kPer;
+    // Block (a, b), a <= b, acts on node b's entries and, transposed
+    // (symmetry), on node a's.
+    for (int b = 0; b < K; ++b) {
+      for (int a = 0; a < b; ++a, p += 9) {
+        const Eigen::Map<const Mat3> block(p);
+        ye.col(a).noalias() += block.lazyProduct(ze.col(b));
+        ye.col(b).noalias() += block.transpose().lazyProduct(ze.col(a));
+      }
+      ye.col(b).noalias() += Eigen::Map<const Mat3>(p).lazyProduct(ze.col(b));
+      p += 9;
+    }
+    Eigen::Map<Eigen::Matrix<double, 3, K>>(element_buffer_.data() + static_cast<size_t>(e) * 3 * K) = ye;
   });
   GatherElementBuffer(out, threads);
 }
 
-void ElasticForces::ApplyElementMatrices(const std::vector<double>& blocks, const VectorXd& z, VectorXd* out,
+void ElasticForces::ApplyElementMatrices(const std::vector<double>& packed, const VectorXd& z, VectorXd* out,
                                          int threads) {
-  if (fem_.nodes_per_element() == 4) ApplyElementMatricesImpl<4>(blocks, z, out, threads);
-  else ApplyElementMatricesImpl<8>(blocks, z, out, threads);
+  if (fem_.nodes_per_element() == 4) ApplyElementMatricesImpl<4>(packed, z, out, threads);
+  else ApplyElementMatricesImpl<8>(packed, z, out, threads);
 }
 
 template <int K>

@@ -61,10 +61,15 @@ class ElasticForces {
   // SVDs are cold started).
   void ElementHessians(const VectorXd& x, const LameField& lame, bool project_spd, std::vector<double>* blocks,
                        int threads);
-  // out = sum_e K_e z_e with the blocks of ElementHessians: the Hessian
-  // product for many products at one x ((3K)^2 multiply-adds per element and
-  // product, against about 3 (3K)^2 through StressDifferentials for hexahedra).
-  void ApplyElementMatrices(const std::vector<double>& blocks, const VectorXd& z, VectorXd* out, int threads);
+  // The upper triangle of each (symmetric) element block by 3 x 3 node
+  // blocks: for b = 0..K-1, a = 0..b, block (a, b) column-major, 9 K (K + 1) / 2
+  // values per element (1296 of 2304 bytes for hexahedra).
+  void PackElementMatrices(const std::vector<double>& blocks, std::vector<double>* packed) const;
+  // out = sum_e K_e z_e with packed element Hessians: the Hessian product for
+  // many products at one x ((3K)^2 multiply-adds per element and product,
+  // against about 3 (3K)^2 through StressDifferentials for hexahedra, and
+  // half the memory traffic of full blocks).
+  void ApplyElementMatrices(const std::vector<double>& packed, const VectorXd& z, VectorXd* out, int threads);
 
 
  private:
@@ -78,7 +83,7 @@ class ElasticForces {
   template <int K>
   void ApplyHessianImpl(const std::vector<Mat9>& d, const VectorXd& z, VectorXd* out, int threads);
   template <int K>
-  void ApplyElementMatricesImpl(const std::vector<double>& blocks, const VectorXd& z, VectorXd* out, int threads);
+  void ApplyElementMatricesImpl(const std::vector<double>& packed, const VectorXd& z, VectorXd* out, int threads);
   template <int K>
   void ElementHessiansImpl(const VectorXd& x, const LameField& lame, bool project_spd, std::vector<double>* blocks,
                            int threads);

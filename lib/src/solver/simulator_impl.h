@@ -156,8 +156,8 @@ class StepLinearization {
   VectorXd ApplyUnmasked(const VectorXd& z);
 
  private:
-  // The elastic element Hessians at x_ (computed on first use).
-  const std::vector<double>& ElasticBlocks();
+  // The packed elastic element Hessians at x_ (computed on first use).
+  const std::vector<double>& PackedBlocks();
   // Assembles matrix_ (elastic and auxiliary blocks, inertia) once.
   void AssembleMatrix();
   bool DirectSolve(const VectorXd& b, VectorXd* z);
@@ -170,8 +170,8 @@ class StepLinearization {
   VectorXd x_;
   VectorXd inertia_;
   // Elastic element Hessians at x_ (ElasticForces::ElementHessians, not
-  // projected): PD methods apply H with them; direct solves assemble them.
-  std::vector<double> elastic_blocks_;
+  // projected), packed: every product with H uses them.
+  std::vector<double> packed_blocks_;
   SparseMatrix matrix_;  // assembled exact H (lazily)
   bool have_matrix_ = false;
   bool factored_ = false;

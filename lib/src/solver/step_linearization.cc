@@ -25,18 +25,22 @@ StepLinearization::StepLinearization(SimulatorImpl& sim, const VectorXd& x, bool
     : sim_(sim), x_(x) {
   inertia_ = static_problem ? VectorXd::Zero(sim.num_dofs()) : VectorXd(sim.Mass() / (sim.h() * sim.h()));
   const Method m = sim.options.method;
-  if (m == Method::kPd || m == Method::kPdLbfgs) ElasticBlocks();
+  if (m == Method::kPd || m == Method::kPdLbfgs) PackedBlocks();
 }
 
-const std::vector<double>& StepLinearization::ElasticBlocks() {
-  if (elastic_blocks_.empty())
-    sim_.elastic.ElementHessians(x_, sim_.lame(), /*project_spd=*/false, &elastic_blocks_, sim_.threads());
-  return elastic_blocks_;
+const std::vector<double>& StepLinearization::PackedBlocks() {
+  if (packed_blocks_.empty()) {
+    std::vector<double> blocks;
+    sim_.elastic.ElementHessians(x_, sim_.lame(), /*project_spd=*/false, &blocks, sim_.threads());
+    sim_.elastic.PackElementMatrices(blocks, &packed_blocks_);
+  }
+  return packed_blocks_;
 }
 
 void StepLinearization::AssembleMatrix() {
   if (have_matrix_) return;
-  std::vector<double> blocks = ElasticBlocks();
+  std::vector<double> blocks;
+  sim_.elastic.ElementHessians(x_, sim_.lame(), /*project_spd=*/false, &blocks, sim_.threads());
   sim_.aux.AddElementHessians(x_, sim_.activation, /*project_spd=*/false, &blocks);
   sim_.hessian_assembler().Assemble(blocks, inertia_, sim_.fixed, &matrix_);
   have_matrix_ = true;
@@ -52,7 +56,7 @@ VectorXd StepLinearization::ApplyUnmasked(const VectorXd& z) {
   VectorXd zf = z;
   sim_.ZeroFixed(&zf);
   VectorXd out;
-  sim_.elastic.ApplyElementMatrices(ElasticBlocks(), zf, &out, sim_.threads());
+  sim_.elastic.ApplyElementMatrices(PackedBlocks(), zf, &out, sim_.threads());
   sim_.aux.AddHessianProduct(x_, sim_.activation, zf, &out);
   out.array() += inertia_.array() * zf.array();
   return out;
