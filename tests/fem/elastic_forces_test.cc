@@ -74,6 +74,24 @@ struct Case {
   double noise;
 };
 
+// A case's beam with its FEM model and elastic forces (not copyable: fem
+// refers to scene.mesh, forces to fem).
+struct CaseBody {
+  Scene scene;
+  FemModel fem;
+  ElasticForces forces;
+  explicit CaseBody(const Case& c)
+      : scene(testing::SmallBeamScene(c.tets)), fem(scene.mesh), forces(fem, c.energies) {}
+};
+
+// n entries drawn from N(0, 1) with *rng.
+VectorXd NormalVector(int n, std::mt19937* rng) {
+  std::normal_distribution<double> normal;
+  VectorXd v(n);
+  for (int i = 0; i < n; ++i) v(i) = normal(*rng);
+  return v;
+}
+
 std::vector<Case> Cases() {
   const std::vector<ElasticEnergy> pd = {ElasticEnergy::kPdCorotated, ElasticEnergy::kPdVolume};
   return {{false, pd, 1e-3},  {true, pd, 1e-3},  {false, pd, 1.5e-2}, {true, pd, 1.5e-2},
@@ -83,12 +101,10 @@ std::vector<Case> Cases() {
 TEST(ElasticForcesTest, EnergyIsTheQuadratureSumOfTheReferenceDensities) {
   const double mu = 7e4, lambda = 2.8e5;
   for (const Case& c : Cases()) {
-    const Scene scene = testing::SmallBeamScene(c.tets);
-    FemModel fem(scene.mesh);
-    ElasticForces forces(fem, c.energies);
-    const VectorXd x = DeformedPositions(scene.mesh, c.noise, 3);
-    const double expected = ReferenceEnergy(fem, c.energies, x, mu, lambda);
-    const double energy = forces.EnergyAndGradient(x, LameField::Uniform(mu, lambda), nullptr, 1);
+    CaseBody body(c);
+    const VectorXd x = DeformedPositions(body.scene.mesh, c.noise, 3);
+    const double expected = ReferenceEnergy(body.fem, c.energies, x, mu, lambda);
+    const double energy = body.forces.EnergyAndGradient(x, LameField::Uniform(mu, lambda), nullptr, 1);
     EXPECT_NEAR(energy, expected, 1e-12 * std::abs(expected)) << "tets " << c.tets << " noise " << c.noise;
   }
 }
@@ -96,17 +112,14 @@ TEST(ElasticForcesTest, EnergyIsTheQuadratureSumOfTheReferenceDensities) {
 TEST(ElasticForcesTest, GradientMatchesCentralDifferencesOfTheEnergy) {
   const double mu = 7e4, lambda = 2.8e5;
   for (const Case& c : Cases()) {
-    const Scene scene = testing::SmallBeamScene(c.tets);
-    FemModel fem(scene.mesh);
-    ElasticForces forces(fem, c.energies);
-    const VectorXd x = DeformedPositions(scene.mesh, c.noise, 4);
+    CaseBody body(c);
+    ElasticForces& forces = body.forces;
+    const VectorXd x = DeformedPositions(body.scene.mesh, c.noise, 4);
     VectorXd grad;
     forces.EnergyAndGradient(x, LameField::Uniform(mu, lambda), &grad, 1);
     std::mt19937 rng(5);
-    std::normal_distribution<double> normal;
     for (int trial = 0; trial < 3; ++trial) {
-      VectorXd dir(x.size());
-      for (int i = 0; i < dir.size(); ++i) dir(i) = normal(rng);
+      const VectorXd dir = NormalVector(static_cast<int>(x.size()), &rng);
       const double eps = 1e-7;
       const double plus = forces.EnergyAndGradient(x + eps * dir, LameField::Uniform(mu, lambda), nullptr, 1);
       const double minus = forces.EnergyAndGradient(x - eps * dir, LameField::Uniform(mu, lambda), nullptr, 1);
@@ -148,9 +161,7 @@ TEST(ElasticForcesTest, PartLameDotsAreTheUnitParameterGradientsAlongZ) {
     ElasticForces forces(fem, scene.energies);
     const VectorXd x = DeformedPositions(scene.mesh, 1e-3, 8);
     std::mt19937 rng(9);
-    std::normal_distribution<double> normal;
-    VectorXd z(x.size());
-    for (int i = 0; i < z.size(); ++i) z(i) = normal(rng);
+    const VectorXd z = NormalVector(static_cast<int>(x.size()), &rng);
     // Two parts: even and odd elements.
     std::vector<int> part(fem.num_elements());
     std::vector<double> mu_even(fem.num_elements()), lambda_zero(fem.num_elements(), 0.0);
@@ -177,19 +188,16 @@ TEST(ElasticForcesTest, PartLameDotsAreTheUnitParameterGradientsAlongZ) {
 TEST(ElasticForcesTest, ElementHessiansAreTheGradientsDerivativeAndMatchTheSampleProduct) {
   const double mu = 7e4, lambda = 2.8e5;
   for (const Case& c : Cases()) {
-    const Scene scene = testing::SmallBeamScene(c.tets);
-    FemModel fem(scene.mesh);
-    ElasticForces forces(fem, c.energies);
+    CaseBody body(c);
+    ElasticForces& forces = body.forces;
     const LameField lame = LameField::Uniform(mu, lambda);
-    const VectorXd x = DeformedPositions(scene.mesh, c.noise, 10);
+    const VectorXd x = DeformedPositions(body.scene.mesh, c.noise, 10);
     std::vector<double> blocks;
     forces.ElementHessians(x, lame, /*project_spd=*/false, &blocks, 1);
     std::vector<Mat9> dstress;
     forces.StressDifferentials(x, lame, &dstress, 1);
     std::mt19937 rng(11);
-    std::normal_distribution<double> normal;
-    VectorXd dir(x.size());
-    for (int i = 0; i < dir.size(); ++i) dir(i) = normal(rng);
+    const VectorXd dir = NormalVector(static_cast<int>(x.size()), &rng);
     VectorXd h_blocks, h_samples, g_plus, g_minus;
     std::vector<double> packed;
     forces.PackElementMatrices(blocks, &packed);

@@ -104,10 +104,10 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
   };
 
   VectorXd x = xhat;
-  // Screening (contact.h): while `screening`, each pass's solve stops at a
-  // checkpoint at the loose tolerance if the set changes there; if it does
-  // not, the same solve goes on to the step's tolerance (no restart) and
-  // screening ends.
+  // Screening (contact.h): while `screening`, each pass's solve pauses at a
+  // checkpoint at the loose tolerance and ends there if the set changes; if
+  // it does not, the same solve goes on to the step's tolerance (no restart)
+  // and screening ends.
   bool screening = opt.screening_rel_tolerance > sim.options.rel_tolerance;
   double first_target = 0, screen_target = 0;
   for (int pass = 1;; ++pass) {
@@ -124,6 +124,7 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
     }
     StepReport pass_report;
     bool screening_pass = false, cycled = false;
+    VectorXd grad;  // after a final pass: grad g with the pinned rows kept (the contact forces)
     {
       const ContactPinScope scope(sim, nodes, pinned);
       VectorXd x0 = x;
@@ -148,6 +149,7 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
       const ToleranceScope tolerance(sim, pass == 1 ? -1.0 : first_target);
       x = solve(objective, x0, &pass_report);
       screening_pass = objective.checkpoint_stopped();
+      if (!screening_pass && !nodes.empty()) objective.Evaluate(x, &grad, /*keep_fixed_rows=*/true);
     }
     if (pass == 1) {
       first_target = sim.options.abs_tolerance + sim.options.rel_tolerance * pass_report.initial_residual;
@@ -159,16 +161,9 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
     report->final_residual = pass_report.final_residual;
     report->active_set_passes = pass;
 
-    // Contact forces f_c = grad g at the pinned nodes (the Dirichlet reaction).
-    VectorXd grad;
-    bool changed = true;  // a screening pass stopped because the set changed
-    if (!screening_pass) {
-      if (!nodes.empty()) {
-        StepObjective objective(sim, xhat, force);
-        objective.Evaluate(x, &grad);
-      }
-      changed = update_set(x, grad, /*screening_pass=*/false, &cycled);
-    }
+    // A screening pass stopped because the set changed; a final pass applies
+    // the test with the contact forces f_c = grad g at the pinned nodes.
+    const bool changed = screening_pass || update_set(x, grad, /*screening_pass=*/false, &cycled);
     if (cycled) screening = false;
     if (sim.options.verbosity >= 2)
       std::fprintf(stderr, "  contact pass %d%s: %zu pinned nodes%s\n", pass, screening_pass ? " (screening)" : "",

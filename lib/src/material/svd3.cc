@@ -159,24 +159,24 @@ struct alignas(64) BatchColumns {
 DIFFPD_SIMD_INLINE bool OrthogonalizeBatchColumns(BatchColumns& m, int i, int j) {
   int any = 0;
   const double eps2 = kEps * kEps;
-  // First only the test (the last sweep of a converged batch rotates no lane).
+  // The test first, over all lanes: the last sweep of a converged batch
+  // rotates no lane and skips the rotation arithmetic below.
+  double alphas[kSvdBatch], betas[kSvdBatch], gammas[kSvdBatch];
 #pragma omp simd reduction(| : any)
   for (int l = 0; l < kSvdBatch; ++l) {
     const double bi0 = m.b[3 * i][l], bi1 = m.b[3 * i + 1][l], bi2 = m.b[3 * i + 2][l];
     const double bj0 = m.b[3 * j][l], bj1 = m.b[3 * j + 1][l], bj2 = m.b[3 * j + 2][l];
-    const double alpha = bi0 * bi0 + bi1 * bi1 + bi2 * bi2;
-    const double beta = bj0 * bj0 + bj1 * bj1 + bj2 * bj2;
-    const double gamma = bi0 * bj0 + bi1 * bj1 + bi2 * bj2;
-    any |= gamma * gamma > eps2 * alpha * beta ? 1 : 0;
+    alphas[l] = bi0 * bi0 + bi1 * bi1 + bi2 * bi2;
+    betas[l] = bj0 * bj0 + bj1 * bj1 + bj2 * bj2;
+    gammas[l] = bi0 * bj0 + bi1 * bj1 + bi2 * bj2;
+    any |= gammas[l] * gammas[l] > eps2 * alphas[l] * betas[l] ? 1 : 0;
   }
   if (any == 0) return false;
 #pragma omp simd
   for (int l = 0; l < kSvdBatch; ++l) {
     const double bi0 = m.b[3 * i][l], bi1 = m.b[3 * i + 1][l], bi2 = m.b[3 * i + 2][l];
     const double bj0 = m.b[3 * j][l], bj1 = m.b[3 * j + 1][l], bj2 = m.b[3 * j + 2][l];
-    const double alpha = bi0 * bi0 + bi1 * bi1 + bi2 * bi2;
-    const double beta = bj0 * bj0 + bj1 * bj1 + bj2 * bj2;
-    const double gamma = bi0 * bj0 + bi1 * bj1 + bi2 * bj2;
+    const double alpha = alphas[l], beta = betas[l], gamma = gammas[l];
     const bool rotate = gamma * gamma > eps2 * alpha * beta;
     const double diff = beta - alpha;
     const double root = std::sqrt(diff * diff + 4.0 * gamma * gamma);

@@ -152,6 +152,14 @@ double StepObjective::Evaluate(const VectorXd& x, VectorXd* grad, bool keep_fixe
   return value;
 }
 
+bool StepObjective::StopAtCheckpoint(const VectorXd& x, double grad_norm, double initial_norm) {
+  if (!checkpoint_.stop || checkpoint_done_) return false;
+  if (grad_norm > checkpoint_.abs_tolerance + checkpoint_.rel_tolerance * initial_norm) return false;
+  checkpoint_done_ = true;
+  checkpoint_stopped_ = checkpoint_.stop(x);
+  return checkpoint_stopped_;
+}
+
 bool Converged(const SolverOptions& options, double grad_norm, double initial_norm) {
   return grad_norm <= options.abs_tolerance + options.rel_tolerance * initial_norm;
 }
@@ -163,15 +171,7 @@ bool IterationConverged(StepObjective& objective, int it, const VectorXd& x, dou
   if (options.verbosity >= 2)
     std::fprintf(stderr, "  %s iteration %d |grad g| = %.3e\n", ToString(options.method), it, grad_norm);
   if (Converged(options, grad_norm, report->initial_residual)) return true;
-  StepObjective::Checkpoint& checkpoint = objective.checkpoint_;
-  if (checkpoint.stop && !objective.checkpoint_done_ &&
-      grad_norm <= checkpoint.abs_tolerance + checkpoint.rel_tolerance * report->initial_residual) {
-    objective.checkpoint_done_ = true;
-    if (checkpoint.stop(x)) {
-      objective.checkpoint_stopped_ = true;
-      return true;
-    }
-  }
+  if (objective.StopAtCheckpoint(x, grad_norm, report->initial_residual)) return true;
   if (it >= options.max_iterations) ThrowNotConverged(options, it, grad_norm, report->initial_residual);
   return false;
 }

@@ -121,11 +121,12 @@ class StepObjective {
     std::function<bool(const VectorXd& x)> stop;
   };
   void SetCheckpoint(Checkpoint checkpoint) { checkpoint_ = std::move(checkpoint); }
+  // Called by the solvers with each iterate that does not meet the step's
+  // test: true when it is the checkpoint's iterate and stop(x) says stop.
+  bool StopAtCheckpoint(const VectorXd& x, double grad_norm, double initial_norm);
   bool checkpoint_stopped() const { return checkpoint_stopped_; }
 
  private:
-  friend bool IterationConverged(StepObjective& objective, int it, const VectorXd& x, double grad_norm,
-                                 StepReport* report);
   SimulatorImpl& sim_;
   VectorXd xhat_;
   VectorXd force_;
