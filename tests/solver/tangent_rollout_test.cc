@@ -163,14 +163,16 @@ INSTANTIATE_TEST_SUITE_P(AllMethods, TangentReverseModeTest,
                          CaseName);
 
 TEST(TangentRolloutTest, PdReusesTheForwardFactorForEveryColumn) {
-  // L-BFGS (the default PD backward) converges without a direct fallback; the
-  // DiffPD fixed point A z_{k+1} = b + dA z_k contracts too slowly on this
-  // scene and falls back, exactly like the adjoint; both give the same tangents.
+  // CG (the default PD backward) and L-BFGS converge without a direct
+  // fallback; the DiffPD fixed point A z_{k+1} = b + dA z_k contracts too
+  // slowly on this scene and falls back, exactly like the adjoint; all give
+  // the same tangents.
   SolverOptions options = TightOptions(Method::kPd);
   const std::vector<InputDirection> dirs = {InputDirection::YoungsModulus(), InputDirection::PoissonsRatio(),
                                             InputDirection::Density()};
   std::vector<MatrixXd> last;
-  for (PdBackwardMethod backward : {PdBackwardMethod::kLbfgs, PdBackwardMethod::kFixedPoint}) {
+  for (PdBackwardMethod backward :
+       {PdBackwardMethod::kConjugateGradient, PdBackwardMethod::kLbfgs, PdBackwardMethod::kFixedPoint}) {
     options.pd_backward = backward;
     Simulator sim(testing::SmallBeamScene(), options);
     const Rollout rollout = sim.Simulate(MovingStart(sim), std::vector<StepInput>(3));
@@ -182,12 +184,13 @@ TEST(TangentRolloutTest, PdReusesTheForwardFactorForEveryColumn) {
     loss.dx[3] = VectorXd::Ones(sim.num_dofs());
     const RolloutGradient g = sim.Backward(rollout, loss);
     EXPECT_EQ(t.report.fallbacks, static_cast<int>(dirs.size()) * g.report.fallbacks);
-    if (backward == PdBackwardMethod::kLbfgs) {
+    if (backward != PdBackwardMethod::kFixedPoint) {
       EXPECT_EQ(t.report.fallbacks, 0);
     }
     last.push_back(t.dx.back());
   }
   EXPECT_LT((last[0] - last[1]).norm(), 1e-8 * last[0].norm());
+  EXPECT_LT((last[0] - last[2]).norm(), 1e-8 * last[0].norm());
 }
 
 TEST(TangentRolloutTest, SeveralColumnsEqualOneColumnAtATime) {

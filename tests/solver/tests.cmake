@@ -5,3 +5,4 @@ diffpd_add_test(solver_options_test ${CMAKE_CURRENT_LIST_DIR}/solver_options_tes
 diffpd_add_test(pd_system_test ${CMAKE_CURRENT_LIST_DIR}/pd_system_test.cc)
 diffpd_add_test(tangent_rollout_test ${CMAKE_CURRENT_LIST_DIR}/tangent_rollout_test.cc)
 diffpd_add_test(region_materials_test ${CMAKE_CURRENT_LIST_DIR}/region_materials_test.cc)
+diffpd_add_test(preconditioned_iteration_test ${CMAKE_CURRENT_LIST_DIR}/preconditioned_iteration_test.cc)

@@ -24,6 +24,10 @@ enum class PcgPreconditioner { kJacobi, kIncompleteCholesky };
 enum class PdBackwardMethod {
   kFixedPoint,  // A z_{k+1} = b + dA z_k, the DiffPD iteration
   kLbfgs,       // L-BFGS on 1/2 z^T H z - b^T z, A as initial Hessian, exact steps
+  // Conjugate gradients preconditioned by A^{-1}: the same iterates as kLbfgs
+  // in exact arithmetic (exact steps on a quadratic), without its two-loop
+  // recursion's 4 * lbfgs_history vector passes per iteration.
+  kConjugateGradient,
 };
 
 struct SolverOptions {
@@ -64,12 +68,12 @@ struct SolverOptions {
   // 0.05: no convergence in 1000 iterations at rtol 1e-12). The plain `pd`
   // method always uses 1 (its fixed point needs the true A). With a factor
   // < 1 the fixed-point backward (PdBackwardMethod::kFixedPoint) may not
-  // converge and then falls back to a direct solve; the default kLbfgs
-  // backward converges for any factor.
+  // converge and then falls back to a direct solve; the kLbfgs and default
+  // kConjugateGradient backwards converge for any factor (H positive definite).
   double lbfgs_weight_scale = 0.3;
 
   // Backward (adjoint) linear solves: relative residual ||H z - b|| / ||b||.
-  PdBackwardMethod pd_backward = PdBackwardMethod::kLbfgs;
+  PdBackwardMethod pd_backward = PdBackwardMethod::kConjugateGradient;
   double backward_rel_tolerance = 1e-10;
   int backward_max_iterations = 1000;
 

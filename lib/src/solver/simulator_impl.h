@@ -163,7 +163,8 @@ class StepLinearization {
   void AssembleMatrix();
   bool DirectSolve(const VectorXd& b, VectorXd* z);
   bool IterativeSolve(const VectorXd& b, VectorXd* z, int* iterations);
-  // Lockstep IterativeSolve of several columns; ok[c] tells which converged.
+  // The PD-preconditioned iteration (options.pd_backward) on the columns of
+  // b in lockstep; ok[c] tells which converged.
   void IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, std::vector<char>* ok, int* iterations);
   bool PcgSolve(const VectorXd& b, VectorXd* z, int* iterations);
 

@@ -3,20 +3,18 @@
 //
 // Newton methods assemble H and factorise it (CHOLMOD, or PCG for
 // newton-pcg). PD methods never assemble H: they apply it element by element
-// and iterate with the forward factor of A as preconditioner,
-//   fixed point (DiffPD):  A z_{k+1} = b + (A - H) z_k,
-//   or L-BFGS on 1/2 z^T H z - b^T z with H0 = A^{-1} and exact steps.
+// and iterate with the forward factor of A as preconditioner
+// (preconditioned_iteration.h: CG, the DiffPD fixed point or L-BFGS).
 // Residual growth, stagnation or negative curvature triggers a reported
 // fallback to a direct solve of the assembled H (CHOLMOD, then sparse LU
 // when H is indefinite).
-#include <cmath>
 #include <cstdio>
-#include <deque>
 
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseLU>
 
 #include "diffpd/error.h"
+#include "solver/preconditioned_iteration.h"
 #include "solver/simulator_impl.h"
 
 namespace diffpd::internal {
@@ -82,76 +80,29 @@ bool StepLinearization::DirectSolve(const VectorXd& b, VectorXd* z) {
   return z->allFinite();
 }
 
-bool StepLinearization::IterativeSolve(const VectorXd& b, VectorXd* z, int* iterations) {
+void StepLinearization::IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, std::vector<char>* ok,
+                                              int* iterations) {
   PdSystem& pd = sim_.pd_system();
   const SolverOptions& opt = sim_.options;
-  VectorXd rhs = b;
-  sim_.ZeroFixed(&rhs);
-  const double bnorm = rhs.norm();
-  *z = VectorXd::Zero(rhs.size());
-  if (bnorm == 0) return true;
-  const double tol = opt.backward_rel_tolerance * bnorm;
-  VectorXd r = rhs;  // r = b - H z
-  if (opt.pd_backward == PdBackwardMethod::kFixedPoint) {
-    double best = bnorm;
-    int stalled = 0;
-    for (int it = 1; it <= opt.backward_max_iterations; ++it) {
-      *z += pd.Solve(r);
-      r = rhs - Apply(*z);
-      const double rn = r.norm();
-      *iterations = it;
-      if (!std::isfinite(rn)) return false;
-      if (rn <= tol) return true;
-      if (rn > 10 * best) return false;  // growth: spectral radius of A^{-1} dA >= 1
-      if (rn < 0.999 * best) {
-        best = rn;
-        stalled = 0;
-      } else if (++stalled >= 20) {
-        return false;  // stagnation
-      }
-    }
-    return false;
-  }
-  // L-BFGS with exact steps on the quadratic; gradient of the quadratic is -r.
-  std::deque<VectorXd> s_list, y_list;
-  std::deque<double> rho_list;
-  std::vector<double> alpha(opt.lbfgs_history);
-  for (int it = 1; it <= opt.backward_max_iterations; ++it) {
-    VectorXd q = -r;
-    const int k = static_cast<int>(s_list.size());
-    for (int j = k - 1; j >= 0; --j) {
-      alpha[j] = rho_list[j] * s_list[j].dot(q);
-      q -= alpha[j] * y_list[j];
-    }
-    VectorXd p = pd.Solve(q);
-    for (int j = 0; j < k; ++j) p += (alpha[j] - rho_list[j] * y_list[j].dot(p)) * s_list[j];
-    p = -p;
-    sim_.ZeroFixed(&p);
-    const VectorXd hp = Apply(p);
-    const double curvature = p.dot(hp);
-    if (!(curvature > 0)) return false;  // negative curvature: H is not positive definite
-    const double step = r.dot(p) / curvature;
-    *z += step * p;
-    r -= step * hp;
-    *iterations = it;
-    const double rn = r.norm();
-    if (!std::isfinite(rn)) return false;
-    if (rn <= tol) {
-      // Guard against drift of the recurrence: confirm with a true residual.
-      const double true_rn = (rhs - Apply(*z)).norm();
-      if (true_rn <= 10 * tol) return true;
-      r = rhs - Apply(*z);
-    }
-    if (static_cast<int>(s_list.size()) == opt.lbfgs_history) {
-      s_list.pop_front();
-      y_list.pop_front();
-      rho_list.pop_front();
-    }
-    s_list.push_back(step * p);
-    y_list.push_back(step * hp);
-    rho_list.push_back(1.0 / (step * step * curvature));
-  }
-  return false;
+  MatrixXd rhs = b;
+  for (int d = 0; d < rhs.rows(); ++d)
+    if (sim_.fixed[d]) rhs.row(d).setZero();
+  PreconditionedSolveOptions iteration;
+  iteration.method = opt.pd_backward;
+  iteration.rel_tolerance = opt.backward_rel_tolerance;
+  iteration.max_iterations = opt.backward_max_iterations;
+  iteration.lbfgs_history = opt.lbfgs_history;
+  SolvePreconditioned(
+      iteration, rhs, [this](const VectorXd& v) { return Apply(v); },
+      [&pd](const MatrixXd& r) { return pd.Solve(r); }, z, ok, iterations);
+}
+
+bool StepLinearization::IterativeSolve(const VectorXd& b, VectorXd* z, int* iterations) {
+  MatrixXd zs;
+  std::vector<char> ok;
+  IterativeSolveColumns(b, &zs, &ok, iterations);
+  *z = zs.col(0);
+  return ok[0] != 0;
 }
 
 bool StepLinearization::PcgSolve(const VectorXd& b, VectorXd* z, int* iterations) {
@@ -194,121 +145,6 @@ VectorXd StepLinearization::Solve(const VectorXd& b, BackwardReport* report) {
     throw SolverError(SolverStatus::kFactorizationFailed,
                       std::string(ToString(m)) + " backward: the step Hessian is singular; no gradient exists here");
   return z;
-}
-
-}  // namespace diffpd::internal
-
-namespace diffpd::internal {
-
-// The single-column iterations above, run for all columns in lockstep so that
-// each iteration makes one A^{-1} solve with several right-hand sides.
-void StepLinearization::IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, std::vector<char>* ok,
-                                              int* iterations) {
-  PdSystem& pd = sim_.pd_system();
-  const SolverOptions& opt = sim_.options;
-  const int cols = static_cast<int>(b.cols());
-  MatrixXd rhs = b;
-  for (int c = 0; c < cols; ++c) {
-    VectorXd col = rhs.col(c);
-    sim_.ZeroFixed(&col);
-    rhs.col(c) = col;
-  }
-  *z = MatrixXd::Zero(rhs.rows(), cols);
-  ok->assign(cols, 0);
-  MatrixXd r = rhs;
-  std::vector<double> tol(cols), best(cols);
-  std::vector<int> stalled(cols, 0);
-  std::vector<int> active;
-  for (int c = 0; c < cols; ++c) {
-    const double bnorm = rhs.col(c).norm();
-    tol[c] = opt.backward_rel_tolerance * bnorm;
-    best[c] = bnorm;
-    if (bnorm == 0)
-      (*ok)[c] = 1;
-    else
-      active.push_back(c);
-  }
-  // Per-column L-BFGS memory.
-  std::vector<std::deque<VectorXd>> s_list(cols), y_list(cols);
-  std::vector<std::deque<double>> rho_list(cols);
-  std::vector<std::vector<double>> alpha(cols, std::vector<double>(opt.lbfgs_history));
-  const bool fixed_point = opt.pd_backward == PdBackwardMethod::kFixedPoint;
-  for (int it = 1; it <= opt.backward_max_iterations && !active.empty(); ++it) {
-    const int na = static_cast<int>(active.size());
-    MatrixXd q(rhs.rows(), na);
-    for (int j = 0; j < na; ++j) {
-      const int c = active[j];
-      if (fixed_point) {
-        q.col(j) = r.col(c);
-        continue;
-      }
-      VectorXd qc = -r.col(c);
-      for (int m = static_cast<int>(s_list[c].size()) - 1; m >= 0; --m) {
-        alpha[c][m] = rho_list[c][m] * s_list[c][m].dot(qc);
-        qc -= alpha[c][m] * y_list[c][m];
-      }
-      q.col(j) = qc;
-    }
-    const MatrixXd p_all = pd.Solve(q);
-    *iterations += na;
-    std::vector<int> still;
-    for (int j = 0; j < na; ++j) {
-      const int c = active[j];
-      bool converged = false, failed = false;
-      if (fixed_point) {
-        z->col(c) += p_all.col(j);
-        r.col(c) = rhs.col(c) - Apply(z->col(c));
-        const double rn = r.col(c).norm();
-        if (!std::isfinite(rn) || rn > 10 * best[c]) {
-          failed = true;
-        } else if (rn <= tol[c]) {
-          converged = true;
-        } else if (rn < 0.999 * best[c]) {
-          best[c] = rn;
-          stalled[c] = 0;
-        } else if (++stalled[c] >= 20) {
-          failed = true;
-        }
-      } else {
-        VectorXd p = p_all.col(j);
-        const int k = static_cast<int>(s_list[c].size());
-        for (int m = 0; m < k; ++m) p += (alpha[c][m] - rho_list[c][m] * y_list[c][m].dot(p)) * s_list[c][m];
-        p = -p;
-        sim_.ZeroFixed(&p);
-        const VectorXd hp = Apply(p);
-        const double curvature = p.dot(hp);
-        if (!(curvature > 0)) {
-          failed = true;
-        } else {
-          const double step = r.col(c).dot(p) / curvature;
-          z->col(c) += step * p;
-          r.col(c) -= step * hp;
-          const double rn = r.col(c).norm();
-          if (!std::isfinite(rn)) {
-            failed = true;
-          } else {
-            if (rn <= tol[c]) {
-              r.col(c) = rhs.col(c) - Apply(z->col(c));  // confirm with a true residual
-              if (r.col(c).norm() <= 10 * tol[c]) converged = true;
-            }
-            if (static_cast<int>(s_list[c].size()) == opt.lbfgs_history) {
-              s_list[c].pop_front();
-              y_list[c].pop_front();
-              rho_list[c].pop_front();
-            }
-            s_list[c].push_back(step * p);
-            y_list[c].push_back(step * hp);
-            rho_list[c].push_back(1.0 / (step * step * curvature));
-          }
-        }
-      }
-      if (converged)
-        (*ok)[c] = 1;
-      else if (!failed)
-        still.push_back(c);
-    }
-    active.swap(still);
-  }
 }
 
 MatrixXd StepLinearization::SolveColumns(const MatrixXd& b, BackwardReport* report) {
