@@ -46,7 +46,6 @@ SolverOptions MethodOptions(Method method, const BenchOptions& o, double time_st
   s.num_threads = o.threads;
   s.max_iterations = o.max_iterations;
   s.lbfgs_weight_scale = o.lbfgs_weight_scale;
-  s.lbfgs_carry_pairs = o.lbfgs_carry_pairs;
   return s;
 }
 

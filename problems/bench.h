@@ -97,7 +97,6 @@ struct BenchOptions {
   int threads = 0;                       // SolverOptions::num_threads
   int max_iterations = 1000;             // SolverOptions::max_iterations of each step
   double lbfgs_weight_scale = SolverOptions().lbfgs_weight_scale;  // pd-lbfgs preconditioner
-  bool lbfgs_carry_pairs = SolverOptions().lbfgs_carry_pairs;      // pd-lbfgs: pairs carried across steps
   int repeat = 1;                        // runs per method (median), >= 1
   int refine = 0;                        // MakeRefinedProblem doublings
   std::uint64_t seed = 20211;            // loss vectors

@@ -144,8 +144,6 @@ Subcommand AddBenchCommand(CLI::App* parent) {
   cmd->add_option("--lbfgs-scale", args->options.lbfgs_weight_scale,
                   "pd-lbfgs: elastic weight factor of its initial Hessian A, in (0, 1]")
       ->capture_default_str();
-  cmd->add_flag("--carry-pairs", args->options.lbfgs_carry_pairs,
-               "pd-lbfgs: start each step from the previous step's early curvature pairs (SolverOptions::lbfgs_carry_pairs)");
   cmd->add_option("--steps", args->options.steps, "number of time steps (default: the problem's)");
   cmd->add_option("--dt", args->options.time_step, "time step in seconds (default: the problem's)");
   cmd->add_option("--refine", args->options.refine,

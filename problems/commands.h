@@ -24,7 +24,6 @@ struct CommandArgs {
   double dt = -1;        // -1: the problem's default (s)
   double rel_tolerance = -1;  // -1: the command's default
   double lbfgs_weight_scale = SolverOptions().lbfgs_weight_scale;  // pd-lbfgs preconditioner
-  bool lbfgs_carry_pairs = SolverOptions().lbfgs_carry_pairs;      // pd-lbfgs: pairs carried across steps
   int verbosity = 0;     // SolverOptions::verbosity: 0 silent, 1 per step, 2 per iteration
   std::string out_dir;   // "" : no files
   bool json = false;

@@ -26,8 +26,6 @@ void AddCommonOptions(CLI::App* cmd, CommandArgs* args, std::string* method) {
   cmd->add_option("--lbfgs-scale", args->lbfgs_weight_scale,
                   "pd-lbfgs: elastic weight factor of its initial Hessian A, in (0, 1]")
       ->capture_default_str();
-  cmd->add_flag("--carry-pairs", args->lbfgs_carry_pairs,
-               "pd-lbfgs: start each step from the previous step's early curvature pairs (SolverOptions::lbfgs_carry_pairs)");
   cmd->add_option("--verbosity", args->verbosity,
                   "solver log on stderr: 0 none, 1 a line per step, 2 a line per iteration and contact pass")
       ->check(CLI::Range(0, 2))

@@ -71,19 +71,6 @@ struct SolverOptions {
   // converge and then falls back to a direct solve; the kLbfgs and default
   // kConjugateGradient backwards converge for any factor (H positive definite).
   double lbfgs_weight_scale = 0.3;
-  // PD-LBFGS: a step that continues the previous one (its state is the state
-  // the previous Step returned, bit for bit) starts with the curvature pairs
-  // of the previous step's first lbfgs_history iterations instead of none:
-  // the large-scale curvature (the slow, bending-like modes of A^{-1} H)
-  // often changes little from step to step, and a fresh memory spends its
-  // first iterations rebuilding it. Every step still meets the same
-  // convergence test. Simulate always starts fresh, so a rollout does not
-  // depend on what the simulator did before; the pairs are dropped when the
-  // fixed set (contact pins) differs. Off by default: measured (README,
-  // "Carried curvature pairs") 16-19% fewer iterations at rtol 1e-4 on the
-  // cantilever and the rolling sphere, ~4% at 3e-6, but 4-5% more on a
-  // quickly oscillating beam of 16 cells.
-  bool lbfgs_carry_pairs = false;
 
   // Backward (adjoint) linear solves: relative residual ||H z - b|| / ||b||.
   PdBackwardMethod pd_backward = PdBackwardMethod::kConjugateGradient;

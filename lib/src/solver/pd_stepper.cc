@@ -36,33 +36,13 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
   const int m = sim.options.lbfgs_history;
   std::deque<VectorXd> s_list, y_list;
   std::deque<double> rho_list;
-  SimulatorImpl::CarriedPairs& carried = sim.carried_pairs;
-  const bool carry = sim.options.lbfgs_carry_pairs;
-  if (carry && carried.continues && carried.fixed == sim.fixed) {
-    s_list = carried.s;
-    y_list = carried.y;
-    rho_list = carried.rho;
-  }
-  // The pairs of this solve's first m iterations (or all, if it converges
-  // sooner) are the ones the next step starts from.
-  auto keep_pairs = [&] {
-    if (!carry) return;
-    carried.s = s_list;
-    carried.y = y_list;
-    carried.rho = rho_list;
-    carried.fixed = sim.fixed;
-  };
   VectorXd x = x0;
   VectorXd grad;
   double value = objective.Evaluate(x, &grad);
   report->initial_residual = grad.norm();
   std::vector<double> alpha(m);
   for (int it = 0;; ++it) {
-    if (IterationConverged(objective, it, x, grad.norm(), report)) {
-      if (it < m) keep_pairs();
-      return x;
-    }
-    if (it == m) keep_pairs();
+    if (IterationConverged(objective, it, x, grad.norm(), report)) return x;
     // Two-loop recursion with H0 = A^{-1}.
     VectorXd q = grad;
     const int k = static_cast<int>(s_list.size());

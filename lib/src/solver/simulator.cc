@@ -46,7 +46,6 @@ int Simulator::num_dofs() const { return impl_->num_dofs(); }
 void Simulator::SetOptions(const SolverOptions& options) {
   options.Validate();
   impl_->options = options;
-  impl_->carried_pairs.Clear();
 }
 
 void Simulator::SetMaterial(const MaterialParameters& material) {
@@ -100,10 +99,6 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
   CheckVector(input.external_force, n, "external_force", true);
   internal::CheckActivation(input.activation, sim.aux.num_muscles());
   const internal::ActivationScope activation(sim, input.activation);
-  internal::SimulatorImpl::CarriedPairs& carried = sim.carried_pairs;
-  carried.continues = carried.next_x.size() == n && (carried.next_x.array() == state.x.array()).all() &&
-                      (carried.next_v.array() == state.v.array()).all();
-  carried.next_x.resize(0);  // until this step succeeds
   const auto start = Clock::now();
   StepReport local;
   StepReport* rep = report ? report : &local;
@@ -152,8 +147,6 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
         << " s; an explicit method needs a smaller time step)";
     throw SolverError(SolverStatus::kNonFinite, msg.str());
   }
-  carried.next_x = next.x;
-  carried.next_v = next.v;
   rep->seconds = Seconds(start);
   if (sim.options.verbosity >= 1)
     std::fprintf(stderr, "%s step: %d iterations, |grad g| %.3e -> %.3e, %.4f s\n", ToString(sim.options.method),
@@ -170,7 +163,6 @@ Rollout Simulator::Simulate(const State& initial, const std::vector<StepInput>& 
   r.states.reserve(inputs.size() + 1);
   r.reports.resize(inputs.size());
   r.states.push_back(initial);
-  impl_->carried_pairs.Clear();  // a rollout does not depend on earlier calls
   for (size_t i = 0; i < inputs.size(); ++i) r.states.push_back(Step(r.states.back(), inputs[i], &r.reports[i]));
   return r;
 }

@@ -40,7 +40,6 @@ void SimulatorImpl::SetRegionMaterial(int region, const MaterialParameters& mate
 }
 
 void SimulatorImpl::MaterialsChanged() {
-  carried_pairs.Clear();
   std::vector<double> densities;
   for (int p = 0; p < num_parts(); ++p) densities.push_back(part_material(p).density);
   mass_model.SetDensities(densities);

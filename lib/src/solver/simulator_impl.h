@@ -1,7 +1,6 @@
 // State shared by the simulator's steppers and adjoints (internal).
 #pragma once
 
-#include <deque>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -71,28 +70,6 @@ class SimulatorImpl {
   VectorXd ExplicitForce(const StepInput& input) const;
   // Sets fixed DoFs of v to zero.
   void ZeroFixed(VectorXd* v) const;
-
-  // PD-LBFGS curvature pairs carried from one step to the next
-  // (SolverOptions::lbfgs_carry_pairs). Step keeps `continues` true only
-  // while the step it solves continues the previous one; PdLbfgsSolve
-  // starts from the pairs when they were made with the current fixed set,
-  // and replaces them with those of its own first lbfgs_history iterations.
-  struct CarriedPairs {
-    bool continues = false;
-    std::deque<VectorXd> s, y;
-    std::deque<double> rho;
-    std::vector<char> fixed;  // the fixed DoFs the pairs were made with
-    VectorXd next_x, next_v;  // the state the last step returned
-    void Clear() {
-      continues = false;
-      s.clear();
-      y.clear();
-      rho.clear();
-      next_x.resize(0);
-      next_v.resize(0);
-    }
-  };
-  CarriedPairs carried_pairs;
 
   // Lazily built solvers.
   HessianAssembler& hessian_assembler();
