@@ -14,6 +14,7 @@
 #include <ceres/gradient_problem_solver.h>
 
 #include "commands.h"
+#include "diffpd/csv_fields.h"
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
 #include "diffpd/surface_mesh.h"
@@ -57,28 +58,6 @@ std::string Num(double v) {
   return s.str();
 }
 
-std::string Trim(const std::string& s) {
-  const size_t b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return "";
-  const size_t e = s.find_last_not_of(" \t\r\n");
-  return s.substr(b, e - b + 1);
-}
-
-std::vector<std::string> Split(const std::string& line) {
-  std::vector<std::string> fields;
-  std::stringstream in(line);
-  std::string f;
-  while (std::getline(in, f, ',')) fields.push_back(Trim(f));
-  if (!line.empty() && line.back() == ',') fields.push_back("");
-  return fields;
-}
-
-bool ParseNumber(const std::string& text, double* value) {
-  if (text.empty()) return false;
-  char* end = nullptr;
-  *value = std::strtod(text.c_str(), &end);
-  return end == text.c_str() + text.size();
-}
 
 double Sigmoid(double u) { return 1 / (1 + std::exp(-u)); }
 double Logit(double s) { return std::log(s / (1 - s)); }
@@ -258,25 +237,25 @@ StarfishRecording ReadStarfishRecording(const std::string& path) {
   if (!std::getline(in, line)) throw InvalidInputError(path + ": empty file (expected a header row and data rows)");
   ++number;
   {
-    const std::vector<std::string> header = Split(line);
+    const std::vector<std::string> header = SplitCsvLine(line);
     if (header.size() != 10)
       throw InvalidInputError(path + ":1: expected a header row of 10 column labels, got " +
                               std::to_string(header.size()) + " fields");
     double v;
-    if (ParseNumber(header[0], &v))
+    if (ParseCsvNumber(header[0], &v))
       throw InvalidInputError(path + ":1: expected a header row of column labels, got the number '" + header[0] + "'");
   }
   while (std::getline(in, line)) {
     ++number;
-    if (Trim(line).empty()) continue;
+    if (TrimCsvField(line).empty()) continue;
     const std::string where = path + ":" + std::to_string(number) + ": ";
-    const std::vector<std::string> fields = Split(line);
+    const std::vector<std::string> fields = SplitCsvLine(line);
     if (fields.size() != 10)
       throw InvalidInputError(where + "expected 10 fields (time ms, tendon mm, M1 x, M1 y, ..., M4 x, M4 y), got " +
                               std::to_string(fields.size()));
     double v[10];
     for (int c = 0; c < 10; ++c)
-      if (!ParseNumber(fields[c], &v[c]))
+      if (!ParseCsvNumber(fields[c], &v[c]))
         throw InvalidInputError(where + kColumns[c] + " is not a number: '" + fields[c] + "'");
     if (!std::isfinite(v[0])) throw InvalidInputError(where + "time = " + Num(v[0]) + " is invalid: must be finite (ms)");
     if (std::isinf(v[1]))

@@ -12,35 +12,11 @@
 #include <random>
 #include <sstream>
 
+#include "diffpd/csv_fields.h"
 #include "diffpd/error.h"
 
 namespace diffpd {
 namespace {
-
-std::string Trim(const std::string& s) {
-  const size_t b = s.find_first_not_of(" \t\r");
-  if (b == std::string::npos) return "";
-  const size_t e = s.find_last_not_of(" \t\r");
-  return s.substr(b, e - b + 1);
-}
-
-std::vector<std::string> SplitFields(const std::string& line) {
-  std::vector<std::string> fields;
-  std::string field;
-  std::istringstream in(line);
-  while (std::getline(in, field, ',')) fields.push_back(Trim(field));
-  if (!line.empty() && line.back() == ',') fields.push_back("");
-  return fields;
-}
-
-// Whole-string parses; no range or finiteness check.
-bool ParseNumber(const std::string& s, double* value) {
-  if (s.empty()) return false;
-  char* end = nullptr;
-  errno = 0;
-  *value = std::strtod(s.c_str(), &end);
-  return end == s.c_str() + s.size();
-}
 
 bool ParseInteger(const std::string& s, long* value) {
   if (s.empty()) return false;
@@ -155,9 +131,9 @@ CapturedMotion ReadCapturedMotion(const std::string& path) {
   };
   while (std::getline(in, raw)) {
     ++line_number;
-    const std::string line = Trim(raw);
+    const std::string line = TrimCsvField(raw);
     if (line.empty() || line[0] == '#') continue;
-    const std::vector<std::string> f = SplitFields(line);
+    const std::vector<std::string> f = SplitCsvLine(line);
     if (f[0] == "marker") {
       if (num_fields) fail("marker declarations must come before the header");
       Marker m;
@@ -166,7 +142,7 @@ CapturedMotion ReadCapturedMotion(const std::string& path) {
       const bool vertex = f.size() == 4 && f[2] == "vertex";
       const bool element = f.size() == 7 && f[2] == "element";
       bool ok = (vertex || element) && ParseInteger(f[1], &id) && ParseInteger(f[3], &index);
-      for (int c = 0; ok && element && c < 3; ++c) ok = ParseNumber(f[4 + c], &m.local(c));
+      for (int c = 0; ok && element && c < 3; ++c) ok = ParseCsvNumber(f[4 + c], &m.local(c));
       if (!ok)
         fail("expected 'marker,<id>,vertex,<v>' or 'marker,<id>,element,<e>,<c0>,<c1>,<c2>', got '" + line + "'");
       m.id = static_cast<int>(id);
@@ -197,7 +173,7 @@ CapturedMotion ReadCapturedMotion(const std::string& path) {
     double values[8];
     for (int c = 0; c < num_fields; ++c) {
       if (c == 1) continue;
-      if (!ParseNumber(f[c], &values[c])) fail(std::string(kNames[c]) + " is not a number: '" + f[c] + "'");
+      if (!ParseCsvNumber(f[c], &values[c])) fail(std::string(kNames[c]) + " is not a number: '" + f[c] + "'");
     }
     long id = 0;
     if (!ParseInteger(f[1], &id) || id != static_cast<int>(id)) fail("marker is not an integer: '" + f[1] + "'");
