@@ -52,7 +52,8 @@ struct SolverOptions {
   double pcg_rel_tolerance = 1e-8;
   int pcg_max_iterations = 20000;
 
-  // PD-LBFGS and the PD backward's L-BFGS: number of stored pairs (20 measured
+  // PD-LBFGS and the PD backward's L-BFGS (PdBackwardMethod::kLbfgs): number
+  // of stored pairs (20 measured
   // best on the cantilever: 73 iterations per step vs 90 with 8 and 130 with 5).
   int lbfgs_history = 20;
   // PD-LBFGS (forward and backward): its initial Hessian is the PD matrix A
