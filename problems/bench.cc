@@ -163,6 +163,8 @@ RolloutMeasurement MeasureRollout(const Scene& scene, const SolverOptions& optio
       start = Clock::now();
       const RolloutGradient g = sim.Backward(rollout, dl);
       backward.push_back(SecondsSince(start));
+      m.backward_iterations = g.report.linear_iterations;
+      m.backward_fallbacks = g.report.fallbacks;
       const int n = sim.num_dofs();
       m.gradient.resize(2 * n + 3);
       m.gradient << g.x0, g.v0, g.youngs_modulus, g.poissons_ratio, g.density;
@@ -258,6 +260,8 @@ BenchResult RunBench(const std::string& problem, const BenchOptions& options, st
       row.forward_s = m.forward_s;
       row.backward_s = m.backward_s;
       row.iters_per_step = m.iters_per_step;
+      row.backward_iters_per_step = result.steps > 0 ? double(m.backward_iterations) / result.steps : 0;
+      row.backward_fallbacks = m.backward_fallbacks;
       row.forward_per_iteration_ms = m.total_iterations > 0 ? 1e3 * m.forward_s / m.total_iterations : 0;
       row.state_rel_error = RelativeError(StackState(m.final_state), ref_state);
       row.position_rel_error = RelativeError(m.final_state.x, reference.final_state.x);
@@ -293,6 +297,8 @@ nlohmann::json BenchToJson(const BenchResult& result, const BenchOptions& option
                     {"forward_s", NumberOrNull(ok, r.forward_s)},
                     {"backward_s", NumberOrNull(ok, r.backward_s)},
                     {"iters_per_step", NumberOrNull(ok, r.iters_per_step)},
+                    {"backward_iters_per_step", NumberOrNull(ok, r.backward_iters_per_step)},
+                    {"backward_fallbacks", ok ? nlohmann::json(r.backward_fallbacks) : nlohmann::json(nullptr)},
                     {"state_rel_error", NumberOrNull(ok, r.state_rel_error)},
                     {"position_rel_error", NumberOrNull(ok, r.position_rel_error)},
                     {"velocity_rel_error", NumberOrNull(ok, r.velocity_rel_error)},

@@ -69,6 +69,11 @@ struct RolloutMeasurement {
   double backward_s = 0;
   long total_iterations = 0;
   double iters_per_step = 0;
+  // Backward: iterations of the iterative adjoint solves (PD's
+  // A-preconditioned CG, Newton-PCG's CG; 0 for a direct solve) and solves
+  // that fell back to a direct one, of the last run.
+  long backward_iterations = 0;
+  int backward_fallbacks = 0;
   State final_state;
   // [dL/dx0, dL/dv0, dL/dE, dL/dnu, dL/drho] (6n + 3).
   VectorXd gradient;
@@ -111,6 +116,8 @@ struct BenchRow {
   double forward_s = 0;
   double backward_s = 0;
   double iters_per_step = 0;
+  double backward_iters_per_step = 0;   // adjoint solver iterations per step (0: direct)
+  int backward_fallbacks = 0;           // adjoint solves that fell back to a direct solve
   double forward_per_iteration_ms = 0;  // forward_s / total iterations, ms
   double state_rel_error = 0;     // of [x; v] stacked
   double position_rel_error = 0;  // of x alone

@@ -53,16 +53,18 @@ struct BenchArgs {
 void PrintBenchTable(const BenchResult& r) {
   std::printf("# %s: %d elements, %d DoFs, %d steps of %g s; reference newton-cholesky rtol 1e-10 (%.3f s)\n",
               r.problem.c_str(), r.elements, r.dofs, r.steps, r.time_step, r.reference_forward_s);
-  std::printf("%-16s %10s %10s %10s %12s %12s %10s %10s %12s %10s\n", "method", "forward_s", "backward_s",
-              "iters/step", "ms/iter", "state_err", "x_err", "v_err", "grad_err", "speedup");
+  std::printf("%-16s %10s %10s %10s %12s %12s %12s %10s %10s %12s %10s\n", "method", "forward_s", "backward_s",
+              "iters/step", "ms/iter", "bwd_it/step", "state_err", "x_err", "v_err", "grad_err", "speedup");
   for (const auto& row : r.rows) {
     if (!row.failure.empty()) {
       std::printf("%-16s failed: %s\n", row.method.c_str(), row.failure.c_str());
       continue;
     }
-    std::printf("%-16s %10.4f %10.4f %10.2f %12.4f %12.3e %10.2e %10.2e %12.3e", row.method.c_str(), row.forward_s,
-                row.backward_s, row.iters_per_step, row.forward_per_iteration_ms, row.state_rel_error,
-                row.position_rel_error, row.velocity_rel_error, row.grad_rel_error);
+    std::printf("%-16s %10.4f %10.4f %10.2f %12.4f %12.2f %12.3e %10.2e %10.2e %12.3e", row.method.c_str(),
+                row.forward_s, row.backward_s, row.iters_per_step, row.forward_per_iteration_ms,
+                row.backward_iters_per_step, row.state_rel_error, row.position_rel_error, row.velocity_rel_error,
+                row.grad_rel_error);
+    if (row.backward_fallbacks > 0) std::printf(" (%d adjoint fallbacks)", row.backward_fallbacks);
     if (row.speedup_vs_newton_cholesky) std::printf(" %10.2f\n", *row.speedup_vs_newton_cholesky);
     else std::printf(" %10s\n", "-");
   }

@@ -115,6 +115,11 @@ TEST(BenchTest, RowsCarryEveryMethodAndTheReportedQuantities) {
     EXPECT_EQ(row.grad_rel_error_by_input.size(), 5u);
   }
   EXPECT_DOUBLE_EQ(*Row(r, "newton-cholesky").speedup_vs_newton_cholesky, 1.0);
+  // The adjoint: PD methods iterate, Newton-Cholesky solves directly (Newton-PCG's
+  // incomplete Cholesky is exact on this 60-DoF beam: no iteration either).
+  EXPECT_EQ(Row(r, "newton-cholesky").backward_iters_per_step, 0.0);
+  EXPECT_GE(Row(r, "pd-lbfgs").backward_iters_per_step, 1.0);
+  EXPECT_GE(Row(r, "pd").backward_iters_per_step, 1.0);
   // Newton converges quadratically: a few iterations; PD needs hundreds.
   EXPECT_LT(Row(r, "newton-cholesky").iters_per_step, 10);
   EXPECT_GT(Row(r, "pd").iters_per_step, 10 * Row(r, "newton-cholesky").iters_per_step);
@@ -160,7 +165,8 @@ TEST(BenchTest, JsonIsAListWithTheRequiredFields) {
   ASSERT_EQ(parsed.size(), 2u);
   for (const auto& row : parsed) {
     for (const char* field : {"forward_s", "backward_s", "iters_per_step", "state_rel_error", "grad_rel_error",
-                              "forward_per_iteration_ms", "speedup_vs_newton_cholesky"})
+                              "forward_per_iteration_ms", "speedup_vs_newton_cholesky", "backward_iters_per_step",
+                              "backward_fallbacks"})
       EXPECT_TRUE(row.at(field).is_number()) << field;
     EXPECT_TRUE(row.at("method").is_string());
     EXPECT_EQ(row.at("status"), "ok");
