@@ -32,7 +32,7 @@ class ColumnIteration {
     return r_.norm() <= 10 * tol_ ? ColumnStatus::kConverged : ColumnStatus::kRunning;
   }
 
-  const VectorXd& b_;
+  const VectorXd b_;
   VectorXd r_;  // b - H z
   VectorXd z_;
   const double tol_;
@@ -153,16 +153,14 @@ void SolvePreconditioned(const PreconditionedSolveOptions& options, const Matrix
   const int cols = static_cast<int>(b.cols());
   *z = MatrixXd::Zero(b.rows(), cols);
   ok->assign(cols, 0);
-  std::vector<VectorXd> rhs(cols);
   std::vector<std::unique_ptr<ColumnIteration>> column(cols);
   std::vector<int> active;
   for (int c = 0; c < cols; ++c) {
-    rhs[c] = b.col(c);
-    if (rhs[c].squaredNorm() == 0) {
+    if (b.col(c).squaredNorm() == 0) {
       (*ok)[c] = 1;
       continue;
     }
-    column[c] = MakeColumn(options, rhs[c], apply_h);
+    column[c] = MakeColumn(options, b.col(c), apply_h);
     active.push_back(c);
   }
   for (int it = 1; it <= options.max_iterations && !active.empty(); ++it) {
