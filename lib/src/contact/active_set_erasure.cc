@@ -109,7 +109,9 @@ MatrixXd ActiveSetErasure::Solve(const CholmodSolver& base, MatrixXd rhs) const 
   for (int r = 0; r < s; ++r) ys.row(r) = y.row(nodes_[r]);
   const MatrixXd lambda = capacitance_.solve(ys);
   if (s <= kDenseCorrectionMax) {
-    y.noalias() -= w_ * lambda;
+    // Column by column: matrix-vector products (a matrix product would pack
+    // W for a few right-hand sides, measured as costly as the rest of the solve).
+    for (Eigen::Index c = 0; c < y.cols(); ++c) y.col(c).noalias() -= w_ * lambda.col(c);
   } else {
     // A^-1 (R - P lambda): R is zero on S, so the corrected right-hand side
     // is -lambda there and R elsewhere.

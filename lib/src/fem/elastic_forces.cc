@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "diffpd/error.h"
+#include "fem/pd_hex_kernel.h"
 #include "material/density_kernels.h"
 #include "material/svd3.h"
 
@@ -106,6 +107,22 @@ ElasticForces::ElasticForces(const FemModel& fem, std::vector<ElasticEnergy> ene
   element_buffer_.assign(static_cast<size_t>(fem_.num_elements()) * 3 * fem_.nodes_per_element(), 0.0);
   element_energy_.assign(fem_.num_elements(), 0.0);
   v_cache_.assign(fem_.num_samples(), Mat3::Identity());
+  for (const ElasticEnergy e : energies_) {
+    rotation_terms_ += e == ElasticEnergy::kPdCorotated;
+    volume_terms_ += e == ElasticEnergy::kPdVolume;
+  }
+  const bool pd_only = !energies_.empty() && rotation_terms_ + volume_terms_ == static_cast<int>(energies_.size());
+  pd_hex_kernel_ = pd_only && fem_.nodes_per_element() == 8 && fem_.samples_per_element() == 8;
+  if (pd_hex_kernel_) {
+    hex_lane_gradients_.resize(static_cast<size_t>(fem_.num_elements()) * kHexLaneGradients);
+    for (int e = 0; e < fem_.num_elements(); ++e) {
+      double* out = hex_lane_gradients_.data() + static_cast<size_t>(e) * kHexLaneGradients;
+      for (int l = 0; l < 8; ++l) {
+        const double* g = fem_.grad(8 * e + l);  // 8 x 3, column-major
+        for (int k = 0; k < 24; ++k) out[k * 8 + l] = g[k];
+      }
+    }
+  }
 }
 
 double ElasticForces::PdWeight(double mu, double lambda) const {
@@ -173,7 +190,8 @@ double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, const LameField& 
                                             int threads) {
   if (!x.allFinite()) throw SolverError(SolverStatus::kNonFinite, "positions are not finite");
   const int q_per = fem_.samples_per_element();
-  ForEachDecomposedElement<K>(x, threads, [&](int e, const Mat3* F, const Svd3* svd, const VolumeProjection* volume) {
+  // The general path for element e (F, svd, volume: its samples').
+  auto element = [&](int e, const Mat3* F, const Svd3* svd, const VolumeProjection* volume) {
     const double mu = lame.mu_of(e), lambda = lame.lambda_of(e);
     Eigen::Matrix<double, 3, K> fe = Eigen::Matrix<double, 3, K>::Zero();
     double energy = 0;
@@ -188,7 +206,26 @@ double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, const LameField& 
     }
     element_energy_[e] = energy;
     if (grad) Eigen::Map<Eigen::Matrix<double, 3, K>>(element_buffer_.data() + static_cast<size_t>(e) * 3 * K) = fe;
-  });
+  };
+  if (K == 8 && pd_hex_kernel_) {
+    ParallelForElements(fem_.num_elements(), threads, [&](int e) {
+      const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(fem_.mesh(), x, e);
+      PdHexWeights w;
+      w.rotation = rotation_terms_ * 2.0 * lame.mu_of(e);
+      w.volume = volume_terms_ * lame.lambda_of(e);
+      if (PdHexEnergyAndForces(xe.data(), hex_lane_gradients_.data() + static_cast<size_t>(e) * kHexLaneGradients,
+                               fem_.grad(8 * e), fem_.sample_volumes(8 * e), w, &v_cache_[8 * static_cast<size_t>(e)],
+                               element_buffer_.data() + static_cast<size_t>(e) * 3 * K, &element_energy_[e]))
+        return;
+      Mat3 F[kSvdBatch];
+      Svd3 svd[kSvdBatch];
+      VolumeProjection volume[kSvdBatch];
+      SampleDecompositions<K>(x, e, 1, F, svd, volume);
+      element(e, F, svd, needs_volume_ ? volume : nullptr);
+    });
+  } else {
+    ForEachDecomposedElement<K>(x, threads, element);
+  }
   double total = 0;
   for (double v : element_energy_) total += v;
   if (!std::isfinite(total))

@@ -114,6 +114,12 @@ class ElasticForces {
   std::vector<double> element_dot_;     // per element (PartLameDots' lambda dots)
   // Per-sample V of the last SVD: warm start of the next one (see svd3.h).
   std::vector<Mat3> v_cache_;
+  // Hexahedra with PD energies only: the fused kernel (pd_hex_kernel.h), its
+  // lane-ordered shape gradients (kHexLaneGradients per element) and the
+  // number of pd-corotated / pd-volume terms declared.
+  bool pd_hex_kernel_ = false;
+  std::vector<double> hex_lane_gradients_;
+  int rotation_terms_ = 0, volume_terms_ = 0;
 };
 
 // Energy density, stress and (optionally) stress differential of the sum of

@@ -31,6 +31,8 @@ class FemModel {
   const double* grad(int s) const { return grad_.data() + static_cast<size_t>(s) * k_ * 3; }
   // Rest volume carried by sample s (quadrature weight x det J), m^3.
   double sample_volume(int s) const { return volume_[s]; }
+  // The rest volumes of samples s, s + 1, ... (contiguous, m^3).
+  const double* sample_volumes(int s) const { return volume_.data() + s; }
   // Rest volume of element e, m^3.
   double element_volume(int e) const;
   // Lumped mass per node for unit density: integral of N_a over the mesh (m^3).

@@ -143,20 +143,11 @@ inline bool NeedsNoRescaling(const Mat3& F) {
   return max_abs != 0.0 && max_abs >= 1e-100 && max_abs <= 1e100;
 }
 
-// Structure-of-arrays Jacobi sweeps over kSvdBatch matrices: entry (r, c) of
-// lane l's B at b[r + 3 c][l]. The same rotations as OrthogonalizeColumns,
-// lane by lane; a lane whose columns are already orthogonal gets c = 1,
-// s = 0, which leaves it unchanged exactly, so every lane ends as its own
-// scalar sweep would.
-struct alignas(64) BatchColumns {
-  double b[9][kSvdBatch];
-  double v[9][kSvdBatch];
-  double u[9][kSvdBatch];      // output of BatchFinish
-  double sigma[3][kSvdBatch];  // output of BatchFinish
-  double det_sign_reference[kSvdBatch];
-};
-
-DIFFPD_SIMD_INLINE bool OrthogonalizeBatchColumns(BatchColumns& m, int i, int j) {
+// Structure-of-arrays Jacobi sweeps over kSvdBatch matrices (Svd3Lanes). The
+// same rotations as OrthogonalizeColumns, lane by lane; a lane whose columns
+// are already orthogonal gets c = 1, s = 0, which leaves it unchanged exactly,
+// so every lane ends as its own scalar sweep would.
+DIFFPD_SIMD_INLINE bool OrthogonalizeSvd3Lanes(Svd3Lanes& m, int i, int j) {
   int any = 0;
   const double eps2 = kEps * kEps;
   // The test first, over all lanes: the last sweep of a converged batch
@@ -207,7 +198,7 @@ DIFFPD_SIMD_INLINE bool OrthogonalizeBatchColumns(BatchColumns& m, int i, int j)
 
 // Swaps columns i and j of B and V (and their squared norms) in the lanes
 // where norm_i < norm_j, flipping those lanes' permutation parity.
-DIFFPD_SIMD_INLINE void BatchSortPair(BatchColumns& m, double (&norms)[3][kSvdBatch], double* odd, int i, int j) {
+DIFFPD_SIMD_INLINE void BatchSortPair(Svd3Lanes& m, double (&norms)[3][kSvdBatch], double* odd, int i, int j) {
 #pragma omp simd
   for (int l = 0; l < kSvdBatch; ++l) {
     const bool swap = norms[i][l] < norms[j][l];
@@ -228,7 +219,7 @@ DIFFPD_SIMD_INLINE void BatchSortPair(BatchColumns& m, double (&norms)[3][kSvdBa
 
 // GivensZero lane by lane (rows p, q of B, zeroing B(q, col)); lanes with
 // a = b = 0 get c = 1, s = 0, i.e. no change, as the scalar code skips them.
-DIFFPD_SIMD_INLINE void BatchGivens(BatchColumns& m, int p, int q, int col) {
+DIFFPD_SIMD_INLINE void BatchGivens(Svd3Lanes& m, int p, int q, int col) {
 #pragma omp simd
   for (int l = 0; l < kSvdBatch; ++l) {
     const double a = m.b[p + 3 * col][l], b = m.b[q + 3 * col][l];
@@ -251,7 +242,7 @@ DIFFPD_SIMD_INLINE void BatchGivens(BatchColumns& m, int p, int q, int col) {
 
 // FinishSvd (steps 2 and 3) lane by lane, the same operations with selects
 // for branches; lanes are unscaled (exponent 0).
-DIFFPD_SIMD_INLINE void BatchFinish(BatchColumns& m) {
+DIFFPD_SIMD_INLINE void BatchFinish(Svd3Lanes& m) {
   double norms[3][kSvdBatch];
   double odd[kSvdBatch];
 #pragma omp simd
@@ -289,19 +280,19 @@ DIFFPD_SIMD_INLINE void BatchFinish(BatchColumns& m) {
   }
 }
 
+}  // namespace
+
 // The batch's sweeps and finish, one clone per vector width (simd_dispatch.h).
 DIFFPD_SIMD_CLONES
-void BatchSvd(BatchColumns& m) {
+void ComputeSvd3Lanes(Svd3Lanes& m) {
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
-    bool rotated = OrthogonalizeBatchColumns(m, 0, 1);
-    rotated = OrthogonalizeBatchColumns(m, 0, 2) || rotated;
-    rotated = OrthogonalizeBatchColumns(m, 1, 2) || rotated;
+    bool rotated = OrthogonalizeSvd3Lanes(m, 0, 1);
+    rotated = OrthogonalizeSvd3Lanes(m, 0, 2) || rotated;
+    rotated = OrthogonalizeSvd3Lanes(m, 1, 2) || rotated;
     if (!rotated) break;
   }
   BatchFinish(m);
 }
-
-}  // namespace
 
 Svd3 ComputeSvd3(const Mat3& F) { return ComputeSvd3(F, Mat3::Identity()); }
 
@@ -344,7 +335,7 @@ void ComputeSvd3Batch(int count, const Mat3* F, const Mat3* v_guess, Svd3* out) 
     for (int l = 0; l < count; ++l) out[l] = ComputeSvd3(F[l], v_guess[l]);
     return;
   }
-  BatchColumns m;
+  Svd3Lanes m;
   bool batched[kSvdBatch];
   for (int l = 0; l < kSvdBatch; ++l) {
     batched[l] = l < count && NeedsNoRescaling(F[l]);
@@ -357,7 +348,7 @@ void ComputeSvd3Batch(int count, const Mat3* F, const Mat3* v_guess, Svd3* out) 
       m.v[k][l] = V(k);
     }
   }
-  BatchSvd(m);
+  ComputeSvd3Lanes(m);
   for (int l = 0; l < count; ++l) {
     if (!batched[l]) {
       out[l] = ComputeSvd3(F[l], v_guess[l]);

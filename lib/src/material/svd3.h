@@ -32,4 +32,19 @@ Svd3 ComputeSvd3(const Mat3& F, const Mat3& v_guess);
 constexpr int kSvdBatch = 8;
 void ComputeSvd3Batch(int count, const Mat3* F, const Mat3* v_guess, Svd3* out);
 
+// The batch in structure-of-arrays form, for callers that already hold their
+// matrices lane by lane (entry k = r + 3 c of lane l's matrix at [k][l]).
+// In: b = F v_guess, v = v_guess, det_sign_reference = det(b), every lane
+// finite with max |F(i, j)| in [1e-100, 1e100] (the unscaled path; idle lanes
+// hold the identity). Out: b overwritten, v = V, u = U, sigma, each lane equal
+// to ComputeSvd3(F, v_guess) up to rounding.
+struct alignas(64) Svd3Lanes {
+  double b[9][kSvdBatch];
+  double v[9][kSvdBatch];
+  double u[9][kSvdBatch];
+  double sigma[3][kSvdBatch];
+  double det_sign_reference[kSvdBatch];
+};
+void ComputeSvd3Lanes(Svd3Lanes& m);
+
 }  // namespace diffpd::internal

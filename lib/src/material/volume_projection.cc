@@ -244,17 +244,23 @@ DIFFPD_SIMD_INLINE double FirstOrderMultiplier(double s0, double s1, double s2) 
   const double inv0 = 1.0 / s0, inv1 = 1.0 / s1, inv2 = 1.0 / s2;
   return -2.0 * (p - 1.0) / ((p + 1.0) * (inv0 * inv0 + inv1 * inv1 + inv2 * inv2));
 }
-// One Halley evaluation at mu: d_i, the residual f = P - 1 and the next mu.
-DIFFPD_SIMD_INLINE double HalleyStep(const double* s, double mu, double* d, double* residual) {
-  double product = 1.0, sum = 0.0, curvature = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    const double r = std::sqrt(s[i] * s[i] + 4.0 * mu);
-    d[i] = 0.5 * (s[i] + r);
-    const double a = 1.0 / (d[i] * r);
-    product *= d[i];
-    sum += a;
-    curvature += (1.0 + 2.0 * d[i] / r) * a * a;
-  }
+// One Halley evaluation at mu: d_i, the residual f = P - 1 and the next mu
+// (scalar arguments, so that the lane loop calling it vectorises).
+DIFFPD_SIMD_INLINE void HalleyTerm(double s, double mu, double* d, double* a, double* c) {
+  const double r = std::sqrt(s * s + 4.0 * mu);
+  *d = 0.5 * (s + r);
+  *a = 1.0 / (*d * r);
+  *c = (1.0 + 2.0 * *d / r) * *a * *a;
+}
+DIFFPD_SIMD_INLINE double HalleyStep(double s0, double s1, double s2, double mu, double* d0, double* d1, double* d2,
+                                     double* residual) {
+  double a0, a1, a2, c0, c1, c2;
+  HalleyTerm(s0, mu, d0, &a0, &c0);
+  HalleyTerm(s1, mu, d1, &a1, &c1);
+  HalleyTerm(s2, mu, d2, &a2, &c2);
+  const double product = *d0 * *d1 * *d2;
+  const double sum = a0 + a1 + a2;
+  const double curvature = c0 + c1 + c2;
   const double f = product - 1.0;
   const double df = product * sum;
   const double d2f = product * (sum * sum - curvature);
@@ -268,7 +274,7 @@ bool GrowingRootByMultiplier(const Vec3& s, VolumeProjection* out) {
   for (int iteration = 0; iteration <= kMaxHalleySteps; ++iteration) {
     if (!(mu > mu_floor)) return false;
     double d[3], residual;
-    const double next = HalleyStep(s.data(), mu, d, &residual);
+    const double next = HalleyStep(s(0), s(1), s(2), mu, &d[0], &d[1], &d[2], &residual);
     if (std::abs(residual) <= 4.0 * kEps) {
       out->d = Vec3(d[0], d[1], d[2]);
       out->multiplier = mu;
@@ -279,19 +285,12 @@ bool GrowingRootByMultiplier(const Vec3& s, VolumeProjection* out) {
   return false;
 }
 
-// The fast path for kVolumeBatch targets at once, lane by lane (structure of
-// arrays, OpenMP SIMD). done[l] is set for the lanes that converged, whose
-// d and mu are then those of the scalar fast path up to rounding.
-struct alignas(64) VolumeBatch {
-  double s[3][kVolumeBatch];
-  double d[3][kVolumeBatch];
-  double mu[kVolumeBatch];
-  double done[kVolumeBatch];  // 1 when converged, else 0
-};
+}  // namespace
 
-// One clone per vector width (simd_dispatch.h).
+// The fast path for kVolumeBatch targets at once, lane by lane (OpenMP SIMD),
+// one clone per vector width (simd_dispatch.h).
 DIFFPD_SIMD_CLONES
-void BatchGrowingRoots(VolumeBatch& b) {
+void ProjectVolumeLanes(VolumeLanes& b) {
 #pragma omp simd
   for (int l = 0; l < kVolumeBatch; ++l) {
     b.mu[l] = FirstOrderMultiplier(b.s[0][l], b.s[1][l], b.s[2][l]);
@@ -299,24 +298,30 @@ void BatchGrowingRoots(VolumeBatch& b) {
   }
   for (int iteration = 0; iteration <= kMaxHalleySteps; ++iteration) {
     int pending = 0;
+    // Branch-free body (bitwise & on the tests, selects for the updates) so
+    // that the lanes vectorise.
 #pragma omp simd reduction(+ : pending)
     for (int l = 0; l < kVolumeBatch; ++l) {
-      const double s[3] = {b.s[0][l], b.s[1][l], b.s[2][l]};
+      const double s0 = b.s[0][l], s1 = b.s[1][l], s2 = b.s[2][l];
       const double mu = b.mu[l];
-      const bool active = b.done[l] == 0.0 && mu > -0.25 * s[2] * s[2];
-      double d[3], residual;
-      const double next = HalleyStep(s, active ? mu : 0.0, d, &residual);
-      const bool converged = active && std::abs(residual) <= 4.0 * kEps;
-      for (int i = 0; i < 3; ++i) b.d[i][l] = converged ? d[i] : b.d[i][l];
+      const bool active = (b.done[l] == 0.0) & (mu > -0.25 * s2 * s2);
+      const double m = active ? mu : 0.0;
+      double d0, d1, d2, residual;
+      const double next = HalleyStep(s0, s1, s2, m, &d0, &d1, &d2, &residual);
+      const bool converged = active & (std::abs(residual) <= 4.0 * kEps);
+      const bool go_on = active & !converged;
+      b.d[0][l] = converged ? d0 : b.d[0][l];
+      b.d[1][l] = converged ? d1 : b.d[1][l];
+      b.d[2][l] = converged ? d2 : b.d[2][l];
       b.done[l] = converged ? 1.0 : b.done[l];
-      b.mu[l] = active && !converged ? next : mu;
-      pending += active && !converged ? 1 : 0;
+      b.mu[l] = go_on ? next : mu;
+      pending += go_on ? 1 : 0;
     }
     if (pending == 0) break;
   }
 }
 
-}  // namespace
+bool VolumeLanesApply(const Vec3& sigma) { return FastPathApplies(sigma); }
 
 VolumeProjection ProjectSingularValuesToUnitDeterminant(const Vec3& sigma) {
   if (!sigma.allFinite()) {
@@ -387,7 +392,7 @@ IsotropicDifferentialCoefficients UnitDeterminantProjectionCoefficients(
 
 void ProjectSingularValuesToUnitDeterminantBatch(int count, const Vec3* sigma, VolumeProjection* out) {
   DIFFPD_CHECK(count >= 0 && count <= kVolumeBatch, "ProjectSingularValuesToUnitDeterminantBatch: count = " << count);
-  VolumeBatch b;
+  VolumeLanes b;
   bool fast[kVolumeBatch];
   for (int l = 0; l < kVolumeBatch; ++l) {
     fast[l] = l < count && FastPathApplies(sigma[l]);
@@ -396,7 +401,7 @@ void ProjectSingularValuesToUnitDeterminantBatch(int count, const Vec3* sigma, V
       b.d[i][l] = 1.0;
     }
   }
-  BatchGrowingRoots(b);
+  ProjectVolumeLanes(b);
   for (int l = 0; l < count; ++l) {
     if (fast[l] && b.done[l] != 0.0) {
       out[l].d = Vec3(b.d[0][l], b.d[1][l], b.d[2][l]);

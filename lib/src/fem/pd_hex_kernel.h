@@ -1,0 +1,42 @@
+// Fused energy-and-gradient kernel of one hexahedron for the PD energies
+// (internal): the hot loop of every PD and PD-LBFGS iteration.
+//
+// For a scene whose energies are pd-corotated and/or pd-volume only, the
+// density at a sample with signed SVD F = U diag(sigma) V^T is
+//   Psi = (w_rot / 2) |sigma - 1|^2 + (w_vol / 2) |sigma - d|^2,
+//   P   = U diag(w_rot (sigma - 1) + w_vol (sigma - d)) V^T,
+// with d the unit-determinant projection of sigma, w_rot = 2 mu per declared
+// pd-corotated and w_vol = lambda per declared pd-volume (density_kernels.h).
+// The kernel keeps the element's 8 samples lane by lane (structure of arrays)
+// from the deformation gradients through the SVDs and projections to the nodal
+// forces, instead of packing and unpacking 3x3 matrices around each batched
+// stage; the results equal the general path's (EvaluateDensity per sample) up
+// to rounding.
+#pragma once
+
+#include "diffpd/types.h"
+
+namespace diffpd::internal {
+
+// Shape-function gradients of one hexahedron's 8 samples, lane by lane:
+// entry (a, c) = dN_a/dX_c of sample l at [(a + 8 c) * 8 + l] (192 doubles).
+constexpr int kHexLaneGradients = 192;
+
+struct PdHexWeights {
+  double rotation = 0;  // w_rot (Pa)
+  double volume = 0;    // w_vol (Pa); 0: pd-volume not declared (no projection)
+};
+
+// One element: xe the 3 x 8 nodal positions (column-major), g its lane
+// gradients, grads the same in sample order (FemModel::grad of its first
+// sample: 8 x 3 column-major per sample), sample_volume its 8 sample volumes
+// (m^3), v_cache its 8 samples'
+// last V (read as warm start, written back). Sets fe (3 x 8, column-major) to
+// the element's nodal elastic forces dE_e/dx_e and *energy to E_e (J) and
+// returns true; returns false and changes nothing when a sample's F is not
+// finite, is zero or has entries outside [1e-100, 1e100] in magnitude (the
+// caller then takes the general path, which reports or rescales them).
+bool PdHexEnergyAndForces(const double* xe, const double* g, const double* grads, const double* sample_volume,
+                          const PdHexWeights& w, Mat3* v_cache, double* fe, double* energy);
+
+}  // namespace diffpd::internal
