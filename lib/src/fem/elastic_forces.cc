@@ -91,11 +91,25 @@ double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F
   if (stress) stress->setZero();
   if (dstress) dstress->setZero();
   Mat3 p;
+  // The singular-value energies' differentials share U and V: their
+  // coefficients add up and are assembled once.
+  IsotropicDifferentialCoefficients sum;
+  bool any_svd = false;
   for (const ElasticEnergy energy : energies) {
     psi += EnergyAndStress(energy, F, svd, mu, lambda, stress ? &p : nullptr, volume);
     if (stress) *stress += p;
-    if (dstress) *dstress += internal::StressDifferential(energy, F, svd, mu, lambda);
+    if (!dstress) continue;
+    if (!NeedsSvd(energy)) {
+      *dstress += internal::StressDifferential(energy, F, svd, mu, lambda);
+      continue;
+    }
+    const IsotropicDifferentialCoefficients c = StressDifferentialCoefficients(energy, svd, mu, lambda, volume);
+    sum.dp_dsigma += c.dp_dsigma;
+    sum.symmetric += c.symmetric;
+    sum.skew += c.skew;
+    any_svd = true;
   }
+  if (any_svd) *dstress += AssembleIsotropicDifferential(svd, sum);
   return psi;
 }
 
@@ -399,10 +413,16 @@ void ElasticForces::ElementHessiansImpl(const VectorXd& x, const LameField& lame
       const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(mesh, x, e0 + j);
       for (int q = 0; q < q_per; ++q) F[j * q_per + q] = DeformationGradient<K>(xe, fem_.grad(s0 + j * q_per + q));
     }
+    VolumeProjection volume[kSvdBatch];
     if (needs_svd_) {
       Mat3 cold[kSvdBatch];
       for (Mat3& v : cold) v.setIdentity();
       ComputeSvd3Batch(count * q_per, F, cold, svd);
+      if (needs_volume_) {
+        Vec3 sigma[kSvdBatch];
+        for (int i = 0; i < count * q_per; ++i) sigma[i] = svd[i].sigma;
+        ProjectSingularValuesToUnitDeterminantBatch(count * q_per, sigma, volume);
+      }
     }
     for (int j = 0; j < count; ++j) {
       const int e = e0 + j;
@@ -412,7 +432,7 @@ void ElasticForces::ElementHessiansImpl(const VectorXd& x, const LameField& lame
       for (int q = 0; q < q_per; ++q) {
         const int i = j * q_per + q;
         Mat9 dP;
-        EvaluateDensity(energies_, F[i], svd[i], mu, lambda, nullptr, &dP);
+        EvaluateDensity(energies_, F[i], svd[i], mu, lambda, nullptr, &dP, needs_volume_ ? &volume[i] : nullptr);
         AddSampleStiffness<K>(fem_.grad(s0 + i), fem_.sample_volume(s0 + i), dP, ke);
       }
       if (project_spd) {

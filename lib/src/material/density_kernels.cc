@@ -22,7 +22,7 @@ double CorotatedEnergyAndStress(const Svd3& svd, double mu, double lambda, Mat3*
   return mu * (s - Vec3::Ones()).squaredNorm() + 0.5 * lambda * (J - 1.0) * (J - 1.0);
 }
 
-Mat9 CorotatedStressDifferential(const Svd3& svd, double mu, double lambda) {
+IsotropicDifferentialCoefficients CorotatedCoefficients(const Svd3& svd, double mu, double lambda) {
   // p_i = 2 mu (sigma_i - 1) + lambda (J - 1) c_i, c_i = prod_{j != i} sigma_j:
   //   dp_i/dsigma_i = 2 mu + lambda c_i^2,
   //   dp_i/dsigma_j = lambda (c_i c_j + (J - 1) sigma_k),
@@ -45,7 +45,7 @@ Mat9 CorotatedStressDifferential(const Svd3& svd, double mu, double lambda) {
                    lambda * (J - 1.0) * s(k);
   }
   c.dp_dsigma.diagonal().array() += 2.0 * mu;
-  return AssembleIsotropicDifferential(svd, c);
+  return c;
 }
 
 double VolumeEnergyAndStress(const Svd3& svd, double lambda, Mat3* stress, const VolumeProjection* volume) {
@@ -56,14 +56,14 @@ double VolumeEnergyAndStress(const Svd3& svd, double lambda, Mat3* stress, const
   return 0.5 * lambda * residual.squaredNorm();
 }
 
-Mat9 VolumeStressDifferential(const Svd3& svd, double lambda) {
+IsotropicDifferentialCoefficients VolumeCoefficients(const Svd3& svd, double lambda, const VolumeProjection* volume) {
   // lambda (I - dProj/dF): the coefficients of the identity are (I, 1, 1).
-  const VolumeProjection projection = ProjectSingularValuesToUnitDeterminant(svd.sigma);
+  const VolumeProjection projection = volume ? *volume : ProjectSingularValuesToUnitDeterminant(svd.sigma);
   IsotropicDifferentialCoefficients c = UnitDeterminantProjectionCoefficients(svd.sigma, projection);
   c.dp_dsigma = lambda * (Mat3::Identity() - c.dp_dsigma);
   c.symmetric = lambda * (Vec3::Ones() - c.symmetric);
   c.skew = lambda * (Vec3::Ones() - c.skew);
-  return AssembleIsotropicDifferential(svd, c);
+  return c;
 }
 
 [[noreturn]] void NotProjective(ElasticEnergy energy) {
@@ -113,18 +113,24 @@ double EnergyAndStress(ElasticEnergy energy, const Mat3& F, const Svd3& svd, dou
 
 Mat9 StressDifferential(ElasticEnergy energy, const Mat3& F, const Svd3& svd, double mu,
                         double lambda) {
+  if (NeedsSvd(energy)) return AssembleIsotropicDifferential(svd, StressDifferentialCoefficients(energy, svd, mu, lambda));
+  return ::diffpd::StressDifferential(energy, F, mu, lambda);
+}
+
+IsotropicDifferentialCoefficients StressDifferentialCoefficients(ElasticEnergy energy, const Svd3& svd, double mu,
+                                                                 double lambda, const VolumeProjection* volume) {
   switch (energy) {
     case ElasticEnergy::kCorotated:
-      return CorotatedStressDifferential(svd, mu, lambda);
+      return CorotatedCoefficients(svd, mu, lambda);
     case ElasticEnergy::kPdCorotated:
-      return CorotatedStressDifferential(svd, mu, 0.0);
+      return CorotatedCoefficients(svd, mu, 0.0);
     case ElasticEnergy::kPdVolume:
-      return VolumeStressDifferential(svd, lambda);
+      return VolumeCoefficients(svd, lambda, volume);
     case ElasticEnergy::kLinear:
     case ElasticEnergy::kNeoHookean:
       break;
   }
-  return ::diffpd::StressDifferential(energy, F, mu, lambda);
+  DIFFPD_CHECK(false, "energy " << ToString(energy) << " has no singular-value form");
 }
 
 double ProjectiveWeight(ElasticEnergy energy, double mu, double lambda) {

@@ -147,7 +147,7 @@ inline bool NeedsNoRescaling(const Mat3& F) {
 // same rotations as OrthogonalizeColumns, lane by lane; a lane whose columns
 // are already orthogonal gets c = 1, s = 0, which leaves it unchanged exactly,
 // so every lane ends as its own scalar sweep would.
-DIFFPD_SIMD_INLINE bool OrthogonalizeSvd3Lanes(Svd3Lanes& m, int i, int j) {
+DIFFPD_SIMD_INLINE bool OrthogonalizeLanePair(Svd3Lanes& m, int i, int j) {
   int any = 0;
   const double eps2 = kEps * kEps;
   // The test first, over all lanes: the last sweep of a converged batch
@@ -286,9 +286,9 @@ DIFFPD_SIMD_INLINE void BatchFinish(Svd3Lanes& m) {
 DIFFPD_SIMD_CLONES
 void ComputeSvd3Lanes(Svd3Lanes& m) {
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
-    bool rotated = OrthogonalizeSvd3Lanes(m, 0, 1);
-    rotated = OrthogonalizeSvd3Lanes(m, 0, 2) || rotated;
-    rotated = OrthogonalizeSvd3Lanes(m, 1, 2) || rotated;
+    bool rotated = OrthogonalizeLanePair(m, 0, 1);
+    rotated = OrthogonalizeLanePair(m, 0, 2) || rotated;
+    rotated = OrthogonalizeLanePair(m, 1, 2) || rotated;
     if (!rotated) break;
   }
   BatchFinish(m);
