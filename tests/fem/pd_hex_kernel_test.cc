@@ -60,17 +60,37 @@ double GeneralPath(const Hex& hex, const Eigen::Matrix<double, 3, 8>& xe, const 
   return energy;
 }
 
-// The kernel with weights for `energies`, from a cold (identity) cache.
-bool Kernel(const Hex& hex, const Eigen::Matrix<double, 3, 8>& xe, const std::vector<ElasticEnergy>& energies, double mu,
-            double lambda, Eigen::Matrix<double, 3, 8>* fe, double* energy, std::vector<Mat3>* v_cache) {
+PdHexWeights WeightsOf(const std::vector<ElasticEnergy>& energies, double mu, double lambda) {
   PdHexWeights w;
   for (const ElasticEnergy e : energies) {
     if (e == ElasticEnergy::kPdCorotated) w.rotation += 2 * mu;
     if (e == ElasticEnergy::kPdVolume) w.volume += lambda;
   }
+  return w;
+}
+
+// Element 0 of hex at xe, with outputs into fe, energy and v_cache.
+internal::PdHexElement ElementOf(const Hex& hex, const Eigen::Matrix<double, 3, 8>& xe, const PdHexWeights& w,
+                                 Eigen::Matrix<double, 3, 8>* fe, double* energy, std::vector<Mat3>* v_cache) {
+  internal::PdHexElement element;
+  element.xe = xe.data();
+  element.lane_gradients = hex.lanes.data();
+  element.grads = hex.fem.grad(0);
+  element.sample_volume = hex.fem.sample_volumes(0);
+  element.weights = w;
+  element.v_cache = v_cache->data();
+  element.fe = fe->data();
+  element.energy = energy;
+  return element;
+}
+
+// The kernel on one element with weights for `energies`, from a cold
+// (identity) cache.
+bool Kernel(const Hex& hex, const Eigen::Matrix<double, 3, 8>& xe, const std::vector<ElasticEnergy>& energies, double mu,
+            double lambda, Eigen::Matrix<double, 3, 8>* fe, double* energy, std::vector<Mat3>* v_cache) {
   v_cache->assign(8, Mat3::Identity());
-  return PdHexEnergyAndForces(xe.data(), hex.lanes.data(), hex.fem.grad(0), hex.fem.sample_volumes(0), w,
-                              v_cache->data(), fe->data(), energy);
+  const internal::PdHexElement element = ElementOf(hex, xe, WeightsOf(energies, mu, lambda), fe, energy, v_cache);
+  return PdHexEnergyAndForces(&element, 1);
 }
 
 // Positions: the rest hexahedron under a linear map plus per-node noise.
@@ -129,6 +149,33 @@ TEST(PdHexKernelTest, RefusesSamplesTheBatchedSvdCannotTakeAndChangesNothing) {
     EXPECT_EQ(energy, 7.0);
     EXPECT_TRUE((fe.array() == 7.0).all());
     for (const Mat3& vq : v) EXPECT_TRUE(vq.isIdentity(0.0));
+  }
+}
+
+// A batch of two elements (different states and weights) gives each the
+// result of its own call.
+TEST(PdHexKernelTest, TwoElementsInOneCallMatchSeparateCalls) {
+  const Hex hex;
+  using E = ElasticEnergy;
+  const Mat3 rotation = Eigen::AngleAxisd(0.4, Vec3(0, 1, 1).normalized()).toRotationMatrix();
+  const Eigen::Matrix<double, 3, 8> xa = Deformed(hex, rotation, 2e-3, 11), xb = Deformed(hex, 0.9 * Mat3::Identity(), 3e-3, 12);
+  const PdHexWeights wa = WeightsOf({E::kPdCorotated, E::kPdVolume}, 7e4, 2.8e5);
+  const PdHexWeights wb = WeightsOf({E::kPdCorotated, E::kPdVolume}, 3e5, 0.0);  // nu = 0: no volume weight
+  Eigen::Matrix<double, 3, 8> fa, fb, fa1, fb1;
+  double ea = 0, eb = 0, ea1 = 0, eb1 = 0;
+  std::vector<Mat3> va(8, Mat3::Identity()), vb(8, Mat3::Identity()), va1 = va, vb1 = vb;
+  const internal::PdHexElement both[2] = {ElementOf(hex, xa, wa, &fa, &ea, &va), ElementOf(hex, xb, wb, &fb, &eb, &vb)};
+  ASSERT_TRUE(PdHexEnergyAndForces(both, 2));
+  const internal::PdHexElement a = ElementOf(hex, xa, wa, &fa1, &ea1, &va1), b = ElementOf(hex, xb, wb, &fb1, &eb1, &vb1);
+  ASSERT_TRUE(PdHexEnergyAndForces(&a, 1));
+  ASSERT_TRUE(PdHexEnergyAndForces(&b, 1));
+  EXPECT_NEAR(ea, ea1, 1e-14 * ea1);
+  EXPECT_NEAR(eb, eb1, 1e-14 * eb1);
+  EXPECT_LE((fa - fa1).norm(), 1e-14 * fa1.norm());
+  EXPECT_LE((fb - fb1).norm(), 1e-14 * fb1.norm());
+  for (int q = 0; q < 8; ++q) {
+    EXPECT_LE((va[q] - va1[q]).norm(), 1e-15);
+    EXPECT_LE((vb[q] - vb1[q]).norm(), 1e-15);
   }
 }
 

@@ -38,7 +38,7 @@ void ParallelForElements(int m, int threads, Body&& body, int min_parallel = kMi
 }
 
 // Runs body(e0, count) over groups of consecutive elements whose quadrature
-// points fill one SVD batch (8 tetrahedra of 1 point, or 1 hexahedron of 8),
+// points fill one SVD batch (16 tetrahedra of 1 point, or 2 hexahedra of 8),
 // in parallel over groups.
 template <class Body>
 void ParallelForSampleBatches(int num_elements, int samples_per_element, int threads, Body&& body) {
@@ -222,20 +222,29 @@ double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, const LameField& 
     if (grad) Eigen::Map<Eigen::Matrix<double, 3, K>>(element_buffer_.data() + static_cast<size_t>(e) * 3 * K) = fe;
   };
   if (K == 8 && pd_hex_kernel_) {
-    ParallelForElements(fem_.num_elements(), threads, [&](int e) {
-      const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(fem_.mesh(), x, e);
-      PdHexWeights w;
-      w.rotation = rotation_terms_ * 2.0 * lame.mu_of(e);
-      w.volume = volume_terms_ * lame.lambda_of(e);
-      if (PdHexEnergyAndForces(xe.data(), hex_lane_gradients_.data() + static_cast<size_t>(e) * kHexLaneGradients,
-                               fem_.grad(8 * e), fem_.sample_volumes(8 * e), w, &v_cache_[8 * static_cast<size_t>(e)],
-                               element_buffer_.data() + static_cast<size_t>(e) * 3 * K, &element_energy_[e]))
-        return;
+    ParallelForSampleBatches(fem_.num_elements(), q_per, threads, [&](int e0, int count) {
+      Eigen::Matrix<double, 3, K> xe[kPdHexBatch];
+      PdHexElement batch[kPdHexBatch];
+      for (int j = 0; j < count; ++j) {
+        const int e = e0 + j;
+        xe[j] = GatherElement<K>(fem_.mesh(), x, e);
+        PdHexElement& element = batch[j];
+        element.xe = xe[j].data();
+        element.lane_gradients = hex_lane_gradients_.data() + static_cast<size_t>(e) * kHexLaneGradients;
+        element.grads = fem_.grad(8 * e);
+        element.sample_volume = fem_.sample_volumes(8 * e);
+        element.weights.rotation = rotation_terms_ * 2.0 * lame.mu_of(e);
+        element.weights.volume = volume_terms_ * lame.lambda_of(e);
+        element.v_cache = &v_cache_[8 * static_cast<size_t>(e)];
+        element.fe = element_buffer_.data() + static_cast<size_t>(e) * 3 * K;
+        element.energy = &element_energy_[e];
+      }
+      if (PdHexEnergyAndForces(batch, count)) return;
       Mat3 F[kSvdBatch];
       Svd3 svd[kSvdBatch];
       VolumeProjection volume[kSvdBatch];
-      SampleDecompositions<K>(x, e, 1, F, svd, volume);
-      element(e, F, svd, needs_volume_ ? volume : nullptr);
+      SampleDecompositions<K>(x, e0, count, F, svd, volume);
+      for (int j = 0; j < count; ++j) element(e0 + j, F + 8 * j, svd + 8 * j, needs_volume_ ? volume + 8 * j : nullptr);
     });
   } else {
     ForEachDecomposedElement<K>(x, threads, element);

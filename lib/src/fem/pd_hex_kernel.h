@@ -24,19 +24,30 @@ constexpr int kHexLaneGradients = 192;
 
 struct PdHexWeights {
   double rotation = 0;  // w_rot (Pa)
-  double volume = 0;    // w_vol (Pa); 0: pd-volume not declared (no projection)
+  double volume = 0;    // w_vol (Pa); 0: no volume term (no projection)
 };
 
-// One element: xe the 3 x 8 nodal positions (column-major), g its lane
-// gradients, grads the same in sample order (FemModel::grad of its first
-// sample: 8 x 3 column-major per sample), sample_volume its 8 sample volumes
-// (m^3), v_cache its 8 samples'
-// last V (read as warm start, written back). Sets fe (3 x 8, column-major) to
-// the element's nodal elastic forces dE_e/dx_e and *energy to E_e (J) and
-// returns true; returns false and changes nothing when a sample's F is not
-// finite, is zero or has entries outside [1e-100, 1e100] in magnitude (the
-// caller then takes the general path, which reports or rescales them).
-bool PdHexEnergyAndForces(const double* xe, const double* g, const double* grads, const double* sample_volume,
-                          const PdHexWeights& w, Mat3* v_cache, double* fe, double* energy);
+// One element's inputs and outputs (pointers not owned, not retained).
+struct PdHexElement {
+  const double* xe = nullptr;              // 3 x 8 nodal positions (m), column-major
+  const double* lane_gradients = nullptr;  // kHexLaneGradients (1/m)
+  const double* grads = nullptr;           // the same in sample order: FemModel::grad of its first sample
+  const double* sample_volume = nullptr;   // 8 sample volumes (m^3)
+  PdHexWeights weights;
+  Mat3* v_cache = nullptr;  // 8 samples' last V: warm start, written back
+  double* fe = nullptr;     // out: 3 x 8 nodal forces dE_e/dx_e (N), column-major
+  double* energy = nullptr; // out: E_e (J)
+};
+
+// Elements per call: two hexahedra fill one SVD batch (svd3.h), whose lanes
+// then carry two independent dependency chains (the sweeps' square roots and
+// divisions are latency-bound).
+constexpr int kPdHexBatch = 2;
+
+// Evaluates `count` (1..kPdHexBatch) elements and returns true; returns
+// false and changes nothing when a sample's F is not finite, is zero or has
+// entries outside [1e-100, 1e100] in magnitude (the caller then takes the
+// general path, which reports or rescales them).
+bool PdHexEnergyAndForces(const PdHexElement* elements, int count);
 
 }  // namespace diffpd::internal

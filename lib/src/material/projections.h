@@ -30,7 +30,7 @@ VolumeProjection ProjectSingularValuesToUnitDeterminant(const Vec3& sigma);
 // (<= kVolumeBatch), the common case (all sigma > 0, prod < 2) solved for all
 // entries together lane by lane (OpenMP SIMD), the others one by one.
 // Results match the single calls to rounding.
-constexpr int kVolumeBatch = 8;
+constexpr int kVolumeBatch = 16;
 void ProjectSingularValuesToUnitDeterminantBatch(int count, const Vec3* sigma, VolumeProjection* out);
 // The batch's common case in structure-of-arrays form. In: s[i][l] = sigma_i
 // of lane l, each lane in the common case (sigma_2 > 0, finite,
