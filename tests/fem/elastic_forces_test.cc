@@ -241,3 +241,41 @@ TEST(ElasticForcesTest, ElementHessiansDependOnThePositionsAloneAndAreSymmetric)
 
 }  // namespace
 }  // namespace diffpd
+
+namespace diffpd {
+namespace {
+
+// The packed, element-interleaved product equals the dense element blocks'
+// product, also when the element count leaves the last group of 8 partly
+// empty (3 hexahedra; 5 tetrahedra per cube x 3 cubes = 15 or 6 x 3 = 18).
+TEST(ElasticForcesTest, PackedProductMatchesTheDenseBlocksForPartialGroups) {
+  const double mu = 7e4, lambda = 2.8e5;
+  for (const bool tets : {false, true}) {
+    Scene scene = testing::SmallBeamScene(tets);
+    scene.mesh = tets ? testing::BoxTetMesh(3, 1, 1, 0.12, 0.04, 0.04) : testing::BoxHexMesh(3, 1, 1, 0.12, 0.04, 0.04);
+    FemModel fem(scene.mesh);
+    ASSERT_NE(fem.num_elements() % 8, 0);
+    ElasticForces forces(fem, scene.energies);
+    const VectorXd x = DeformedPositions(scene.mesh, 2e-3, 14);
+    std::vector<double> blocks, packed;
+    forces.ElementHessians(x, LameField::Uniform(mu, lambda), false, &blocks, 1);
+    forces.PackElementMatrices(blocks, &packed);
+    std::mt19937 rng(15);
+    const VectorXd z = NormalVector(static_cast<int>(x.size()), &rng);
+    VectorXd product;
+    forces.ApplyElementMatrices(packed, z, &product, 1);
+    const int k = fem.nodes_per_element(), n = 3 * k;
+    VectorXd expected = VectorXd::Zero(x.size());
+    for (int e = 0; e < fem.num_elements(); ++e) {
+      const Eigen::Map<const Eigen::MatrixXd> ke(blocks.data() + static_cast<size_t>(e) * n * n, n, n);
+      VectorXd ze(n);
+      for (int a = 0; a < k; ++a) ze.segment<3>(3 * a) = z.segment<3>(3 * scene.mesh.elements(a, e));
+      const VectorXd ye = ke * ze;
+      for (int a = 0; a < k; ++a) expected.segment<3>(3 * scene.mesh.elements(a, e)) += ye.segment<3>(3 * a);
+    }
+    EXPECT_LE((product - expected).norm(), 1e-13 * expected.norm()) << "tets " << tets;
+  }
+}
+
+}  // namespace
+}  // namespace diffpd

@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "diffpd/error.h"
+#include "fem/packed_element_matrices.h"
 #include "fem/pd_hex_kernel.h"
 #include "material/density_kernels.h"
 #include "material/svd3.h"
@@ -358,44 +359,48 @@ void ElasticForces::PackElementMatrices(const std::vector<double>& blocks, std::
   const int k = fem_.nodes_per_element(), n = 3 * k, m = fem_.num_elements();
   DIFFPD_CHECK(blocks.size() == static_cast<size_t>(m) * n * n,
                "PackElementMatrices: " << blocks.size() << " block entries for " << m << " elements");
-  const size_t per = static_cast<size_t>(9) * k * (k + 1) / 2;
-  packed->resize(static_cast<size_t>(m) * per);
+  const size_t entries = PackedEntries(k);
+  const int groups = (m + kElementLanes - 1) / kElementLanes;
+  packed->assign(static_cast<size_t>(groups) * entries * kElementLanes, 0.0);
   for (int e = 0; e < m; ++e) {
     const Eigen::Map<const MatrixXd> ke(blocks.data() + static_cast<size_t>(e) * n * n, n, n);
-    double* out = packed->data() + static_cast<size_t>(e) * per;
+    double* out = packed->data() + static_cast<size_t>(e / kElementLanes) * entries * kElementLanes + e % kElementLanes;
     for (int b = 0; b < k; ++b)
-      for (int a = 0; a <= b; ++a, out += 9) {
-        Eigen::Map<Mat3> block(out);
-        block = ke.block<3, 3>(3 * a, 3 * b);
-      }
+      for (int a = 0; a <= b; ++a)
+        for (int c = 0; c < 3; ++c)
+          for (int r = 0; r < 3; ++r, out += kElementLanes) *out = ke(3 * a + r, 3 * b + c);
   }
 }
 
 template <int K>
 void ElasticForces::ApplyElementMatricesImpl(const std::vector<double>& packed, const VectorXd& z, VectorXd* out,
                                              int threads) {
-  constexpr size_t kPer = 9 * K * (K + 1) / 2;
+  const size_t entries = PackedEntries(K);
   const Mesh& mesh = fem_.mesh();
-  DIFFPD_CHECK(packed.size() == static_cast<size_t>(fem_.num_elements()) * kPer,
-               "ApplyElementMatrices: " << packed.size() << " packed entries for " << fem_.num_elements()
-                                        << " elements");
-  ParallelForElements(fem_.num_elements(), threads, [&](int e) {
-    const Eigen::Matrix<double, 3, K> ze = GatherElement<K>(mesh, z, e);
-    Eigen::Matrix<double, 3, K> ye = Eigen::Matrix<double, 3, K>::Zero();
-    const double* p = packed.data() + static_cast<size_t>(e) * kPer;
-    // Block (a, b), a <= b, acts on node b's entries and, transposed
-    // (symmetry), on node a's.
-    for (int b = 0; b < K; ++b) {
-      for (int a = 0; a < b; ++a, p += 9) {
-        const Eigen::Map<const Mat3> block(p);
-        ye.col(a).noalias() += block.lazyProduct(ze.col(b));
-        ye.col(b).noalias() += block.transpose().lazyProduct(ze.col(a));
-      }
-      ye.col(b).noalias() += Eigen::Map<const Mat3>(p).lazyProduct(ze.col(b));
-      p += 9;
-    }
-    Eigen::Map<Eigen::Matrix<double, 3, K>>(element_buffer_.data() + static_cast<size_t>(e) * 3 * K) = ye;
-  });
+  const int m = fem_.num_elements();
+  const int groups = (m + kElementLanes - 1) / kElementLanes;
+  DIFFPD_CHECK(packed.size() == static_cast<size_t>(groups) * entries * kElementLanes,
+               "ApplyElementMatrices: " << packed.size() << " packed entries for " << m << " elements");
+  ParallelForElements(
+      groups, threads,
+      [&](int g) {
+        alignas(64) double zl[3 * K][kElementLanes];
+        alignas(64) double yl[3 * K][kElementLanes];
+        const int count = std::min(kElementLanes, m - g * kElementLanes);
+        for (int j = 0; j < kElementLanes; ++j) {
+          const int e = g * kElementLanes + j;
+          for (int a = 0; a < K; ++a) {
+            const int node = j < count ? mesh.elements(a, e) : 0;
+            for (int i = 0; i < 3; ++i) zl[3 * a + i][j] = j < count ? z(3 * node + i) : 0.0;
+          }
+        }
+        ApplyPackedGroup(K, packed.data() + static_cast<size_t>(g) * entries * kElementLanes, zl, yl);
+        for (int j = 0; j < count; ++j) {
+          double* ye = element_buffer_.data() + static_cast<size_t>(g * kElementLanes + j) * 3 * K;
+          for (int r = 0; r < 3 * K; ++r) ye[r] = yl[r][j];
+        }
+      },
+      std::max(1, kMinParallelElements / kElementLanes));
   GatherElementBuffer(out, threads);
 }
 

@@ -62,8 +62,8 @@ class ElasticForces {
   void ElementHessians(const VectorXd& x, const LameField& lame, bool project_spd, std::vector<double>* blocks,
                        int threads);
   // The upper triangle of each (symmetric) element block by 3 x 3 node
-  // blocks: for b = 0..K-1, a = 0..b, block (a, b) column-major, 9 K (K + 1) / 2
-  // values per element (1296 of 2304 bytes for hexahedra).
+  // blocks, interleaved across groups of elements (layout in
+  // packed_element_matrices.h; 1296 of 2304 bytes per hexahedron).
   void PackElementMatrices(const std::vector<double>& blocks, std::vector<double>* packed) const;
   // out = sum_e K_e z_e with packed element Hessians: the Hessian product for
   // many products at one x ((3K)^2 multiply-adds per element and product,
