@@ -156,17 +156,11 @@ bool PdHexEnergyAndForces(const PdHexElement* elements, int count) {
   }
   VolumeLanes b;
   if (any_volume) {
-    bool lane_applies[kLanes];
-    for (int l = 0; l < kLanes; ++l) {
-      lane_applies[l] = VolumeLanesApply(Vec3(m.sigma[0][l], m.sigma[1][l], m.sigma[2][l]));
-      for (int i = 0; i < 3; ++i) {
-        b.s[i][l] = lane_applies[l] ? m.sigma[i][l] : 1.0;
-        b.d[i][l] = 1.0;
-      }
-    }
+    for (int i = 0; i < 3; ++i)
+      for (int l = 0; l < kLanes; ++l) b.s[i][l] = m.sigma[i][l];
     ProjectVolumeLanes(b);
     for (int l = 0; l < kLanes; ++l) {
-      if (w.volume[l] == 0.0 || (lane_applies[l] && b.done[l] != 0.0)) continue;
+      if (w.volume[l] == 0.0 || b.done[l] != 0.0) continue;
       const VolumeProjection single =
           ProjectSingularValuesToUnitDeterminant(Vec3(m.sigma[0][l], m.sigma[1][l], m.sigma[2][l]));
       for (int i = 0; i < 3; ++i) b.d[i][l] = single.d(i);

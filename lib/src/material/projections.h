@@ -33,11 +33,11 @@ VolumeProjection ProjectSingularValuesToUnitDeterminant(const Vec3& sigma);
 constexpr int kVolumeBatch = 16;
 void ProjectSingularValuesToUnitDeterminantBatch(int count, const Vec3* sigma, VolumeProjection* out);
 // The batch's common case in structure-of-arrays form. In: s[i][l] = sigma_i
-// of lane l, each lane in the common case (sigma_2 > 0, finite,
-// prod(sigma) < 2; idle lanes hold (1, 1, 1)). Out: for lanes with done[l] = 1,
-// d[i][l] and mu[l] (the multiplier) as ProjectSingularValuesToUnitDeterminant
-// gives them up to rounding; lanes with done[l] = 0 (Halley's iteration did not
-// settle) need the single call.
+// of lane l (any values). Out: for lanes in the common case (sigma_2 > 0,
+// finite, prod(sigma) < 2) whose Halley iteration settled, done[l] = 1 and
+// d[i][l], mu[l] (the multiplier) as ProjectSingularValuesToUnitDeterminant
+// gives them up to rounding; done[l] = 0 for the other lanes, which need the
+// single call.
 struct alignas(64) VolumeLanes {
   double s[3][kVolumeBatch];
   double d[3][kVolumeBatch];
@@ -45,8 +45,6 @@ struct alignas(64) VolumeLanes {
   double done[kVolumeBatch];
 };
 void ProjectVolumeLanes(VolumeLanes& b);
-// True when sigma is in the common case ProjectVolumeLanes solves.
-bool VolumeLanesApply(const Vec3& sigma);
 Mat3 ProjectToUnitDeterminant(const Svd3& svd);
 Mat9 UnitDeterminantProjectionDifferential(const Svd3& svd);
 

@@ -291,10 +291,16 @@ bool GrowingRootByMultiplier(const Vec3& s, VolumeProjection* out) {
 // one clone per vector width (simd_dispatch.h).
 DIFFPD_SIMD_CLONES
 void ProjectVolumeLanes(VolumeLanes& b) {
+  // done: -1 outside the common case (FastPathApplies; never iterated),
+  // 0 pending, 1 converged.
 #pragma omp simd
   for (int l = 0; l < kVolumeBatch; ++l) {
-    b.mu[l] = FirstOrderMultiplier(b.s[0][l], b.s[1][l], b.s[2][l]);
-    b.done[l] = 0.0;
+    const double s0 = b.s[0][l], s1 = b.s[1][l], s2 = b.s[2][l];
+    const double sum = s0 + s1 + s2;
+    const bool applies = (s2 > 0.0) & (s0 * s1 * s2 < 2.0) & (sum - sum == 0.0);
+    b.mu[l] = applies ? FirstOrderMultiplier(s0, s1, s2) : 0.0;
+    b.done[l] = applies ? 0.0 : -1.0;
+    for (int i = 0; i < 3; ++i) b.d[i][l] = 1.0;
   }
   for (int iteration = 0; iteration <= kMaxHalleySteps; ++iteration) {
     int pending = 0;
@@ -319,9 +325,9 @@ void ProjectVolumeLanes(VolumeLanes& b) {
     }
     if (pending == 0) break;
   }
+#pragma omp simd
+  for (int l = 0; l < kVolumeBatch; ++l) b.done[l] = b.done[l] > 0.0 ? 1.0 : 0.0;
 }
-
-bool VolumeLanesApply(const Vec3& sigma) { return FastPathApplies(sigma); }
 
 VolumeProjection ProjectSingularValuesToUnitDeterminant(const Vec3& sigma) {
   if (!sigma.allFinite()) {
@@ -393,17 +399,11 @@ IsotropicDifferentialCoefficients UnitDeterminantProjectionCoefficients(
 void ProjectSingularValuesToUnitDeterminantBatch(int count, const Vec3* sigma, VolumeProjection* out) {
   DIFFPD_CHECK(count >= 0 && count <= kVolumeBatch, "ProjectSingularValuesToUnitDeterminantBatch: count = " << count);
   VolumeLanes b;
-  bool fast[kVolumeBatch];
-  for (int l = 0; l < kVolumeBatch; ++l) {
-    fast[l] = l < count && FastPathApplies(sigma[l]);
-    for (int i = 0; i < 3; ++i) {
-      b.s[i][l] = fast[l] ? sigma[l](i) : 1.0;  // idle lanes: sigma = (1, 1, 1)
-      b.d[i][l] = 1.0;
-    }
-  }
+  for (int l = 0; l < kVolumeBatch; ++l)
+    for (int i = 0; i < 3; ++i) b.s[i][l] = l < count ? sigma[l](i) : 1.0;  // idle lanes: sigma = (1, 1, 1)
   ProjectVolumeLanes(b);
   for (int l = 0; l < count; ++l) {
-    if (fast[l] && b.done[l] != 0.0) {
+    if (b.done[l] != 0.0) {
       out[l].d = Vec3(b.d[0][l], b.d[1][l], b.d[2][l]);
       out[l].multiplier = b.mu[l];
     } else {
