@@ -1,10 +1,33 @@
 #include "solver/cholmod_solver.h"
 
+#include <omp.h>
+
 #include <Eigen/CholmodSupport>
 
 #include "diffpd/error.h"
 
 namespace diffpd::internal {
+namespace {
+
+// For its lifetime, OpenMP parallel regions run on the calling thread alone.
+// CHOLMOD's supernodal factorisation opens its parallel loops with a fixed
+// team of CHOLMOD_OMP_NUM_THREADS = 4 threads (a compile-time constant of the
+// Debian build, not capped by OMP_NUM_THREADS or the caller's thread count):
+// on the 2-core machines this project targets the oversubscribed team spent
+// ~20% of a Newton run in the kernel (futex waits, context switches) and made
+// Newton-Cholesky 1.7x slower on the rolling sphere, 1 or 2 threads alike.
+class SerialOpenMpScope {
+ public:
+  SerialOpenMpScope() : saved_(omp_get_max_active_levels()) { omp_set_max_active_levels(0); }
+  ~SerialOpenMpScope() { omp_set_max_active_levels(saved_); }
+  SerialOpenMpScope(const SerialOpenMpScope&) = delete;
+  SerialOpenMpScope& operator=(const SerialOpenMpScope&) = delete;
+
+ private:
+  int saved_;
+};
+
+}  // namespace
 
 struct CholmodSolver::Impl {
   // Exactly one is used, by layout_ (Eigen gives each layout its own type).
@@ -33,6 +56,7 @@ bool CholmodSolver::Factorize(const SparseMatrix& a) {
     nonzeros_ = a.nonZeros();
     ++num_analyses_;
   }
+  const SerialOpenMpScope serial;
   factorized_ = impl_->With(layout_, [&](auto& llt) {
     if (analyse) llt.analyzePattern(a);
     llt.factorize(a);
