@@ -222,7 +222,7 @@ double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, const LameField& 
     element_energy_[e] = energy;
     if (grad) Eigen::Map<Eigen::Matrix<double, 3, K>>(element_buffer_.data() + static_cast<size_t>(e) * 3 * K) = fe;
   };
-  if (K == 8 && pd_hex_kernel_) {
+  if (K == 8 && pd_hex_kernel_) {  // hexahedra (8 samples each), PD energies only: the fused kernel
     ParallelForSampleBatches(fem_.num_elements(), q_per, threads, [&](int e0, int count) {
       Eigen::Matrix<double, 3, K> xe[kPdHexBatch];
       PdHexElement batch[kPdHexBatch];

@@ -7,9 +7,9 @@
 //   P   = U diag(w_rot (sigma - 1) + w_vol (sigma - d)) V^T,
 // with d the unit-determinant projection of sigma, w_rot = 2 mu per declared
 // pd-corotated and w_vol = lambda per declared pd-volume (density_kernels.h).
-// The kernel keeps the element's 8 samples lane by lane (structure of arrays)
-// from the deformation gradients through the SVDs and projections to the nodal
-// forces, instead of packing and unpacking 3x3 matrices around each batched
+// The kernel keeps the samples of kPdHexBatch elements (8 each) lane by lane
+// (structure of arrays) from the deformation gradients through the SVDs and
+// projections to the nodal forces, instead of packing and unpacking 3x3 matrices around each batched
 // stage; the results equal the general path's (EvaluateDensity per sample) up
 // to rounding.
 #pragma once
