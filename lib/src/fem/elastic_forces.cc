@@ -118,14 +118,14 @@ ElasticForces::ElasticForces(const FemModel& fem, std::vector<ElasticEnergy> ene
     : fem_(fem), energies_(std::move(energies)) {
   for (const ElasticEnergy e : energies_) all_projective_ = all_projective_ && IsProjective(e);
   needs_svd_ = AnyNeedsSvd(energies_);
-  for (const ElasticEnergy e : energies_) needs_volume_ = needs_volume_ || e == ElasticEnergy::kPdVolume;
-  element_buffer_.assign(static_cast<size_t>(fem_.num_elements()) * 3 * fem_.nodes_per_element(), 0.0);
-  element_energy_.assign(fem_.num_elements(), 0.0);
-  v_cache_.assign(fem_.num_samples(), Mat3::Identity());
   for (const ElasticEnergy e : energies_) {
     rotation_terms_ += e == ElasticEnergy::kPdCorotated;
     volume_terms_ += e == ElasticEnergy::kPdVolume;
   }
+  needs_volume_ = volume_terms_ > 0;
+  element_buffer_.assign(static_cast<size_t>(fem_.num_elements()) * 3 * fem_.nodes_per_element(), 0.0);
+  element_energy_.assign(fem_.num_elements(), 0.0);
+  v_cache_.assign(fem_.num_samples(), Mat3::Identity());
   const bool pd_only = !energies_.empty() && rotation_terms_ + volume_terms_ == static_cast<int>(energies_.size());
   pd_hex_kernel_ = pd_only && fem_.nodes_per_element() == 8 && fem_.samples_per_element() == 8;
   if (pd_hex_kernel_) {
@@ -166,7 +166,7 @@ void ElasticForces::GatherElementBuffer(VectorXd* out, int threads) const {
 
 template <int K>
 void ElasticForces::SampleDecompositions(const VectorXd& x, int e0, int count, Mat3* F, Svd3* svd,
-                                         VolumeProjection* volume) {
+                                         VolumeProjection* volume, bool warm_start) {
   const int q_per = fem_.samples_per_element();
   const int n = count * q_per;
   DIFFPD_CHECK(n <= kSvdBatch, "more samples than an SVD batch: " << n);
@@ -176,9 +176,15 @@ void ElasticForces::SampleDecompositions(const VectorXd& x, int e0, int count, M
     for (int q = 0; q < q_per; ++q) F[j * q_per + q] = DeformationGradient<K>(xe, fem_.grad(s0 + j * q_per + q));
   }
   if (!needs_svd_) return;
-  // All samples' SVDs together, warm started from the last ones.
-  ComputeSvd3Batch(n, F, &v_cache_[s0], svd);
-  for (int i = 0; i < n; ++i) v_cache_[s0 + i] = svd[i].V;
+  // All samples' SVDs together, warm started from the last ones or cold.
+  if (warm_start) {
+    ComputeSvd3Batch(n, F, &v_cache_[s0], svd);
+    for (int i = 0; i < n; ++i) v_cache_[s0 + i] = svd[i].V;
+  } else {
+    Mat3 cold[kSvdBatch];
+    for (Mat3& v : cold) v.setIdentity();
+    ComputeSvd3Batch(n, F, cold, svd);
+  }
   if (!needs_volume_ || volume == nullptr) return;
   Vec3 sigma[kSvdBatch];
   for (int i = 0; i < n; ++i) sigma[i] = svd[i].sigma;
@@ -186,18 +192,22 @@ void ElasticForces::SampleDecompositions(const VectorXd& x, int e0, int count, M
 }
 
 template <int K, class Body>
-void ElasticForces::ForEachDecomposedElement(const VectorXd& x, int threads, Body&& body) {
+void ElasticForces::VisitDecomposedBatch(const VectorXd& x, int e0, int count, Body&& body) {
   const int q_per = fem_.samples_per_element();
-  ParallelForSampleBatches(fem_.num_elements(), q_per, threads, [&](int e0, int count) {
-    Mat3 F[kSvdBatch];
-    Svd3 svd[kSvdBatch];
-    VolumeProjection volume[kSvdBatch];
-    SampleDecompositions<K>(x, e0, count, F, svd, volume);
-    for (int j = 0; j < count; ++j) {
-      const int i = j * q_per;
-      body(e0 + j, F + i, svd + i, needs_volume_ ? volume + i : nullptr);
-    }
-  });
+  Mat3 F[kSvdBatch];
+  Svd3 svd[kSvdBatch];
+  VolumeProjection volume[kSvdBatch];
+  SampleDecompositions<K>(x, e0, count, F, svd, volume);
+  for (int j = 0; j < count; ++j) {
+    const int i = j * q_per;
+    body(e0 + j, F + i, svd + i, needs_volume_ ? volume + i : nullptr);
+  }
+}
+
+template <int K, class Body>
+void ElasticForces::ForEachDecomposedElement(const VectorXd& x, int threads, Body&& body) {
+  ParallelForSampleBatches(fem_.num_elements(), fem_.samples_per_element(), threads,
+                           [&](int e0, int count) { VisitDecomposedBatch<K>(x, e0, count, body); });
 }
 
 template <int K>
@@ -240,12 +250,7 @@ double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, const LameField& 
         element.fe = element_buffer_.data() + static_cast<size_t>(e) * 3 * K;
         element.energy = &element_energy_[e];
       }
-      if (PdHexEnergyAndForces(batch, count)) return;
-      Mat3 F[kSvdBatch];
-      Svd3 svd[kSvdBatch];
-      VolumeProjection volume[kSvdBatch];
-      SampleDecompositions<K>(x, e0, count, F, svd, volume);
-      for (int j = 0; j < count; ++j) element(e0 + j, F + 8 * j, svd + 8 * j, needs_volume_ ? volume + 8 * j : nullptr);
+      if (!PdHexEnergyAndForces(batch, count)) VisitDecomposedBatch<K>(x, e0, count, element);
     });
   } else {
     ForEachDecomposedElement<K>(x, threads, element);
@@ -414,7 +419,6 @@ template <int K>
 void ElasticForces::ElementHessiansImpl(const VectorXd& x, const LameField& lame, bool project_spd,
                                         std::vector<double>* blocks, int threads) {
   constexpr int N = 3 * K;
-  const Mesh& mesh = fem_.mesh();
   const int q_per = fem_.samples_per_element();
   blocks->resize(static_cast<size_t>(fem_.num_elements()) * N * N);
   // SVDs in batches, cold started (identity guesses): the blocks depend on x
@@ -422,22 +426,9 @@ void ElasticForces::ElementHessiansImpl(const VectorXd& x, const LameField& lame
   ParallelForSampleBatches(fem_.num_elements(), q_per, threads, [&](int e0, int count) {
     Mat3 F[kSvdBatch];
     Svd3 svd[kSvdBatch];
-    const int s0 = e0 * q_per;
-    for (int j = 0; j < count; ++j) {
-      const Eigen::Matrix<double, 3, K> xe = GatherElement<K>(mesh, x, e0 + j);
-      for (int q = 0; q < q_per; ++q) F[j * q_per + q] = DeformationGradient<K>(xe, fem_.grad(s0 + j * q_per + q));
-    }
     VolumeProjection volume[kSvdBatch];
-    if (needs_svd_) {
-      Mat3 cold[kSvdBatch];
-      for (Mat3& v : cold) v.setIdentity();
-      ComputeSvd3Batch(count * q_per, F, cold, svd);
-      if (needs_volume_) {
-        Vec3 sigma[kSvdBatch];
-        for (int i = 0; i < count * q_per; ++i) sigma[i] = svd[i].sigma;
-        ProjectSingularValuesToUnitDeterminantBatch(count * q_per, sigma, volume);
-      }
-    }
+    SampleDecompositions<K>(x, e0, count, F, svd, volume, /*warm_start=*/false);
+    const int s0 = e0 * q_per;
     for (int j = 0; j < count; ++j) {
       const int e = e0 + j;
       const double mu = lame.mu_of(e), lambda = lame.lambda_of(e);

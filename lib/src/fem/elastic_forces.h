@@ -90,15 +90,20 @@ class ElasticForces {
   // Deformation gradients F[i] of the samples of elements e0 .. e0+count-1
   // at positions x (count * samples_per_element <= kSvdBatch, in sample
   // order) and, when an energy needs them, their SVDs (svd[i]), computed as
-  // one batch warm started from and written back to v_cache_, and (pd-volume
+  // one batch, warm started from and written back to v_cache_ (warm_start)
+  // or from the identity (results depending on x alone), and (pd-volume
   // declared and volume != nullptr) the volume projections of their singular
   // values, also as one batch.
   template <int K>
-  void SampleDecompositions(const VectorXd& x, int e0, int count, Mat3* F, Svd3* svd, VolumeProjection* volume);
-  // Runs body(e, F, svd, volume) for every element e, in parallel over SVD
-  // batches (SampleDecompositions): F, svd and volume point at e's
-  // samples_per_element() entries (volume is nullptr unless pd-volume is
+  void SampleDecompositions(const VectorXd& x, int e0, int count, Mat3* F, Svd3* svd, VolumeProjection* volume,
+                            bool warm_start = true);
+  // Runs body(e, F, svd, volume) for elements e0 .. e0+count-1 of one SVD
+  // batch (SampleDecompositions, warm started): F, svd and volume point at
+  // e's samples_per_element() entries (volume is nullptr unless pd-volume is
   // declared).
+  template <int K, class Body>
+  void VisitDecomposedBatch(const VectorXd& x, int e0, int count, Body&& body);
+  // VisitDecomposedBatch over every element, in parallel over batches.
   template <int K, class Body>
   void ForEachDecomposedElement(const VectorXd& x, int threads, Body&& body);
   // Sums the per-element 3 x K buffer into a 3n vector, in parallel over nodes.
@@ -108,7 +113,7 @@ class ElasticForces {
   std::vector<ElasticEnergy> energies_;
   bool all_projective_ = true;
   bool needs_svd_ = false;
-  bool needs_volume_ = false;  // pd-volume declared
+  bool needs_volume_ = false;  // pd-volume declared (volume_terms_ > 0)
   std::vector<double> element_buffer_;  // 3 * K per element
   std::vector<double> element_energy_;  // per element
   std::vector<double> element_dot_;     // per element (PartLameDots' lambda dots)

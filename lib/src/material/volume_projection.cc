@@ -238,7 +238,13 @@ double SolvePositive(const Vec3& s, VolumeProjection* best) {
 // root and logarithms for the general path; no logarithm, so the batched
 // form below vectorises. The iteration stops when |P - 1| <= 4 eps.
 constexpr int kMaxHalleySteps = 8;
-DIFFPD_SIMD_INLINE bool FastPathApplies(const Vec3& s) { return s(2) > 0.0 && s.allFinite() && s.prod() < 2.0; }
+// sigma_2 > 0, all finite and prod(sigma) < 2, branch-free (the lane loop
+// below vectorises with it): a non-finite entry makes the sum's difference
+// with itself NaN.
+DIFFPD_SIMD_INLINE bool FastPathApplies(double s0, double s1, double s2) {
+  const double sum = s0 + s1 + s2;
+  return (s2 > 0.0) & (s0 * s1 * s2 < 2.0) & (sum - sum == 0.0);
+}
 DIFFPD_SIMD_INLINE double FirstOrderMultiplier(double s0, double s1, double s2) {
   const double p = s0 * s1 * s2;
   const double inv0 = 1.0 / s0, inv1 = 1.0 / s1, inv2 = 1.0 / s2;
@@ -296,8 +302,7 @@ void ProjectVolumeLanes(VolumeLanes& b) {
 #pragma omp simd
   for (int l = 0; l < kVolumeBatch; ++l) {
     const double s0 = b.s[0][l], s1 = b.s[1][l], s2 = b.s[2][l];
-    const double sum = s0 + s1 + s2;
-    const bool applies = (s2 > 0.0) & (s0 * s1 * s2 < 2.0) & (sum - sum == 0.0);
+    const bool applies = FastPathApplies(s0, s1, s2);
     b.mu[l] = applies ? FirstOrderMultiplier(s0, s1, s2) : 0.0;
     b.done[l] = applies ? 0.0 : -1.0;
     for (int i = 0; i < 3; ++i) b.d[i][l] = 1.0;
@@ -335,7 +340,7 @@ VolumeProjection ProjectSingularValuesToUnitDeterminant(const Vec3& sigma) {
     return {Vec3::Constant(nan), nan};
   }
   VolumeProjection best{Vec3::Ones(), 0.0};
-  if (FastPathApplies(sigma) && GrowingRootByMultiplier(sigma, &best)) return best;
+  if (FastPathApplies(sigma(0), sigma(1), sigma(2)) && GrowingRootByMultiplier(sigma, &best)) return best;
   const double distance = SolvePositive(sigma, &best);
   if (sigma(2) < 0.0) {
     // Signs (+, -, -): d = flip .* d', d' the all-positive solution for
