@@ -113,6 +113,36 @@ TEST_P(FreeBodyTest, DeformedReleaseConservesMomentumAndDoesNotGainEnergy) {
   EXPECT_LT(e_prev, e0 * 1.01);  // symplectic Euler: bounded, implicit: decays
 }
 
+// Near convergence g's change over a step falls below its own rounding,
+// which is relative to its terms (sums of (sigma - 1)^2), not to g: here g is
+// 2e-8 J and a step predicted to lower it by 2.5e-20 J changed it by +3e-20 J.
+// The line search must then judge by |grad g| (it used to stop at the 20th
+// step with |grad g| = 1.4e-8 N against the 1.0e-8 N tolerance). Same release as
+// above, without energy evaluations between steps (they change the warm SVD
+// guesses and so the rounding).
+TEST(LineSearchTest, PdLbfgsConvergesWhereGIsBlindToItsOwnDecrease) {
+  Scene scene;
+  scene.mesh = testing::BoxHexMesh(3, 3, 3, 0.1, 0.1, 0.1);
+  scene.material.youngs_modulus = 1e5;
+  SolverOptions options;
+  options.method = Method::kPdLbfgs;
+  options.time_step = 0.005;
+  options.rel_tolerance = 1e-10;
+  options.abs_tolerance = 1e-8;
+  Simulator sim(scene, options);
+  State s = sim.RestState();
+  for (int i = 0; i < s.x.size() / 3; ++i) {
+    s.x(3 * i) *= 1.2;
+    s.x(3 * i + 1) += 0.3 * s.x(3 * i + 2);
+  }
+  for (int k = 0; k < 40; ++k) {
+    StepReport report;
+    ASSERT_NO_THROW(s = sim.Step(s, StepInput(), &report)) << "step " << k;
+    EXPECT_LE(report.final_residual, options.abs_tolerance + options.rel_tolerance * report.initial_residual)
+        << "step " << k;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(AllMethods, FreeBodyTest,
                          ::testing::Values(Method::kSemiImplicit, Method::kNewtonCholesky, Method::kNewtonPcg,
                                            Method::kPd, Method::kPdLbfgs),

@@ -6,6 +6,13 @@
 #include "diffpd/error.h"
 
 namespace diffpd::internal {
+namespace {
+// A change of g below this fraction of |g| is rounding.
+constexpr double kRoundingRelative = 1e-12;
+// Where the predicted decrease -grad^T d is below this fraction of |g|, g
+// cannot tell a decrease from rounding (changes up to the same bound).
+constexpr double kBlindRelative = 1e-10;
+}  // namespace
 
 int BacktrackingLineSearch(StepObjective& objective, const VectorXd& d, VectorXd* x, double* value,
                            VectorXd* grad) {
@@ -30,11 +37,17 @@ int BacktrackingLineSearch(StepObjective& objective, const VectorXd& d, VectorXd
       ok = false;
     }
     // Armijo; or, where g's change is lost in rounding (near convergence),
-    // a strict decrease of |grad g|.
+    // a strict decrease of |grad g|. g's rounding is relative to its terms,
+    // which can be far larger than g itself (the elastic energy near rest is
+    // a sum of squares of sigma - 1, each with the absolute rounding of
+    // sigma): where the predicted decrease is below kBlindRelative of g, a
+    // change of g within that bound is rounding, not an increase.
     const bool moved = (trial - *x).cwiseAbs().maxCoeff() > 0;
     const bool armijo = ok && moved && trial_value < *value && trial_value <= *value + options.armijo_c * alpha * slope;
-    const bool rounding = ok && moved && std::abs(trial_value - *value) <= 1e-12 * std::abs(*value) &&
-                          trial_grad.norm() < grad->norm();
+    const double change = std::abs(trial_value - *value), scale = std::abs(*value);
+    const bool blind = change <= kRoundingRelative * scale ||
+                       (std::abs(slope) <= kBlindRelative * scale && change <= kBlindRelative * scale);
+    const bool rounding = ok && moved && blind && trial_grad.norm() < grad->norm();
     if (armijo || rounding) {
       *x = trial;
       *value = trial_value;

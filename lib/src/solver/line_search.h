@@ -6,7 +6,10 @@
 namespace diffpd::internal {
 
 // Tries x + alpha d for alpha = 1, 1/2, 1/4, ... until
-//   g(x + alpha d) <= g(x) + c alpha grad^T d.
+//   g(x + alpha d) <= g(x) + c alpha grad^T d,
+// or, where g cannot resolve the change (it is within 1e-12 |g|, or the
+// predicted decrease -grad^T d and the change are both within 1e-10 |g|:
+// near convergence), until |grad g| strictly decreases.
 // On success sets *x, *value, *grad to the accepted point and returns the
 // number of halvings. Throws SolverError(kLineSearchFailed) when d is not a
 // descent direction or no step is accepted within the limit.
