@@ -148,7 +148,7 @@ RolloutMeasurement MeasureRollout(const Scene& scene, const SolverOptions& optio
     throw InvalidInputError(msg.str());
   }
   RolloutMeasurement m;
-  std::vector<double> forward, backward;
+  std::vector<double> forward, backward, factorization;
   const int steps = static_cast<int>(inputs.size());
   for (int r = 0; r < repeat; ++r) {
     Simulator sim(scene, options);
@@ -157,6 +157,7 @@ RolloutMeasurement MeasureRollout(const Scene& scene, const SolverOptions& optio
       auto start = Clock::now();
       rollout = sim.Simulate(initial, inputs);
       forward.push_back(SecondsSince(start));
+      factorization.push_back(sim.pd_factorization_seconds());
       LossGradient dl(steps);
       dl.dx[steps] = loss.cx;
       dl.dv[steps] = loss.cv;
@@ -184,6 +185,7 @@ RolloutMeasurement MeasureRollout(const Scene& scene, const SolverOptions& optio
   }
   m.forward_s = Median(forward);
   m.backward_s = Median(backward);
+  m.factorization_s = Median(factorization);
   m.iters_per_step = steps > 0 ? double(m.total_iterations) / steps : 0;
   return m;
 }
@@ -263,6 +265,7 @@ BenchResult RunBench(const std::string& problem, const BenchOptions& options, st
       row.backward_iters_per_step = result.steps > 0 ? double(m.backward_iterations) / result.steps : 0;
       row.backward_fallbacks = m.backward_fallbacks;
       row.forward_per_iteration_ms = m.total_iterations > 0 ? 1e3 * m.forward_s / m.total_iterations : 0;
+      row.factorization_s = m.factorization_s;
       row.state_rel_error = RelativeError(StackState(m.final_state), ref_state);
       row.position_rel_error = RelativeError(m.final_state.x, reference.final_state.x);
       row.velocity_rel_error = RelativeError(m.final_state.v, reference.final_state.v);
@@ -305,6 +308,7 @@ nlohmann::json BenchToJson(const BenchResult& result, const BenchOptions& option
                     {"grad_rel_error", NumberOrNull(ok, r.grad_rel_error)},
                     {"grad_rel_error_by_input", ok ? by_input : nlohmann::json(nullptr)},
                     {"forward_per_iteration_ms", NumberOrNull(ok, r.forward_per_iteration_ms)},
+                    {"factorization_s", NumberOrNull(ok, r.factorization_s)},
                     {"speedup_vs_newton_cholesky",
                      r.speedup_vs_newton_cholesky ? nlohmann::json(*r.speedup_vs_newton_cholesky)
                                                   : nlohmann::json(nullptr)},
@@ -359,22 +363,30 @@ ScalingResult RunScaling(const std::string& problem, const BenchOptions& options
         row.backward_s = m.backward_s;
         row.iters_per_step = m.iters_per_step;
         row.forward_per_iteration_ms = m.total_iterations > 0 ? 1e3 * m.forward_s / m.total_iterations : 0;
+        row.factorization_s = m.factorization_s;
+        row.iteration_ms =
+            m.total_iterations > 0 ? 1e3 * (m.forward_s - m.factorization_s) / m.total_iterations : 0;
         row.backward_per_step_ms = 1e3 * m.backward_s / s.steps;
       }
       row.peak_rss_mib = PeakRssMib();
       result.rows.push_back(row);
     }
   }
-  for (Method method : options.methods) {
+  // Least-squares slope of log(ms) against log(DoFs) over a method's rows.
+  auto fit_exponent = [&](Method method, double ScalingRow::*ms, std::map<std::string, double>* out) {
     double sx = 0, sy = 0, sxx = 0, sxy = 0;
     int k = 0;
     for (const auto& r : result.rows) {
-      if (r.method != ToString(method) || !r.failure.empty() || r.forward_per_iteration_ms <= 0) continue;
-      const double x = std::log(double(r.dofs)), y = std::log(r.forward_per_iteration_ms);
+      if (r.method != ToString(method) || !r.failure.empty() || r.*ms <= 0) continue;
+      const double x = std::log(double(r.dofs)), y = std::log(r.*ms);
       sx += x, sy += y, sxx += x * x, sxy += x * y, ++k;
     }
     const double det = k * sxx - sx * sx;
-    if (k >= 2 && det > 0) result.exponent_per_iteration[ToString(method)] = (k * sxy - sx * sy) / det;
+    if (k >= 2 && det > 0) (*out)[ToString(method)] = (k * sxy - sx * sy) / det;
+  };
+  for (Method method : options.methods) {
+    fit_exponent(method, &ScalingRow::iteration_ms, &result.exponent_per_iteration);
+    fit_exponent(method, &ScalingRow::forward_per_iteration_ms, &result.exponent_with_factorization);
   }
   return result;
 }
@@ -384,6 +396,7 @@ nlohmann::json ScalingToJson(const ScalingResult& result) {
   for (const auto& r : result.rows) {
     const bool ok = r.failure.empty();
     const auto exponent = result.exponent_per_iteration.find(r.method);
+    const auto with_factorization = result.exponent_with_factorization.find(r.method);
     rows.push_back({{"method", r.method},
                     {"status", ok ? std::string("ok") : "failed: " + r.failure},
                     {"factor", r.factor},
@@ -394,11 +407,16 @@ nlohmann::json ScalingToJson(const ScalingResult& result) {
                     {"backward_s", NumberOrNull(ok, r.backward_s)},
                     {"iters_per_step", NumberOrNull(ok, r.iters_per_step)},
                     {"forward_per_iteration_ms", NumberOrNull(ok, r.forward_per_iteration_ms)},
+                    {"factorization_s", NumberOrNull(ok, r.factorization_s)},
+                    {"iteration_ms", NumberOrNull(ok, r.iteration_ms)},
                     {"backward_per_step_ms", NumberOrNull(ok, r.backward_per_step_ms)},
                     {"peak_rss_mib", r.peak_rss_mib},
                     {"exponent_per_iteration", exponent == result.exponent_per_iteration.end()
                                                    ? nlohmann::json(nullptr)
-                                                   : nlohmann::json(exponent->second)}});
+                                                   : nlohmann::json(exponent->second)},
+                    {"exponent_with_factorization", with_factorization == result.exponent_with_factorization.end()
+                                                        ? nlohmann::json(nullptr)
+                                                        : nlohmann::json(with_factorization->second)}});
   }
   return rows;
 }

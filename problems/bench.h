@@ -69,6 +69,10 @@ struct RolloutMeasurement {
   double backward_s = 0;
   long total_iterations = 0;
   double iters_per_step = 0;
+  // Seconds of the forward spent factorising the PD matrix (the one-off cost
+  // per mesh, h and weights, Simulator::pd_factorization_seconds; 0 for
+  // Newton, whose factorisations are per iteration), median of the runs.
+  double factorization_s = 0;
   // Backward: iterations of the iterative adjoint solves (PD's
   // A-preconditioned CG, Newton-PCG's CG; 0 for a direct solve) and solves
   // that fell back to a direct one, of the last run.
@@ -119,6 +123,7 @@ struct BenchRow {
   double backward_iters_per_step = 0;   // adjoint solver iterations per step (0: direct)
   int backward_fallbacks = 0;           // adjoint solves that fell back to a direct solve
   double forward_per_iteration_ms = 0;  // forward_s / total iterations, ms
+  double factorization_s = 0;           // RolloutMeasurement::factorization_s
   double state_rel_error = 0;     // of [x; v] stacked
   double position_rel_error = 0;  // of x alone
   double velocity_rel_error = 0;  // of v alone (about |x error| / h: the strictest part)
@@ -165,15 +170,19 @@ struct ScalingRow {
   int elements = 0, vertices = 0, dofs = 0;
   std::string failure;
   double forward_s = 0, backward_s = 0, iters_per_step = 0;
-  double forward_per_iteration_ms = 0;
+  double forward_per_iteration_ms = 0;  // forward_s / iterations
+  double factorization_s = 0;           // PD's one-off factorisation within forward_s
+  double iteration_ms = 0;              // (forward_s - factorization_s) / iterations
   double backward_per_step_ms = 0;
   double peak_rss_mib = 0;
 };
 struct ScalingResult {
   std::vector<ScalingRow> rows;
-  // Per method: least-squares slope of log(forward_per_iteration) against
-  // log(dofs) (1 = linear).
+  // Per method: least-squares slope of log(iteration_ms) against log(dofs)
+  // (1 = linear), and the same for forward_per_iteration_ms, which includes
+  // the one-off factorisation spread over this run's few iterations.
   std::map<std::string, double> exponent_per_iteration;
+  std::map<std::string, double> exponent_with_factorization;
 };
 ScalingResult RunScaling(const std::string& problem, const BenchOptions& options, const std::vector<int>& factors,
                          std::ostream* progress = nullptr);

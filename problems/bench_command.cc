@@ -19,21 +19,24 @@ per method. The loss is L = c_x . x_K + c_v . v_K with fixed N(0,1) vectors
 with rel_tolerance 1e-10 (adjoint 1e-12). state_rel_error ([x; v] stacked),
 position_rel_error (x), velocity_rel_error (v) and grad_rel_error
 are relative 2-norms against it. forward_s / backward_s: wall-clock seconds of
-Simulate / Backward on a fresh simulator (forward includes PD's factorisation),
-median of --repeat runs. The adjoint tolerance is --rtol unless
+Simulate / Backward on a fresh simulator (forward includes PD's factorisation,
+factorization_s: the one-off cost per mesh, h and weights), median of --repeat runs. The adjoint tolerance is --rtol unless
 --backward-rtol is given. speedup_vs_newton_cholesky = (forward+backward of
 newton-cholesky in this run) / (this method's).
 JSON: a list of objects {method, status, forward_s, backward_s,
 iters_per_step, state_rel_error, position_rel_error, velocity_rel_error,
-grad_rel_error, grad_rel_error_by_input,
-forward_per_iteration_ms, speedup_vs_newton_cholesky, problem, dofs, ...}.
+grad_rel_error, grad_rel_error_by_input, forward_per_iteration_ms,
+factorization_s, speedup_vs_newton_cholesky, problem, dofs, ...}.
 --scaling: the problem at --scales x the elements (default 1,2,4,8); rows
 {method, factor, elements, vertices, dofs, forward_s, iters_per_step,
-forward_per_iteration_ms, backward_per_step_ms, peak_rss_mib,
-exponent_per_iteration}. Methods run to --rtol, so iteration counts differ
-per mesh: compare forward_per_iteration_ms; exponent_per_iteration is its
-log-log slope against DoFs (1 = linear). peak_rss_mib is the process's
-high-water mark.
+forward_per_iteration_ms, factorization_s, iteration_ms, backward_per_step_ms,
+peak_rss_mib, exponent_per_iteration, exponent_with_factorization}. Methods
+run to --rtol, so iteration counts differ per mesh: compare iteration_ms (the
+forward without PD's one-off factorisation, per iteration);
+exponent_per_iteration is its log-log slope against DoFs (1 = linear),
+exponent_with_factorization that of forward_per_iteration_ms (the
+factorisation spread over this run's iterations). peak_rss_mib is the
+process's high-water mark.
 --threads-compare: each method with 1 and 2 threads: forward seconds per step
 (whole step), backward seconds, and the local step measured as one
 Simulator::ElasticEnergy(x) evaluation, alternating between the last two
@@ -53,15 +56,15 @@ struct BenchArgs {
 void PrintBenchTable(const BenchResult& r) {
   std::printf("# %s: %d elements, %d DoFs, %d steps of %g s; reference newton-cholesky rtol 1e-10 (%.3f s)\n",
               r.problem.c_str(), r.elements, r.dofs, r.steps, r.time_step, r.reference_forward_s);
-  std::printf("%-16s %10s %10s %10s %12s %12s %12s %10s %10s %12s %10s\n", "method", "forward_s", "backward_s",
-              "iters/step", "ms/iter", "bwd_it/step", "state_err", "x_err", "v_err", "grad_err", "speedup");
+  std::printf("%-16s %10s %10s %10s %10s %12s %12s %12s %10s %10s %12s %10s\n", "method", "forward_s", "backward_s",
+              "factor_s", "iters/step", "ms/iter", "bwd_it/step", "state_err", "x_err", "v_err", "grad_err", "speedup");
   for (const auto& row : r.rows) {
     if (!row.failure.empty()) {
       std::printf("%-16s failed: %s\n", row.method.c_str(), row.failure.c_str());
       continue;
     }
-    std::printf("%-16s %10.4f %10.4f %10.2f %12.4f %12.2f %12.3e %10.2e %10.2e %12.3e", row.method.c_str(),
-                row.forward_s, row.backward_s, row.iters_per_step, row.forward_per_iteration_ms,
+    std::printf("%-16s %10.4f %10.4f %10.4f %10.2f %12.4f %12.2f %12.3e %10.2e %10.2e %12.3e", row.method.c_str(),
+                row.forward_s, row.backward_s, row.factorization_s, row.iters_per_step, row.forward_per_iteration_ms,
                 row.backward_iters_per_step, row.state_rel_error, row.position_rel_error, row.velocity_rel_error,
                 row.grad_rel_error);
     if (row.backward_fallbacks > 0) std::printf(" (%d adjoint fallbacks)", row.backward_fallbacks);
@@ -71,20 +74,26 @@ void PrintBenchTable(const BenchResult& r) {
 }
 
 void PrintScalingTable(const ScalingResult& r) {
-  std::printf("%-16s %6s %9s %9s %10s %10s %10s %12s %12s %10s\n", "method", "factor", "elements", "dofs",
-              "forward_s", "backward_s", "iters/step", "ms/iter", "bwd_ms/step", "rss_MiB");
+  std::printf("%-16s %6s %9s %9s %10s %10s %10s %10s %12s %12s %12s %10s\n", "method", "factor", "elements", "dofs",
+              "forward_s", "factor_s", "backward_s", "iters/step", "ms/iter", "iter_ms", "bwd_ms/step", "rss_MiB");
   for (const auto& row : r.rows) {
     if (!row.failure.empty()) {
       std::printf("%-16s %6d %9d %9d failed: %s\n", row.method.c_str(), row.factor, row.elements, row.dofs,
                   row.failure.c_str());
       continue;
     }
-    std::printf("%-16s %6d %9d %9d %10.4f %10.4f %10.2f %12.4f %12.4f %10.1f\n", row.method.c_str(), row.factor,
-                row.elements, row.dofs, row.forward_s, row.backward_s, row.iters_per_step,
-                row.forward_per_iteration_ms, row.backward_per_step_ms, row.peak_rss_mib);
+    std::printf("%-16s %6d %9d %9d %10.4f %10.4f %10.4f %10.2f %12.4f %12.4f %12.4f %10.1f\n", row.method.c_str(),
+                row.factor, row.elements, row.dofs, row.forward_s, row.factorization_s, row.backward_s,
+                row.iters_per_step, row.forward_per_iteration_ms, row.iteration_ms, row.backward_per_step_ms,
+                row.peak_rss_mib);
   }
-  for (const auto& [method, exponent] : r.exponent_per_iteration)
-    std::printf("# %s: time per iteration ~ DoFs^%.2f\n", method.c_str(), exponent);
+  for (const auto& [method, exponent] : r.exponent_per_iteration) {
+    std::printf("# %s: time per iteration (iter_ms, without the one-off factorisation) ~ DoFs^%.2f", method.c_str(),
+                exponent);
+    const auto with = r.exponent_with_factorization.find(method);
+    if (with != r.exponent_with_factorization.end()) std::printf("; with it (ms/iter) ~ DoFs^%.2f", with->second);
+    std::printf("\n");
+  }
 }
 
 void PrintThreadsTable(const std::vector<ThreadsRow>& rows) {

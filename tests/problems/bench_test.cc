@@ -123,6 +123,14 @@ TEST(BenchTest, RowsCarryEveryMethodAndTheReportedQuantities) {
   // Newton converges quadratically: a few iterations; PD needs hundreds.
   EXPECT_LT(Row(r, "newton-cholesky").iters_per_step, 10);
   EXPECT_GT(Row(r, "pd").iters_per_step, 10 * Row(r, "newton-cholesky").iters_per_step);
+  // PD methods factorise A once per fresh simulator, inside the forward time;
+  // Newton has no one-off factor (its factorisations are its iterations).
+  for (const char* pd : {"pd", "pd-lbfgs"}) {
+    EXPECT_GT(Row(r, pd).factorization_s, 0) << pd;
+    EXPECT_LT(Row(r, pd).factorization_s, Row(r, pd).forward_s) << pd;
+  }
+  EXPECT_EQ(Row(r, "newton-cholesky").factorization_s, 0.0);
+  EXPECT_EQ(Row(r, "newton-pcg").factorization_s, 0.0);
 }
 
 TEST(BenchTest, TightlyConvergedNewtonMatchesTheReference) {
@@ -165,8 +173,8 @@ TEST(BenchTest, JsonIsAListWithTheRequiredFields) {
   ASSERT_EQ(parsed.size(), 2u);
   for (const auto& row : parsed) {
     for (const char* field : {"forward_s", "backward_s", "iters_per_step", "state_rel_error", "grad_rel_error",
-                              "forward_per_iteration_ms", "speedup_vs_newton_cholesky", "backward_iters_per_step",
-                              "backward_fallbacks"})
+                              "forward_per_iteration_ms", "factorization_s", "speedup_vs_newton_cholesky",
+                              "backward_iters_per_step", "backward_fallbacks"})
       EXPECT_TRUE(row.at(field).is_number()) << field;
     EXPECT_TRUE(row.at("method").is_string());
     EXPECT_EQ(row.at("status"), "ok");
@@ -209,9 +217,16 @@ TEST(ScalingTest, ElementCountsDoubleAndTimePerIterationIsReported) {
   for (const auto& row : r.rows) {
     EXPECT_TRUE(row.failure.empty()) << row.failure;
     EXPECT_GT(row.forward_per_iteration_ms, 0);
+    // iteration_ms leaves out the one-off factorisation, which is > 0.
+    EXPECT_GT(row.factorization_s, 0);
+    EXPECT_GT(row.iteration_ms, 0);
+    EXPECT_LT(row.iteration_ms, row.forward_per_iteration_ms);
+    EXPECT_NEAR(row.iteration_ms * row.iters_per_step * o.steps,
+                1e3 * (row.forward_s - row.factorization_s), 1e-9 * 1e3 * row.forward_s);
     EXPECT_GT(row.peak_rss_mib, 0);
   }
   EXPECT_EQ(r.exponent_per_iteration.count("pd-lbfgs"), 1u);
+  EXPECT_EQ(r.exponent_with_factorization.count("pd-lbfgs"), 1u);
   EXPECT_THROW(RunScaling("cantilever", o, {3}), InvalidInputError);
   const nlohmann::json rows = ScalingToJson(r);
   EXPECT_EQ(rows[2].at("dofs"), 3 * 9 * 3 * 2);  // 8 x 2 x 1 cells

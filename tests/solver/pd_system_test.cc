@@ -21,14 +21,18 @@ TEST(PdSystemTest, FactorisesOncePerTimeStepAndMaterialAcrossStepsAndRollouts) {
   o.method = Method::kPd;
   Simulator sim(scene, o);
   EXPECT_EQ(sim.num_pd_factorizations(), 0);
+  EXPECT_EQ(sim.pd_factorization_seconds(), 0.0);
   const Rollout r = sim.Simulate(sim.RestState(), std::vector<StepInput>(5));
   EXPECT_GT(r.reports[0].iterations, 1);
   EXPECT_EQ(sim.num_pd_factorizations(), 1);
+  const double factor_seconds = sim.pd_factorization_seconds();
+  EXPECT_GT(factor_seconds, 0.0);
   LossGradient dl(5);
   dl.dx[5] = VectorXd::Ones(sim.num_dofs());
   sim.Backward(r, dl);
   sim.Simulate(sim.RestState(), std::vector<StepInput>(5));
   EXPECT_EQ(sim.num_pd_factorizations(), 1);
+  EXPECT_EQ(sim.pd_factorization_seconds(), factor_seconds);  // reused: no time added
   SolverOptions same_h = o;
   same_h.rel_tolerance = 1e-3;  // not a reason to refactorise
   sim.SetOptions(same_h);

@@ -84,6 +84,11 @@ class Simulator {
 
   // Number of numeric factorisations of the PD matrix A so far.
   int num_pd_factorizations() const;
+  // Wall seconds those factorisations took (assembly of A, symbolic analysis,
+  // numeric factorisation), all of them so far: the one-off cost a PD method
+  // pays per (mesh, h, material weights, Dirichlet set), shared by every
+  // iteration, step and rollout after it.
+  double pd_factorization_seconds() const;
 
  private:
   std::unique_ptr<internal::SimulatorImpl> impl_;

@@ -1,5 +1,7 @@
 #include "solver/pd_system.h"
 
+#include <chrono>
+
 #include <sstream>
 
 #include "diffpd/error.h"
@@ -114,6 +116,7 @@ bool PdSystem::Update(double h, const std::vector<double>& densities, const std:
   DIFFPD_CHECK(static_cast<int>(densities.size()) == num_parts_ && static_cast<int>(weights.size()) == num_parts_,
                densities.size() << " densities and " << weights.size() << " weights for " << num_parts_ << " parts");
   if (h == h_ && densities == densities_ && weights == weights_) return false;
+  const auto start = std::chrono::steady_clock::now();
   const SparseMatrix weighted = WeightedLaplacian(weights);
   const VectorXd diag = MassDiagonal(h, densities);
   for (Group& g : groups_) {
@@ -136,6 +139,7 @@ bool PdSystem::Update(double h, const std::vector<double>& densities, const std:
     }
   }
   ++num_factorizations_;
+  factorization_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   h_ = h;
   densities_ = densities;
   weights_ = weights;

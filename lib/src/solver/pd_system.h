@@ -65,6 +65,9 @@ class PdSystem {
   int num_active_set_factorizations() const;
 
   int num_factorizations() const { return num_factorizations_; }
+  // Wall seconds spent in Update's refactorisations (assembly, symbolic
+  // analysis and numeric factorisation), all of them so far.
+  double factorization_seconds() const { return factorization_seconds_; }
   int num_groups() const { return static_cast<int>(groups_.size()); }
 
  private:
@@ -89,6 +92,7 @@ class PdSystem {
   double h_ = -1;
   std::vector<double> densities_, weights_;
   int num_factorizations_ = 0;
+  double factorization_seconds_ = 0;
   SparseMatrix auxiliary_;                 // 0 x 0 when none
   std::vector<int> active_nodes_;
   ContactLinearSolve active_mode_ = ContactLinearSolve::kWoodbury;

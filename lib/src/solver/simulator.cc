@@ -91,6 +91,8 @@ int Simulator::num_pd_factorizations() const {
   return impl_->pd_factorizations();
 }
 
+double Simulator::pd_factorization_seconds() const { return impl_->pd_factorization_seconds(); }
+
 State Simulator::Step(const State& state, const StepInput& input, StepReport* report) {
   SimulatorImpl& sim = *impl_;
   const int n = sim.num_dofs();

@@ -76,6 +76,7 @@ class SimulatorImpl {
   PdSystem& pd_system();  // factor made current for (h, rho, PD weight)
   CholmodSolver& newton_solver() { return newton_llt_; }
   int pd_factorizations() const { return pd_ ? pd_->num_factorizations() : 0; }
+  double pd_factorization_seconds() const { return pd_ ? pd_->factorization_seconds() : 0.0; }
 
  private:
   void MaterialsChanged();
