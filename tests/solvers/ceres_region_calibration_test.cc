@@ -61,7 +61,11 @@ TEST_P(RegionCostFunctionCheckTest, GradientCheckerAcceptsRandomRegionParameters
   ceres::GradientChecker checker(&cost, &manifolds, numeric);
   std::mt19937_64 rng(9);
   std::uniform_real_distribution<double> u(0, 1);
-  const double precision = c.method == Method::kPd ? 5e-5 : 1e-6;
+  // Ceres judges each entry relative to itself: an entry 1e-3 of the
+  // Jacobian's scale carries the iterative solves' absolute error (2-8e-10
+  // here) as a relative error of ~1e-6 for PD-LBFGS (measured 1.8e-6 on
+  // d r_3 / d nu, the others below 3e-7); a wrong derivative errs by O(1).
+  const double precision = c.method == Method::kPd ? 5e-5 : c.method == Method::kPdLbfgs ? 1e-5 : 1e-6;
   std::vector<double> material = {1e5 + 3e5 * u(rng), 0.25 + 0.2 * u(rng), 2e4 + 8e4 * u(rng),
                                   0.25 + 0.2 * u(rng), 600 + 800 * u(rng)};
   double* blocks[1] = {material.data()};

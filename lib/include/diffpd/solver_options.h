@@ -37,7 +37,10 @@ struct SolverOptions {
 
   // Convergence of each implicit step, the same test for every method:
   //   ||grad g(x)||_2 <= abs_tolerance + rel_tolerance * ||grad g(x0)||_2,
-  // over the free DoFs, x0 the step's initial guess x_i + h v_i.
+  // over the free DoFs, x0 = x_i + h v_i. Every method starts its solve at x0,
+  // or at x_i where g is lower there (then the new potential energy cannot
+  // exceed the previous total energy; one more evaluation of g per step).
+  // The test stays relative to grad g(x0) either way.
   double abs_tolerance = 1e-9;  // N
   double rel_tolerance = 1e-6;
   int max_iterations = 1000;    // per step (Newton or PD iterations)

@@ -48,7 +48,7 @@ VectorXd NewtonSolve(StepObjective& objective, const VectorXd& x0, StepReport* r
   VectorXd x = x0;
   VectorXd grad;
   double value = objective.Evaluate(x, &grad);
-  report->initial_residual = grad.norm();
+  report->initial_residual = objective.ReferenceResidual(grad.norm());
   std::vector<double> blocks;
   SparseMatrix h;
   for (int it = 0;; ++it) {

@@ -22,7 +22,7 @@ VectorXd PdSolve(StepObjective& objective, const VectorXd& x0, StepReport* repor
   VectorXd x = x0;
   VectorXd grad;
   objective.Evaluate(x, &grad);
-  report->initial_residual = grad.norm();
+  report->initial_residual = objective.ReferenceResidual(grad.norm());
   for (int it = 0;; ++it) {
     if (IterationConverged(objective, it, x, grad.norm(), report)) return x;
     x -= pd.Solve(grad);
@@ -39,7 +39,7 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
   VectorXd x = x0;
   VectorXd grad;
   double value = objective.Evaluate(x, &grad);
-  report->initial_residual = grad.norm();
+  report->initial_residual = objective.ReferenceResidual(grad.norm());
   std::vector<double> alpha(m);
   for (int it = 0;; ++it) {
     if (IterationConverged(objective, it, x, grad.norm(), report)) return x;

@@ -10,6 +10,7 @@
 #include "diffpd/error.h"
 #include "forces/activation_scope.h"
 #include "solver/simulator_impl.h"
+#include "solver/step_start.h"
 
 namespace diffpd {
 namespace {
@@ -133,11 +134,11 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
     if (!sim.scene.frictional_contacts.empty()) {
       next.x = internal::SolveWithActiveSet(sim, state, f, solve, rep);
     } else {
-      VectorXd x0 = state.x + h * state.v;
+      VectorXd x0 = state.x + h * state.v, previous = state.x;
       for (int d = 0; d < n; ++d)
-        if (sim.fixed[d]) x0(d) = sim.fixed_values(d);
+        if (sim.fixed[d]) x0(d) = previous(d) = sim.fixed_values(d);
       internal::StepObjective objective(sim, state.x + h * state.v, f);
-      next.x = solve(objective, x0, rep);
+      next.x = solve(objective, internal::ChooseStepStart(objective, x0, previous), rep);
     }
   }
   for (int d = 0; d < n; ++d)

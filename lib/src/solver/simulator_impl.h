@@ -127,6 +127,18 @@ class StepObjective {
   bool StopAtCheckpoint(const VectorXd& x, double grad_norm, double initial_norm);
   bool checkpoint_stopped() const { return checkpoint_stopped_; }
 
+  // The convergence test's reference |grad g(x_i + h v_i)| when the solve
+  // starts elsewhere (solver/step_start.h). ReferenceResidual(r) returns it,
+  // or r (the start's own residual) when none was set.
+  void SetReferenceResidual(double residual) { reference_residual_ = residual; }
+  double ReferenceResidual(double start_residual) const {
+    return reference_residual_ >= 0 ? reference_residual_ : start_residual;
+  }
+  // The next Evaluate, if it is at exactly x with the fixed rows zeroed,
+  // returns this value and gradient instead of recomputing them (once; any
+  // Evaluate clears it).
+  void Prime(const VectorXd& x, double value, const VectorXd& grad);
+
  private:
   SimulatorImpl& sim_;
   VectorXd xhat_;
@@ -135,6 +147,10 @@ class StepObjective {
   Checkpoint checkpoint_;
   bool checkpoint_done_ = false;
   bool checkpoint_stopped_ = false;
+  double reference_residual_ = -1;
+  bool primed_ = false;
+  VectorXd primed_x_, primed_grad_;
+  double primed_value_ = 0;
 };
 
 // Exact Hessian of one step's objective at a point, over the free DoFs,
