@@ -55,6 +55,21 @@ TEST(StepStartTest, StartsFromThePreviousStateWhereThePredictorHoldsMoreThanItsT
   EXPECT_LE((primed_grad - previous_grad).norm(), 1e-6 * previous_grad.norm());
 }
 
+// With SolverOptions::start_at_lower_energy = false the same case starts at
+// the predictor, without evaluating anything.
+TEST(StepStartTest, OptionOffStartsAtThePredictor) {
+  SolverOptions options = Options();
+  options.start_at_lower_energy = false;
+  SimulatorImpl sim(CubeScene(1e10, false), options);
+  const VectorXd x = Eigen::Map<const VectorXd>(sim.scene.mesh.vertices.data(), sim.num_dofs());
+  VectorXd v(x.size());
+  for (int i = 0; i < x.size(); ++i) v(i) = -(x(i) - 0.05);
+  const VectorXd predicted = x + sim.h() * v;
+  StepObjective objective(sim, predicted, VectorXd::Zero(x.size()));
+  EXPECT_EQ(ChooseStepStart(objective, predicted, x), predicted);
+  EXPECT_EQ(objective.ReferenceResidual(123.0), 123.0);  // no reference set: the start's own
+}
+
 // Free fall: the predictor is lower in the gravity potential by h m g |v|
 // than x_i is in kinetic energy above it, so the solve starts there as before.
 TEST(StepStartTest, StartsFromThePredictorInFreeFall) {

@@ -5,6 +5,7 @@
 namespace diffpd::internal {
 
 VectorXd ChooseStepStart(StepObjective& objective, const VectorXd& predicted, const VectorXd& previous) {
+  if (!objective.sim().options.start_at_lower_energy) return predicted;
   VectorXd predicted_grad;
   const double predicted_value = objective.Evaluate(predicted, &predicted_grad);
   objective.SetReferenceResidual(predicted_grad.norm());

@@ -22,7 +22,8 @@
 namespace diffpd::internal {
 
 // `predicted` (x_i + h v_i) and `previous` (x_i), both with the Dirichlet
-// values set. Evaluates g at both (one evaluation more than starting at the
+// values set. Returns `predicted` at once unless
+// SolverOptions::start_at_lower_energy. Evaluates g at both (one evaluation more than starting at the
 // predictor: the chosen start's is primed for the solver's first Evaluate),
 // sets the objective's reference residual to |grad g(predicted)| and returns
 // the start. An evaluation error at `previous` (e.g. an inverted element in
