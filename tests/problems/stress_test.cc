@@ -117,8 +117,8 @@ TEST(StressTest, TenThousandStepsStayFiniteAndDissipative) {
 // stiff cantilever at h = 0.01 s whose second step's predictor is so
 // compressed that Newton's descent from it ended at a stationary point with
 // 5.6e6 J (the body had 12 J): the total energy rose by 0.96 (relative)
-// without an error. Starting each solve from x_i where g is lower there
-// bounds the new potential energy by the previous total energy.
+// without an error. A result with g above g(x_i), the previous total energy,
+// is now solved again from x_i (SolverOptions::bound_step_energy).
 TEST(StressTest, StiffIncompressibleStepsDoNotClimbToAFarStationaryPoint) {
   StressOptions o = ReducedGrid();
   o.steps = 5;

@@ -7,4 +7,4 @@ diffpd_add_test(tangent_rollout_test ${CMAKE_CURRENT_LIST_DIR}/tangent_rollout_t
 diffpd_add_test(region_materials_test ${CMAKE_CURRENT_LIST_DIR}/region_materials_test.cc)
 diffpd_add_test(preconditioned_iteration_test ${CMAKE_CURRENT_LIST_DIR}/preconditioned_iteration_test.cc)
 diffpd_add_test(cholmod_solver_test ${CMAKE_CURRENT_LIST_DIR}/cholmod_solver_test.cc)
-diffpd_add_test(step_start_test ${CMAKE_CURRENT_LIST_DIR}/step_start_test.cc)
+diffpd_add_test(energy_bounded_step_test ${CMAKE_CURRENT_LIST_DIR}/energy_bounded_step_test.cc)

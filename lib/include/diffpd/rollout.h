@@ -31,6 +31,9 @@ struct StepReport {
   double initial_residual = 0; // ||grad g(x0)||
   double final_residual = 0;   // ||grad g(x_{i+1})||
   double seconds = 0;
+  // Solves repeated from x_i because the first result's g was above g(x_i)
+  // (SolverOptions::bound_step_energy): 0 or 1.
+  int energy_restarts = 0;
   // Frictional contact (contact.h): the step's final active set (sorted node
   // indices), the contact force on each of those nodes (3 x |set|, N, the
   // surface's push on the node) and the number of active-set passes (solves).

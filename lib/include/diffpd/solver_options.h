@@ -41,17 +41,16 @@ struct SolverOptions {
   double abs_tolerance = 1e-9;  // N
   double rel_tolerance = 1e-6;
   int max_iterations = 1000;    // per step (Newton or PD iterations)
-  // Start each implicit solve at x_i instead of x0 where g is lower there.
-  // Every method descends on g, so the step's potential energy then never
-  // exceeds the previous total energy (kinetic + elastic + the explicit
-  // forces' potential; without frictional-contact pins); from x0 alone a
-  // very stiff, nearly incompressible body at a large h was driven to a far
-  // stationary point (README, stress report). Costs one evaluation of g per
-  // step. Measured (README): on the cantilever at rel_tolerance 1e-4 it
-  // starts 9 of 25 steps at x_i and PD-LBFGS's final velocity error grows
-  // from 9e-4 to 6e-3 (the same test met from another start); at 3e-6 it
-  // shrinks from 5.9e-5 to 3.3e-5. false: always start at x0.
-  bool start_at_lower_energy = true;
+  // After a step's solve from x0, compare g there with g(x_i), the previous
+  // total energy (kinetic + elastic + the explicit forces' potential); if the
+  // result is above it (a far stationary point: a very stiff, nearly
+  // incompressible body at a large h was driven to one, README stress
+  // report), solve again from x_i, so that the step's potential energy never
+  // exceeds the previous total energy. Costs one evaluation of g per step;
+  // other steps' results are unchanged. With frictional contact each
+  // active-set pass is checked against x_i with that pass's pins (the bound
+  // then holds for the pinned problem). false: no check.
+  bool bound_step_energy = true;
 
   // Backtracking (Armijo) line search of Newton and PD-LBFGS.
   double armijo_c = 1e-4;

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "diffpd/error.h"
-#include "solver/step_start.h"
+#include "solver/energy_bounded_step.h"
 
 namespace diffpd::internal {
 namespace {
@@ -148,13 +148,12 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
       // Later passes start from the previous solution; they must meet the
       // first pass's tolerance, not one relative to their smaller residual.
       const ToleranceScope tolerance(sim, pass == 1 ? -1.0 : first_target);
-      if (pass == 1) {  // from x_i + h v_i, or from x_i if g is lower there (solver/step_start.h)
-        VectorXd previous = state.x;
-        for (int d = 0; d < n; ++d)
-          if (sim.fixed[d]) previous(d) = sim.fixed_values(d);
-        x0 = ChooseStepStart(objective, x0, previous);
-      }
-      x = solve(objective, x0, &pass_report);
+      // Each pass's solve is bounded by g at x_i with this pass's pins
+      // (solver/energy_bounded_step.h).
+      VectorXd previous = state.x;
+      for (int d = 0; d < n; ++d)
+        if (sim.fixed[d]) previous(d) = sim.fixed_values(d);
+      x = SolveEnergyBounded(objective, x0, previous, solve, &pass_report);
       screening_pass = objective.checkpoint_stopped();
       if (!screening_pass && !nodes.empty()) objective.Evaluate(x, &grad, /*keep_fixed_rows=*/true);
     }
@@ -165,6 +164,7 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
     }
     report->iterations += pass_report.iterations;
     report->line_search_steps += pass_report.line_search_steps;
+    report->energy_restarts += pass_report.energy_restarts;
     report->final_residual = pass_report.final_residual;
     report->active_set_passes = pass;
 

@@ -13,9 +13,6 @@
 
 namespace diffpd::internal {
 
-// A forward solver of one implicit step (NewtonSolve, PdSolve, ...).
-using ImplicitSolver = std::function<VectorXd(StepObjective&, const VectorXd& x0, StepReport*)>;
-
 // Where a candidate node is pinned from its previous state (x, v) with time
 // step h, and d pin / dx, d pin / dv (3x3 each); see diffpd/contact.h. The
 // current rule, Project(x), does not depend on v and h (d_dv = 0); callers

@@ -10,7 +10,7 @@
 #include "diffpd/error.h"
 #include "forces/activation_scope.h"
 #include "solver/simulator_impl.h"
-#include "solver/step_start.h"
+#include "solver/energy_bounded_step.h"
 
 namespace diffpd {
 namespace {
@@ -138,7 +138,7 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
       for (int d = 0; d < n; ++d)
         if (sim.fixed[d]) x0(d) = previous(d) = sim.fixed_values(d);
       internal::StepObjective objective(sim, state.x + h * state.v, f);
-      next.x = solve(objective, internal::ChooseStepStart(objective, x0, previous), rep);
+      next.x = internal::SolveEnergyBounded(objective, x0, previous, solve, rep);
     }
   }
   for (int d = 0; d < n; ++d)

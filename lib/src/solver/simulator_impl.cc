@@ -135,21 +135,14 @@ StepObjective::StepObjective(SimulatorImpl& sim, VectorXd xhat, VectorXd force, 
   inertia_ = static_problem ? VectorXd::Zero(sim.num_dofs()) : VectorXd(sim.Mass() / (sim.h() * sim.h()));
 }
 
-void StepObjective::Prime(const VectorXd& x, double value, const VectorXd& grad) {
-  primed_ = true;
-  primed_x_ = x;
-  primed_value_ = value;
-  primed_grad_ = grad;
+bool StepObjective::LastValueAt(const VectorXd& x, double* value) const {
+  if (last_x_.size() != x.size() || last_x_ != x) return false;
+  *value = last_value_;
+  return true;
 }
 
 double StepObjective::Evaluate(const VectorXd& x, VectorXd* grad, bool keep_fixed_rows) {
-  if (primed_) {
-    primed_ = false;
-    if (!keep_fixed_rows && x == primed_x_) {
-      if (grad) *grad = primed_grad_;
-      return primed_value_;
-    }
-  }
+  last_x_.resize(0);  // until this evaluation succeeds
   const double e = sim_.elastic.EnergyAndGradient(x, sim_.lame(), grad, sim_.threads());
   const VectorXd dx = x - xhat_;
   double value = e + sim_.aux.AddEnergyAndGradient(x, sim_.activation, grad);
@@ -163,6 +156,8 @@ double StepObjective::Evaluate(const VectorXd& x, VectorXd* grad, bool keep_fixe
     CheckFinite(*grad, "grad g");
   }
   if (!std::isfinite(value)) throw SolverError(SolverStatus::kNonFinite, "the step objective g(x) is not finite");
+  last_x_ = x;
+  last_value_ = value;
   return value;
 }
 

@@ -128,16 +128,14 @@ class StepObjective {
   bool checkpoint_stopped() const { return checkpoint_stopped_; }
 
   // The convergence test's reference |grad g(x_i + h v_i)| when the solve
-  // starts elsewhere (solver/step_start.h). ReferenceResidual(r) returns it,
-  // or r (the start's own residual) when none was set.
+  // starts elsewhere (solver/energy_bounded_step.h). ReferenceResidual(r)
+  // returns it, or r (the start's own residual) when none was set.
   void SetReferenceResidual(double residual) { reference_residual_ = residual; }
   double ReferenceResidual(double start_residual) const {
     return reference_residual_ >= 0 ? reference_residual_ : start_residual;
   }
-  // The next Evaluate, if it is at exactly x with the fixed rows zeroed,
-  // returns this value and gradient instead of recomputing them (once; any
-  // Evaluate clears it).
-  void Prime(const VectorXd& x, double value, const VectorXd& grad);
+  // True, with *value = g(x), if the latest Evaluate was at exactly x.
+  bool LastValueAt(const VectorXd& x, double* value) const;
 
  private:
   SimulatorImpl& sim_;
@@ -148,9 +146,8 @@ class StepObjective {
   bool checkpoint_done_ = false;
   bool checkpoint_stopped_ = false;
   double reference_residual_ = -1;
-  bool primed_ = false;
-  VectorXd primed_x_, primed_grad_;
-  double primed_value_ = 0;
+  VectorXd last_x_;  // the latest Evaluate's point (empty before the first)
+  double last_value_ = 0;
 };
 
 // Exact Hessian of one step's objective at a point, over the free DoFs,
@@ -199,6 +196,7 @@ class StepLinearization {
 
 // Forward solvers of one implicit step. Each returns x_{i+1} and fills the
 // report; each throws SolverError when the step does not converge.
+using ImplicitSolver = std::function<VectorXd(StepObjective&, const VectorXd& x0, StepReport*)>;
 VectorXd NewtonSolve(StepObjective& objective, const VectorXd& x0, StepReport* report);
 VectorXd PdSolve(StepObjective& objective, const VectorXd& x0, StepReport* report);
 VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* report);
