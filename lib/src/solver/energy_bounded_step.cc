@@ -6,7 +6,7 @@ namespace diffpd::internal {
 namespace {
 // g's rounding relative to |g| allowed for (sums of (sigma - 1)^2 lose
 // relative precision; measured up to 1.5e-12, solver/line_search.cc).
-constexpr double kRoundingRelative = 1e-9;
+constexpr double kRoundingSlack = 1e-9;
 }  // namespace
 
 VectorXd SolveEnergyBounded(StepObjective& objective, const VectorXd& predicted, const VectorXd& previous,
@@ -29,7 +29,7 @@ VectorXd SolveEnergyBounded(StepObjective& objective, const VectorXd& predicted,
   // g's rounding (x_i itself nearly optimal: a body at rest). Only a larger
   // excess is a far stationary point.
   const double slack = report->final_residual * (x - previous).norm() +
-                       kRoundingRelative * (std::abs(value) + std::abs(previous_value));
+                       kRoundingSlack * (std::abs(value) + std::abs(previous_value));
   if (value <= previous_value + slack) return x;
   // A stationary point above the previous total energy: descend from x_i.
   objective.SetReferenceResidual(report->initial_residual);

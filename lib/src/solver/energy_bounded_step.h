@@ -29,8 +29,9 @@ namespace diffpd::internal {
 // With SolverOptions::bound_step_energy off: solve(objective, predicted).
 // Otherwise, after that solve, one evaluation of g at x_i; if the result's g
 // is above it by more than the solve's tolerance and g's rounding allow
-// (|grad g| |x - x_i| + 1e-9 (|g(x)| + |g(x_i)|)), a second solve from x_i (its iterations are added to the
-// report, and report->energy_restarts counts it). An evaluation error at x_i
+// (|grad g| |x - x_i| + 1e-9 (|g(x)| + |g(x_i)|)), a second solve from x_i
+// (its iterations are added to the report, and report->energy_restarts
+// counts it). An evaluation error at x_i
 // (an inverted element in a user's state) keeps the first result.
 VectorXd SolveEnergyBounded(StepObjective& objective, const VectorXd& predicted, const VectorXd& previous,
                             const ImplicitSolver& solve, StepReport* report);

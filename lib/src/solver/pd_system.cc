@@ -1,7 +1,6 @@
 #include "solver/pd_system.h"
 
 #include <chrono>
-
 #include <sstream>
 
 #include "diffpd/error.h"

@@ -9,8 +9,8 @@
 #include "contact/active_set_step.h"
 #include "diffpd/error.h"
 #include "forces/activation_scope.h"
-#include "solver/simulator_impl.h"
 #include "solver/energy_bounded_step.h"
+#include "solver/simulator_impl.h"
 
 namespace diffpd {
 namespace {

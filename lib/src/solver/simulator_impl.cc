@@ -136,13 +136,13 @@ StepObjective::StepObjective(SimulatorImpl& sim, VectorXd xhat, VectorXd force, 
 }
 
 bool StepObjective::LastValueAt(const VectorXd& x, double* value) const {
-  if (last_x_.size() != x.size() || last_x_ != x) return false;
+  if (!have_last_ || last_x_.size() != x.size() || last_x_ != x) return false;
   *value = last_value_;
   return true;
 }
 
 double StepObjective::Evaluate(const VectorXd& x, VectorXd* grad, bool keep_fixed_rows) {
-  last_x_.resize(0);  // until this evaluation succeeds
+  have_last_ = false;  // until this evaluation succeeds
   const double e = sim_.elastic.EnergyAndGradient(x, sim_.lame(), grad, sim_.threads());
   const VectorXd dx = x - xhat_;
   double value = e + sim_.aux.AddEnergyAndGradient(x, sim_.activation, grad);
@@ -156,8 +156,9 @@ double StepObjective::Evaluate(const VectorXd& x, VectorXd* grad, bool keep_fixe
     CheckFinite(*grad, "grad g");
   }
   if (!std::isfinite(value)) throw SolverError(SolverStatus::kNonFinite, "the step objective g(x) is not finite");
-  last_x_ = x;
+  last_x_ = x;  // same size every time: no allocation after the first
   last_value_ = value;
+  have_last_ = true;
   return value;
 }
 

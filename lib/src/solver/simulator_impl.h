@@ -146,8 +146,9 @@ class StepObjective {
   bool checkpoint_done_ = false;
   bool checkpoint_stopped_ = false;
   double reference_residual_ = -1;
-  VectorXd last_x_;  // the latest Evaluate's point (empty before the first)
+  VectorXd last_x_;  // the latest successful Evaluate's point and value
   double last_value_ = 0;
+  bool have_last_ = false;
 };
 
 // Exact Hessian of one step's objective at a point, over the free DoFs,
