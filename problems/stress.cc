@@ -278,6 +278,8 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
       c.max_energy_excess = std::max(c.max_energy_excess, excess);
       rollout.states.push_back(std::move(next));
       c.steps_completed = k + 1;
+      c.rounding_floor_steps += rollout.reports[k].rounding_floor_stop;
+      c.newton_fallback_steps += rollout.reports[k].newton_fallback;
       if (progress && std::chrono::duration<double>(Clock::now() - last_report).count() > 10) {
         last_report = Clock::now();
         *progress << "  ... step " << k + 1 << " of " << steps << std::endl;
@@ -372,6 +374,8 @@ nlohmann::json StressToJson(const std::vector<StressCase>& cases) {
                    {"outcome", c.outcome},
                    {"message", c.message},
                    {"steps_completed", c.steps_completed},
+                   {"rounding_floor_steps", c.rounding_floor_steps},
+                   {"newton_fallback_steps", c.newton_fallback_steps},
                    {"max_energy_excess", c.max_energy_excess},
                    {"gradcheck_error", c.gradcheck_error},
                    {"gradcheck_unresolved", c.gradcheck_unresolved},

@@ -71,6 +71,11 @@ struct StressCase {
   std::string outcome;   // "ok", "failed" or "violation"
   std::string message;   // empty for ok; the error or the violated property
   int steps_completed = 0;
+  // Steps of the rollout that ended at g's rounding floor above the
+  // tolerance (StepReport::rounding_floor_stop), and PD-LBFGS steps that
+  // Newton finished after a line-search stall (StepReport::newton_fallback).
+  int rounding_floor_steps = 0;
+  int newton_fallback_steps = 0;
   // max over steps of (T_k - T_0) / (|T_0 parts| + |T_k parts| + 1e-300),
   // where the parts are kinetic, elastic and gravitational (relative to T_0).
   double max_energy_excess = 0;

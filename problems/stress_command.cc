@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <string>
 
 #include "bench.h"
 #include "commands.h"
@@ -27,12 +28,16 @@ classifies it:
              mismatch or an unexpected error - a library bug.
 Exit code 4 when any case is a violation. JSON: a list of {problem, method,
 youngs_modulus, poissons_ratio, time_step, outcome, message, steps_completed,
-max_energy_excess, gradcheck_error, gradcheck_unresolved, seconds}; inputs
+rounding_floor_steps, newton_fallback_steps, max_energy_excess,
+gradcheck_error, gradcheck_unresolved, seconds}; inputs
 whose effect on the loss is within the finite-difference noise are listed
 as unresolved (not tested) rather than passed.
 Solves stop at |grad g| <= --abs-tol + --rtol |grad g(x0)|; by default
 --abs-tol is 10x an estimate of the rounding floor of |grad g| (never below
-1e-9 N), which grows with stiffness and 1/dt^2.
+1e-9 N), which grows with stiffness and 1/dt^2. Steps whose line search
+stalls at the library's own floor estimate end there (rounding_floor_steps;
+SolverOptions::accept_rounding_floor), and PD-LBFGS steps whose line search
+stalls above it are finished by Newton (newton_fallback_steps).
 Meshes: --refine doublings of each problem's cells (-6: cantilever 8x2x2,
 falling cube 2x2x2; -9: cantilever 4x1x1, cube 1 cell).)";
 
@@ -59,6 +64,11 @@ int RunStressArgs(const StressArgs& args) {
                 "outcome", "steps", "energy_exc", "gradcheck", "seconds", "message");
     for (const auto& c : cases) {
       std::string message = c.message;
+      if (c.rounding_floor_steps > 0 || c.newton_fallback_steps > 0) {
+        message += message.empty() ? "" : "; ";
+        message += std::to_string(c.rounding_floor_steps) + " steps at the rounding floor, " +
+                   std::to_string(c.newton_fallback_steps) + " finished by Newton";
+      }
       if (!c.gradcheck_unresolved.empty()) {
         message += message.empty() ? "" : "; ";
         message += "below finite-difference noise:";

@@ -162,6 +162,8 @@ TEST(StressTest, RunStressCoversTheGridAndWritesJson) {
   const nlohmann::json rows = nlohmann::json::parse(StressToJson(cases).dump());
   EXPECT_EQ(rows[0].at("outcome"), "ok");
   EXPECT_EQ(rows[0].at("steps_completed"), 5);
+  EXPECT_EQ(rows[0].at("rounding_floor_steps"), 0);
+  EXPECT_EQ(rows[0].at("newton_fallback_steps"), 0);
   EXPECT_TRUE(rows[0].at("gradcheck_unresolved").is_array());
 }
 

@@ -8,3 +8,5 @@ diffpd_add_test(region_materials_test ${CMAKE_CURRENT_LIST_DIR}/region_materials
 diffpd_add_test(preconditioned_iteration_test ${CMAKE_CURRENT_LIST_DIR}/preconditioned_iteration_test.cc)
 diffpd_add_test(cholmod_solver_test ${CMAKE_CURRENT_LIST_DIR}/cholmod_solver_test.cc)
 diffpd_add_test(energy_bounded_step_test ${CMAKE_CURRENT_LIST_DIR}/energy_bounded_step_test.cc)
+diffpd_add_test(rounding_floor_test ${CMAKE_CURRENT_LIST_DIR}/rounding_floor_test.cc)
+diffpd_add_test(newton_fallback_test ${CMAKE_CURRENT_LIST_DIR}/newton_fallback_test.cc)

@@ -34,6 +34,12 @@ struct StepReport {
   // Solves repeated from x_i because the first result's g was above g(x_i)
   // (SolverOptions::bound_step_energy): 0 or 1.
   int energy_restarts = 0;
+  // The solve ended at g's rounding floor above the tolerance
+  // (SolverOptions::accept_rounding_floor); final_residual is what it reached.
+  bool rounding_floor_stop = false;
+  // PD-LBFGS's line search stalled and Newton finished the step
+  // (SolverOptions::pd_lbfgs_newton_fallback); iterations include Newton's.
+  bool newton_fallback = false;
   // Frictional contact (contact.h): the step's final active set (sorted node
   // indices), the contact force on each of those nodes (3 x |set|, N, the
   // surface's push on the node) and the number of active-set passes (solves).

@@ -55,6 +55,15 @@ struct SolverOptions {
   // Backtracking (Armijo) line search of Newton and PD-LBFGS.
   double armijo_c = 1e-4;
   int max_line_search_steps = 40;
+  // A line search that finds no acceptable step while ||grad g|| is within
+  // 100 times g's estimated rounding floor (eps times the magnitudes of the
+  // inertia, explicit-force and elastic-stress terms; README stress report)
+  // cannot do better in double precision: true ends the step there, as
+  // converged at the floor (StepReport::rounding_floor_stop); false throws
+  // SolverError(kLineSearchFailed) as for any other stall. Only steps that
+  // would otherwise fail are affected (very stiff material, tolerances below
+  // the floor).
+  bool accept_rounding_floor = true;
 
   // Newton-PCG: the linear solve stops at relative residual pcg_rel_tolerance
   // (relative to the right-hand side) or after pcg_max_iterations.
@@ -82,6 +91,14 @@ struct SolverOptions {
   // converge and then falls back to a direct solve; the kLbfgs and default
   // kConjugateGradient backwards converge for any factor (H positive definite).
   double lbfgs_weight_scale = 0.3;
+  // PD-LBFGS: when the line search stalls (no acceptable step along the
+  // quasi-Newton direction nor the plain PD one) above the rounding-floor
+  // band (accept_rounding_floor), the step goes on with Newton iterations
+  // (projected Hessian, CHOLMOD) from where it stalled, to the same test
+  // (StepReport::newton_fallback). Stiff or nearly incompressible material
+  // at large h, where g can no longer resolve PD-LBFGS's progress (README
+  // stress report); ordinary steps never stall. false: the stall is an error.
+  bool pd_lbfgs_newton_fallback = true;
 
   // Backward (adjoint) linear solves: relative residual ||H z - b|| / ||b||.
   PdBackwardMethod pd_backward = PdBackwardMethod::kConjugateGradient;

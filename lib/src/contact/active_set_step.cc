@@ -166,6 +166,8 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
     report->line_search_steps += pass_report.line_search_steps;
     report->energy_restarts += pass_report.energy_restarts;
     report->final_residual = pass_report.final_residual;
+    report->rounding_floor_stop = pass_report.rounding_floor_stop;
+    report->newton_fallback = report->newton_fallback || pass_report.newton_fallback;
     report->active_set_passes = pass;
 
     // A screening pass stopped because the set changed; a final pass applies

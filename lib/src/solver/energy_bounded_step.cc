@@ -38,6 +38,8 @@ VectorXd SolveEnergyBounded(StepObjective& objective, const VectorXd& predicted,
   report->iterations += again.iterations;
   report->line_search_steps += again.line_search_steps;
   report->final_residual = again.final_residual;
+  report->rounding_floor_stop = again.rounding_floor_stop;
+  report->newton_fallback = report->newton_fallback || again.newton_fallback;
   ++report->energy_restarts;
   return x;
 }

@@ -14,8 +14,8 @@ constexpr double kRoundingRelative = 1e-12;
 constexpr double kBlindRelative = 1e-10;
 }  // namespace
 
-int BacktrackingLineSearch(StepObjective& objective, const VectorXd& d, VectorXd* x, double* value,
-                           VectorXd* grad) {
+LineSearchResult BacktrackingLineSearch(StepObjective& objective, const VectorXd& d, VectorXd* x, double* value,
+                                        VectorXd* grad) {
   const SolverOptions& options = objective.sim().options;
   const double slope = grad->dot(d);
   if (!(slope < 0)) {
@@ -52,14 +52,17 @@ int BacktrackingLineSearch(StepObjective& objective, const VectorXd& d, VectorXd
       *x = trial;
       *value = trial_value;
       *grad = trial_grad;
-      return k;
+      return LineSearchResult{k, false};
     }
     alpha *= 0.5;
   }
+  const double floor = objective.RoundingFloor();
+  if (options.accept_rounding_floor && grad->norm() <= StepObjective::kRoundingFloorStall * floor)
+    return LineSearchResult{options.max_line_search_steps, true};
   std::ostringstream msg;
   msg << ToString(options.method) << ": the line search found no decrease of g after "
       << options.max_line_search_steps << " halvings (|grad g| = " << grad->norm()
-      << "; if this is the rounding floor, raise abs_tolerance)";
+      << ", estimated rounding floor " << floor << ")";
   throw SolverError(SolverStatus::kLineSearchFailed, msg.str());
 }
 

@@ -60,7 +60,9 @@ VectorXd NewtonSolve(StepObjective& objective, const VectorXd& x0, StepReport* r
     VectorXd dx = SolveNewtonSystem(sim, h, rhs);
     sim.ZeroFixed(&dx);
     CheckFinite(dx, "the Newton step");
-    report->line_search_steps += BacktrackingLineSearch(objective, dx, &x, &value, &grad);
+    const LineSearchResult search = BacktrackingLineSearch(objective, dx, &x, &value, &grad);
+    report->line_search_steps += search.halvings;
+    if (search.at_rounding_floor) return EndAtRoundingFloor(x, grad.norm(), report);
   }
 }
 

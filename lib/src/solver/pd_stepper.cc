@@ -7,6 +7,7 @@
 // gives the convergence test's residual for free.
 #include <cstdio>
 #include <deque>
+#include <optional>
 
 #include "diffpd/error.h"
 #include "solver/line_search.h"
@@ -29,6 +30,27 @@ VectorXd PdSolve(StepObjective& objective, const VectorXd& x0, StepReport* repor
     objective.Evaluate(x, &grad);
   }
 }
+
+namespace {
+
+// PD-LBFGS's line search stalled at x above g's rounding floor band (both
+// the quasi-Newton and the plain PD direction): Newton from x, with the
+// same convergence test (SolverOptions::pd_lbfgs_newton_fallback), or the
+// stall's error.
+VectorXd NewtonAfterStall(StepObjective& objective, const VectorXd& x, const SolverError& stall, StepReport* report) {
+  if (!objective.sim().options.pd_lbfgs_newton_fallback) throw stall;
+  objective.SetReferenceResidual(report->initial_residual);
+  StepReport newton;
+  const VectorXd out = NewtonSolve(objective, x, &newton);
+  report->iterations += newton.iterations;
+  report->line_search_steps += newton.line_search_steps;
+  report->final_residual = newton.final_residual;
+  report->rounding_floor_stop = newton.rounding_floor_stop;
+  report->newton_fallback = true;
+  return out;
+}
+
+}  // namespace
 
 VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* report) {
   SimulatorImpl& sim = objective.sim();
@@ -64,19 +86,31 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
       d = -pd.Solve(grad);
     }
     const VectorXd x_old = x, grad_old = grad;
-    try {
-      report->line_search_steps += BacktrackingLineSearch(objective, d, &x, &value, &grad);
-    } catch (const SolverError& e) {
+    LineSearchResult search;
+    std::optional<SolverError> stall;
+    const auto line_search = [&](const VectorXd& direction) {
+      try {
+        search = BacktrackingLineSearch(objective, direction, &x, &value, &grad);
+        stall.reset();
+      } catch (const SolverError& e) {
+        if (e.status() != SolverStatus::kLineSearchFailed) throw;
+        stall = e;
+      }
+    };
+    line_search(d);
+    if (stall && !s_list.empty()) {
       // Stale curvature pairs can spoil the direction near convergence:
-      // restart once from the plain PD direction before giving up.
-      if (e.status() != SolverStatus::kLineSearchFailed || s_list.empty()) throw;
+      // restart once from the plain PD direction.
       s_list.clear();
       y_list.clear();
       rho_list.clear();
       d = -pd.Solve(grad);
       sim.ZeroFixed(&d);
-      report->line_search_steps += BacktrackingLineSearch(objective, d, &x, &value, &grad);
+      line_search(d);
     }
+    if (stall) return NewtonAfterStall(objective, x, *stall, report);
+    report->line_search_steps += search.halvings;
+    if (search.at_rounding_floor) return EndAtRoundingFloor(x, grad.norm(), report);
     VectorXd s = x - x_old, y = grad - grad_old;
     const double sy = s.dot(y);
     if (sy > 1e-12 * s.norm() * y.norm()) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 
 #include "diffpd/error.h"
@@ -135,6 +136,55 @@ StepObjective::StepObjective(SimulatorImpl& sim, VectorXd xhat, VectorXd force, 
   inertia_ = static_problem ? VectorXd::Zero(sim.num_dofs()) : VectorXd(sim.Mass() / (sim.h() * sim.h()));
 }
 
+namespace {
+
+// Per node (n, N): how much one relative rounding of the deformation
+// gradients moves the node's elastic force near positions x,
+//   sqrt(sum_s (w_s vol_s |grad N_a(s)| c_s)^2)
+// over the samples s of the node's elements, w_s = 2 mu + lambda (the P-wave
+// modulus) and c_s = 1 + sqrt(sum_b |x_b|^2 |grad N_b(s)|^2): F = sum_b x_b
+// grad N_b^T is formed from absolute positions, so its rounding grows with
+// the body's distance from the origin.
+VectorXd ElasticRoundingScale(const FemModel& fem, const LameField& lame, const VectorXd& x) {
+  const Mesh& mesh = fem.mesh();
+  const int k = fem.nodes_per_element(), q = fem.samples_per_element();
+  VectorXd squares = VectorXd::Zero(fem.num_nodes());
+  std::vector<double> grad_norm(k);
+  for (int e = 0; e < fem.num_elements(); ++e) {
+    const double w = 2 * lame.mu_of(e) + lame.lambda_of(e);
+    for (int j = 0; j < q; ++j) {
+      const int s = e * q + j;
+      const Eigen::Map<const Eigen::MatrixXd> g(fem.grad(s), k, 3);
+      double positions = 0;
+      for (int b = 0; b < k; ++b) {
+        grad_norm[b] = g.row(b).norm();
+        positions += x.segment<3>(3 * mesh.elements(b, e)).squaredNorm() * grad_norm[b] * grad_norm[b];
+      }
+      const double c = 1 + std::sqrt(positions);
+      for (int a = 0; a < k; ++a) {
+        const double term = w * fem.sample_volume(s) * grad_norm[a] * c;
+        squares(mesh.elements(a, e)) += term * term;
+      }
+    }
+  }
+  return squares.cwiseSqrt();
+}
+
+}  // namespace
+
+double StepObjective::RoundingFloor() {
+  if (rounding_floor_ >= 0) return rounding_floor_;
+  const VectorXd elastic = ElasticRoundingScale(sim_.fem, sim_.lame(), xhat_);
+  double sum = 0;
+  for (int d = 0; d < xhat_.size(); ++d) {
+    if (sim_.fixed[d]) continue;
+    const double term = inertia_(d) * std::abs(xhat_(d)) + std::abs(force_(d)) + elastic(d / 3);
+    sum += term * term;
+  }
+  rounding_floor_ = std::numeric_limits<double>::epsilon() * std::sqrt(sum);
+  return rounding_floor_;
+}
+
 bool StepObjective::LastValueAt(const VectorXd& x, double* value) const {
   if (!have_last_ || last_x_.size() != x.size() || last_x_ != x) return false;
   *value = last_value_;
@@ -150,6 +200,7 @@ double StepObjective::Evaluate(const VectorXd& x, VectorXd* grad, bool keep_fixe
     if (sim_.fixed[d]) continue;
     value += 0.5 * inertia_(d) * dx(d) * dx(d) - force_(d) * x(d);
   }
+
   if (grad) {
     grad->array() += inertia_.array() * dx.array() - force_.array();
     if (!keep_fixed_rows) sim_.ZeroFixed(grad);
@@ -184,6 +235,12 @@ bool IterationConverged(StepObjective& objective, int it, const VectorXd& x, dou
   if (objective.StopAtCheckpoint(x, grad_norm, report->initial_residual)) return true;
   if (it >= options.max_iterations) ThrowNotConverged(options, it, grad_norm, report->initial_residual);
   return false;
+}
+
+VectorXd EndAtRoundingFloor(const VectorXd& x, double grad_norm, StepReport* report) {
+  report->rounding_floor_stop = true;
+  report->final_residual = grad_norm;
+  return x;
 }
 
 void ThrowNotConverged(const SolverOptions& options, int iterations, double grad_norm, double initial_norm) {

@@ -134,6 +134,19 @@ class StepObjective {
   double ReferenceResidual(double start_residual) const {
     return reference_residual_ >= 0 ? reference_residual_ : start_residual;
   }
+  // The estimated rounding floor of |grad g| (N): what rounding alone leaves
+  // in a gradient evaluated in double precision near this step's solution,
+  //   eps sqrt(sum over free DoFs d of (M_d / h^2 |xhat_d| + |f_d| + r_d)^2),
+  // r_d the rounding of the elastic force at d's node: its samples'
+  // (2 mu + lambda) vol |grad N| times 1 + |F|'s rounding scale from the
+  // absolute positions (simulator_impl.cc, ElasticRoundingScale). The solvers
+  // end a solve whose line search stalls within kRoundingFloorStall of it
+  // (SolverOptions::accept_rounding_floor). Computed on first use.
+  double RoundingFloor();
+  // The factor: a stall with |grad g| <= kRoundingFloorStall * RoundingFloor()
+  // is the floor (measured stalls: README stress report).
+  static constexpr double kRoundingFloorStall = 100;
+
   // True, with *value = g(x), if the latest Evaluate was at exactly x.
   bool LastValueAt(const VectorXd& x, double* value) const;
 
@@ -146,6 +159,7 @@ class StepObjective {
   bool checkpoint_done_ = false;
   bool checkpoint_stopped_ = false;
   double reference_residual_ = -1;
+  double rounding_floor_ = -1;  // not computed yet
   VectorXd last_x_;  // the latest successful Evaluate's point and value
   double last_value_ = 0;
   bool have_last_ = false;
@@ -210,6 +224,10 @@ bool Converged(const SolverOptions& options, double grad_norm, double initial_no
 // checkpoint; throws ThrowNotConverged's error when `it` reached the
 // iteration limit without converging.
 bool IterationConverged(StepObjective& objective, int it, const VectorXd& x, double grad_norm, StepReport* report);
+// Ends a solve whose line search stalled at g's rounding floor
+// (LineSearchResult::at_rounding_floor): marks the report, records
+// |grad g| as the final residual and returns x.
+VectorXd EndAtRoundingFloor(const VectorXd& x, double grad_norm, StepReport* report);
 // Throws SolverError(kMaxIterations) with a message naming method and residuals.
 [[noreturn]] void ThrowNotConverged(const SolverOptions& options, int iterations, double grad_norm,
                                     double initial_norm);

@@ -1,0 +1,70 @@
+// PD-LBFGS hands a step whose line search stalls above the rounding floor to
+// Newton from where it stalled (SolverOptions::pd_lbfgs_newton_fallback),
+// which meets the same convergence test; without the fallback the stall is
+// an error.
+#include <gtest/gtest.h>
+
+#include "diffpd/error.h"
+#include "diffpd/simulator.h"
+#include "test_scenes.h"
+
+namespace diffpd {
+namespace {
+
+// A preconditioner with almost no elastic stiffness (A ~ M / h^2) makes the
+// first PD-LBFGS directions far too long in the stiff modes; with two
+// halvings allowed the line search stalls on the first iteration, far above
+// g's rounding floor. A stand-in for the stalls of stiff, nearly
+// incompressible material at large h (README stress report), which depend
+// on rounding paths.
+SolverOptions StallingOptions(bool fallback) {
+  SolverOptions o;
+  o.method = Method::kPdLbfgs;
+  o.time_step = 0.01;
+  o.rel_tolerance = 1e-10;
+  o.abs_tolerance = 1e-12;
+  o.num_threads = 1;
+  o.lbfgs_weight_scale = 1e-6;
+  o.max_line_search_steps = 2;
+  o.pd_lbfgs_newton_fallback = fallback;
+  return o;
+}
+
+TEST(NewtonFallbackTest, WithoutTheFallbackTheStallIsALineSearchError) {
+  Simulator sim(testing::SmallBeamScene(), StallingOptions(false));
+  try {
+    sim.Step(testing::MovingStart(sim), StepInput());
+    ADD_FAILURE() << "expected a line search failure";
+  } catch (const SolverError& e) {
+    EXPECT_EQ(e.status(), SolverStatus::kLineSearchFailed) << e.what();
+  }
+}
+
+TEST(NewtonFallbackTest, NewtonFinishesTheStalledStepAtTheSameTest) {
+  Simulator sim(testing::SmallBeamScene(), StallingOptions(true));
+  const State start = testing::MovingStart(sim);
+  StepReport report;
+  const State next = sim.Step(start, StepInput(), &report);
+  EXPECT_TRUE(report.newton_fallback);
+  EXPECT_FALSE(report.rounding_floor_stop);
+  EXPECT_LE(report.final_residual, 1e-12 + 1e-10 * report.initial_residual);
+
+  SolverOptions newton = testing::TightOptions(Method::kNewtonCholesky);
+  newton.time_step = 0.01;
+  Simulator reference(testing::SmallBeamScene(), newton);
+  const State expected = reference.Step(start, StepInput());
+  EXPECT_LT((next.x - expected.x).norm(), 1e-9 * expected.x.norm());
+}
+
+TEST(NewtonFallbackTest, OrdinaryStepsNeverFallBack) {
+  SolverOptions o;
+  o.method = Method::kPdLbfgs;
+  o.time_step = 0.01;
+  o.num_threads = 1;
+  Simulator sim(testing::SmallBeamScene(), o);
+  const Rollout r = sim.Simulate(testing::MovingStart(sim), std::vector<StepInput>(20));
+  for (const StepReport& report : r.reports) EXPECT_FALSE(report.newton_fallback);
+}
+
+}  // namespace
+}  // namespace diffpd
