@@ -40,10 +40,15 @@ struct CholmodSolver::Impl {
   }
 };
 
-CholmodSolver::CholmodSolver(CholmodLayout layout) : impl_(std::make_unique<Impl>()), layout_(layout) {
-  // Failures are reported through return values.
-  impl_->supernodal.cholmod().print = 0;
-  impl_->simplicial.cholmod().print = 0;
+CholmodSolver::CholmodSolver(CholmodLayout layout, CholmodOrdering ordering)
+    : impl_(std::make_unique<Impl>()), layout_(layout), ordering_(ordering) {
+  for (cholmod_common* common : {&impl_->supernodal.cholmod(), &impl_->simplicial.cholmod()}) {
+    common->print = 0;  // failures are reported through return values
+    if (ordering == CholmodOrdering::kNestedDissection) {
+      common->nmethods = 1;
+      common->method[0].ordering = CHOLMOD_NESDIS;
+    }
+  }
 }
 
 CholmodSolver::~CholmodSolver() = default;
@@ -64,6 +69,10 @@ bool CholmodSolver::Factorize(const SparseMatrix& a) {
   });
   ++num_factorizations_;
   return factorized_;
+}
+
+double CholmodSolver::factor_nonzeros() const {
+  return impl_->With(layout_, [](auto& llt) { return llt.cholmod().lnz; });
 }
 
 MatrixXd CholmodSolver::Solve(const MatrixXd& b) const {

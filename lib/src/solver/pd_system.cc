@@ -13,7 +13,8 @@ namespace {
 // supernode) measured faster on the cantilever from 2 673 to 18 785 nodes
 // (bench --scaling, 2 threads: forward 5-16% and backward 14-25% faster per
 // run); above that range the supernodal layout, measured up to 140 481 nodes,
-// is kept.
+// is kept. Its ordering is nested dissection, whatever the size (fewer
+// factor entries than CHOLMOD's automatic choice: solver/cholmod_solver.h).
 constexpr int kSimplicialMaxNodes = 20000;
 CholmodLayout PdFactorLayout(int num_nodes) {
   return num_nodes <= kSimplicialMaxNodes ? CholmodLayout::kSimplicial : CholmodLayout::kSupernodal;
@@ -82,7 +83,7 @@ PdSystem::PdSystem(const FemModel& fem, const std::vector<char>& fixed, const st
     for (size_t g = 0; g < groups_.size(); ++g)
       if (groups_[g].fixed_node == mask) found = static_cast<int>(g);
     if (found < 0) {
-      groups_.push_back(Group{{}, mask, SparseMatrix(), std::make_unique<CholmodSolver>(PdFactorLayout(n))});
+      groups_.push_back(Group{{}, mask, SparseMatrix(), std::make_unique<CholmodSolver>(PdFactorLayout(n), CholmodOrdering::kNestedDissection)});
       found = static_cast<int>(groups_.size()) - 1;
     }
     groups_[found].axes.push_back(d);
