@@ -84,6 +84,8 @@ std::string Describe(const RolloutMeasurement& m) {
   } else {
     s << "forward " << m.forward_s << " s, backward " << m.backward_s << " s, " << m.iters_per_step
       << " iterations/step";
+    if (m.rounding_floor_steps > 0) s << ", " << m.rounding_floor_steps << " steps ended at the rounding floor";
+    if (m.newton_fallback_steps > 0) s << ", " << m.newton_fallback_steps << " steps finished by Newton";
   }
   return s.str();
 }
@@ -181,7 +183,13 @@ RolloutMeasurement MeasureRollout(const Scene& scene, const SolverOptions& optio
       return m;
     }
     m.total_iterations = 0;
-    for (const auto& rep : rollout.reports) m.total_iterations += rep.iterations;
+    m.rounding_floor_steps = 0;
+    m.newton_fallback_steps = 0;
+    for (const auto& rep : rollout.reports) {
+      m.total_iterations += rep.iterations;
+      m.rounding_floor_steps += rep.rounding_floor_stop;
+      m.newton_fallback_steps += rep.newton_fallback;
+    }
   }
   m.forward_s = Median(forward);
   m.backward_s = Median(backward);
@@ -264,6 +272,8 @@ BenchResult RunBench(const std::string& problem, const BenchOptions& options, st
       row.iters_per_step = m.iters_per_step;
       row.backward_iters_per_step = result.steps > 0 ? double(m.backward_iterations) / result.steps : 0;
       row.backward_fallbacks = m.backward_fallbacks;
+      row.rounding_floor_steps = m.rounding_floor_steps;
+      row.newton_fallback_steps = m.newton_fallback_steps;
       row.forward_per_iteration_ms = m.total_iterations > 0 ? 1e3 * m.forward_s / m.total_iterations : 0;
       row.factorization_s = m.factorization_s;
       row.state_rel_error = RelativeError(StackState(m.final_state), ref_state);
@@ -302,6 +312,8 @@ nlohmann::json BenchToJson(const BenchResult& result, const BenchOptions& option
                     {"iters_per_step", NumberOrNull(ok, r.iters_per_step)},
                     {"backward_iters_per_step", NumberOrNull(ok, r.backward_iters_per_step)},
                     {"backward_fallbacks", ok ? nlohmann::json(r.backward_fallbacks) : nlohmann::json(nullptr)},
+                    {"rounding_floor_steps", ok ? nlohmann::json(r.rounding_floor_steps) : nlohmann::json(nullptr)},
+                    {"newton_fallback_steps", ok ? nlohmann::json(r.newton_fallback_steps) : nlohmann::json(nullptr)},
                     {"state_rel_error", NumberOrNull(ok, r.state_rel_error)},
                     {"position_rel_error", NumberOrNull(ok, r.position_rel_error)},
                     {"velocity_rel_error", NumberOrNull(ok, r.velocity_rel_error)},

@@ -78,6 +78,10 @@ struct RolloutMeasurement {
   // that fell back to a direct one, of the last run.
   long backward_iterations = 0;
   int backward_fallbacks = 0;
+  // Forward steps of the last run that ended at the rounding floor or were
+  // finished by Newton after a PD-LBFGS stall (StepReport).
+  int rounding_floor_steps = 0;
+  int newton_fallback_steps = 0;
   State final_state;
   // [dL/dx0, dL/dv0, dL/dE, dL/dnu, dL/drho] (6n + 3).
   VectorXd gradient;
@@ -122,6 +126,8 @@ struct BenchRow {
   double iters_per_step = 0;
   double backward_iters_per_step = 0;   // adjoint solver iterations per step (0: direct)
   int backward_fallbacks = 0;           // adjoint solves that fell back to a direct solve
+  int rounding_floor_steps = 0;         // forward steps ended at the rounding floor
+  int newton_fallback_steps = 0;        // PD-LBFGS steps finished by Newton after a stall
   double forward_per_iteration_ms = 0;  // forward_s / total iterations, ms
   double factorization_s = 0;           // RolloutMeasurement::factorization_s
   double state_rel_error = 0;     // of [x; v] stacked
@@ -154,7 +160,8 @@ BenchResult RunBench(const std::string& problem, const BenchOptions& options, st
 // The rows as the JSON list the command prints: objects with method,
 // forward_s, backward_s, iters_per_step, state_rel_error, grad_rel_error,
 // forward_per_iteration_ms, speedup_vs_newton_cholesky (null if unknown),
-// grad_rel_error_by_input, status ("ok" or "failed: ..."), and the run's
+// grad_rel_error_by_input, backward_iters_per_step, backward_fallbacks,
+// rounding_floor_steps, newton_fallback_steps, status ("ok" or "failed: ..."), and the run's
 // problem, dofs, steps, time_step, rel_tolerance. A failed method has null
 // numbers.
 nlohmann::json BenchToJson(const BenchResult& result, const BenchOptions& options);

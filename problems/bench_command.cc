@@ -26,7 +26,10 @@ newton-cholesky in this run) / (this method's).
 JSON: a list of objects {method, status, forward_s, backward_s,
 iters_per_step, state_rel_error, position_rel_error, velocity_rel_error,
 grad_rel_error, grad_rel_error_by_input, forward_per_iteration_ms,
-factorization_s, speedup_vs_newton_cholesky, problem, dofs, ...}.
+factorization_s, speedup_vs_newton_cholesky, backward_iters_per_step,
+backward_fallbacks, rounding_floor_steps (forward steps ended at the rounding
+floor), newton_fallback_steps (PD-LBFGS steps finished by Newton), problem,
+dofs, ...}.
 --scaling: the problem at --scales x the elements (default 1,2,4,8); rows
 {method, factor, elements, vertices, dofs, forward_s, iters_per_step,
 forward_per_iteration_ms, factorization_s, iteration_ms, backward_per_step_ms,
@@ -68,6 +71,8 @@ void PrintBenchTable(const BenchResult& r) {
                 row.backward_iters_per_step, row.state_rel_error, row.position_rel_error, row.velocity_rel_error,
                 row.grad_rel_error);
     if (row.backward_fallbacks > 0) std::printf(" (%d adjoint fallbacks)", row.backward_fallbacks);
+    if (row.rounding_floor_steps > 0) std::printf(" (%d steps at the rounding floor)", row.rounding_floor_steps);
+    if (row.newton_fallback_steps > 0) std::printf(" (%d steps finished by Newton)", row.newton_fallback_steps);
     if (row.speedup_vs_newton_cholesky) std::printf(" %10.2f\n", *row.speedup_vs_newton_cholesky);
     else std::printf(" %10s\n", "-");
   }

@@ -174,7 +174,8 @@ TEST(BenchTest, JsonIsAListWithTheRequiredFields) {
   for (const auto& row : parsed) {
     for (const char* field : {"forward_s", "backward_s", "iters_per_step", "state_rel_error", "grad_rel_error",
                               "forward_per_iteration_ms", "factorization_s", "speedup_vs_newton_cholesky",
-                              "backward_iters_per_step", "backward_fallbacks"})
+                              "backward_iters_per_step", "backward_fallbacks", "rounding_floor_steps",
+                              "newton_fallback_steps"})
       EXPECT_TRUE(row.at(field).is_number()) << field;
     EXPECT_TRUE(row.at("method").is_string());
     EXPECT_EQ(row.at("status"), "ok");
