@@ -162,12 +162,7 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
       screen_target = sim.options.abs_tolerance + opt.screening_rel_tolerance * pass_report.initial_residual;
       report->initial_residual = pass_report.initial_residual;
     }
-    report->iterations += pass_report.iterations;
-    report->line_search_steps += pass_report.line_search_steps;
-    report->energy_restarts += pass_report.energy_restarts;
-    report->final_residual = pass_report.final_residual;
-    report->rounding_floor_stop = pass_report.rounding_floor_stop;
-    report->newton_fallback = report->newton_fallback || pass_report.newton_fallback;
+    AppendSolve(pass_report, report);
     report->active_set_passes = pass;
 
     // A screening pass stopped because the set changed; a final pass applies

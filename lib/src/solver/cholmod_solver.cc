@@ -41,7 +41,7 @@ struct CholmodSolver::Impl {
 };
 
 CholmodSolver::CholmodSolver(CholmodLayout layout, CholmodOrdering ordering)
-    : impl_(std::make_unique<Impl>()), layout_(layout), ordering_(ordering) {
+    : impl_(std::make_unique<Impl>()), layout_(layout) {
   for (cholmod_common* common : {&impl_->supernodal.cholmod(), &impl_->simplicial.cholmod()}) {
     common->print = 0;  // failures are reported through return values
     if (ordering == CholmodOrdering::kNestedDissection) {

@@ -45,7 +45,6 @@ class CholmodSolver {
   VectorXd Solve(const VectorXd& b) const;
 
   CholmodLayout layout() const { return layout_; }
-  CholmodOrdering ordering() const { return ordering_; }
   int num_analyses() const { return num_analyses_; }
   // Entries of the factor L after the latest analysis (CHOLMOD's lnz).
   double factor_nonzeros() const;
@@ -56,7 +55,6 @@ class CholmodSolver {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   CholmodLayout layout_;
-  CholmodOrdering ordering_;
   Eigen::Index rows_ = -1;
   Eigen::Index nonzeros_ = -1;
   int num_analyses_ = 0;

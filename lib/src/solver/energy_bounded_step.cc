@@ -35,11 +35,7 @@ VectorXd SolveEnergyBounded(StepObjective& objective, const VectorXd& predicted,
   objective.SetReferenceResidual(report->initial_residual);
   StepReport again;
   x = solve(objective, previous, &again);
-  report->iterations += again.iterations;
-  report->line_search_steps += again.line_search_steps;
-  report->final_residual = again.final_residual;
-  report->rounding_floor_stop = again.rounding_floor_stop;
-  report->newton_fallback = report->newton_fallback || again.newton_fallback;
+  AppendSolve(again, report);
   ++report->energy_restarts;
   return x;
 }

@@ -42,10 +42,7 @@ VectorXd NewtonAfterStall(StepObjective& objective, const VectorXd& x, const Sol
   objective.SetReferenceResidual(report->initial_residual);
   StepReport newton;
   const VectorXd out = NewtonSolve(objective, x, &newton);
-  report->iterations += newton.iterations;
-  report->line_search_steps += newton.line_search_steps;
-  report->final_residual = newton.final_residual;
-  report->rounding_floor_stop = newton.rounding_floor_stop;
+  AppendSolve(newton, report);
   report->newton_fallback = true;
   return out;
 }

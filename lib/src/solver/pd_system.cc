@@ -83,7 +83,8 @@ PdSystem::PdSystem(const FemModel& fem, const std::vector<char>& fixed, const st
     for (size_t g = 0; g < groups_.size(); ++g)
       if (groups_[g].fixed_node == mask) found = static_cast<int>(g);
     if (found < 0) {
-      groups_.push_back(Group{{}, mask, SparseMatrix(), std::make_unique<CholmodSolver>(PdFactorLayout(n), CholmodOrdering::kNestedDissection)});
+      groups_.push_back(Group{{}, mask, SparseMatrix(),
+                              std::make_unique<CholmodSolver>(PdFactorLayout(n), CholmodOrdering::kNestedDissection)});
       found = static_cast<int>(groups_.size()) - 1;
     }
     groups_[found].axes.push_back(d);

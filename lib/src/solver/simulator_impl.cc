@@ -200,7 +200,6 @@ double StepObjective::Evaluate(const VectorXd& x, VectorXd* grad, bool keep_fixe
     if (sim_.fixed[d]) continue;
     value += 0.5 * inertia_(d) * dx(d) * dx(d) - force_(d) * x(d);
   }
-
   if (grad) {
     grad->array() += inertia_.array() * dx.array() - force_.array();
     if (!keep_fixed_rows) sim_.ZeroFixed(grad);
@@ -235,6 +234,15 @@ bool IterationConverged(StepObjective& objective, int it, const VectorXd& x, dou
   if (objective.StopAtCheckpoint(x, grad_norm, report->initial_residual)) return true;
   if (it >= options.max_iterations) ThrowNotConverged(options, it, grad_norm, report->initial_residual);
   return false;
+}
+
+void AppendSolve(const StepReport& later, StepReport* report) {
+  report->iterations += later.iterations;
+  report->line_search_steps += later.line_search_steps;
+  report->energy_restarts += later.energy_restarts;
+  report->final_residual = later.final_residual;
+  report->rounding_floor_stop = later.rounding_floor_stop;
+  report->newton_fallback = report->newton_fallback || later.newton_fallback;
 }
 
 VectorXd EndAtRoundingFloor(const VectorXd& x, double grad_norm, StepReport* report) {

@@ -224,6 +224,11 @@ bool Converged(const SolverOptions& options, double grad_norm, double initial_no
 // checkpoint; throws ThrowNotConverged's error when `it` reached the
 // iteration limit without converging.
 bool IterationConverged(StepObjective& objective, int it, const VectorXd& x, double grad_norm, StepReport* report);
+// Adds a later solve of the same step (a re-solve from x_i, Newton after a
+// PD-LBFGS stall, a contact pass) to the step's report: its iterations,
+// halvings and energy restarts add up, its final residual and rounding-floor
+// flag become the step's, a Newton fallback anywhere marks the step.
+void AppendSolve(const StepReport& later, StepReport* report);
 // Ends a solve whose line search stalled at g's rounding floor
 // (LineSearchResult::at_rounding_floor): marks the report, records
 // |grad g| as the final residual and returns x.
