@@ -2,6 +2,8 @@
 
 #include <omp.h>
 
+#include <vector>
+
 #include <Eigen/CholmodSupport>
 
 #include "diffpd/error.h"
@@ -27,12 +29,33 @@ class SerialOpenMpScope {
   int saved_;
 };
 
+// Eigen's CHOLMOD wrapper with its factor readable (a protected member).
+template <class Base>
+class ReadableFactor : public Base {
+ public:
+  const cholmod_factor* factor() const { return this->m_cholmodFactor; }
+};
+
+// Column j of a CHOLMOD LL^T factor, simplicial or supernodal.
+ParallelTriangularSolve::Column FactorColumn(const cholmod_factor& f, const std::vector<int>& node_of_column, int j) {
+  if (!f.is_super) {
+    const int p = static_cast<const int*>(f.p)[j];
+    return {static_cast<const int*>(f.i) + p, static_cast<const double*>(f.x) + p, static_cast<const int*>(f.nz)[j]};
+  }
+  const int s = node_of_column[j];
+  const int first = static_cast<const int*>(f.super)[s];
+  const int row_begin = static_cast<const int*>(f.pi)[s], row_end = static_cast<const int*>(f.pi)[s + 1];
+  const int nrow = row_end - row_begin, c = j - first;
+  const long values = static_cast<const int*>(f.px)[s] + static_cast<long>(c) * nrow + c;
+  return {static_cast<const int*>(f.s) + row_begin + c, static_cast<const double*>(f.x) + values, nrow - c};
+}
+
 }  // namespace
 
 struct CholmodSolver::Impl {
   // Exactly one is used, by layout_ (Eigen gives each layout its own type).
-  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> supernodal;
-  Eigen::CholmodSimplicialLLT<SparseMatrix, Eigen::Lower> simplicial;
+  ReadableFactor<Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower>> supernodal;
+  ReadableFactor<Eigen::CholmodSimplicialLLT<SparseMatrix, Eigen::Lower>> simplicial;
 
   template <class Body>
   auto With(CholmodLayout layout, Body&& body) {
@@ -40,8 +63,8 @@ struct CholmodSolver::Impl {
   }
 };
 
-CholmodSolver::CholmodSolver(CholmodLayout layout, CholmodOrdering ordering)
-    : impl_(std::make_unique<Impl>()), layout_(layout) {
+CholmodSolver::CholmodSolver(CholmodLayout layout, CholmodOrdering ordering, CholmodSolveKernel kernel)
+    : impl_(std::make_unique<Impl>()), layout_(layout), kernel_(kernel) {
   for (cholmod_common* common : {&impl_->supernodal.cholmod(), &impl_->simplicial.cholmod()}) {
     common->print = 0;  // failures are reported through return values
     if (ordering == CholmodOrdering::kNestedDissection) {
@@ -68,7 +91,32 @@ bool CholmodSolver::Factorize(const SparseMatrix& a) {
     return llt.info() == Eigen::Success;
   });
   ++num_factorizations_;
+  copy_.reset();
+  if (factorized_ && kernel_ == CholmodSolveKernel::kParallelCopy) MakeCopy();
   return factorized_;
+}
+
+void CholmodSolver::MakeCopy() {
+  const cholmod_factor* f = impl_->With(layout_, [](auto& llt) { return llt.factor(); });
+  if (f == nullptr || !f->is_ll || f->xtype != CHOLMOD_REAL || f->itype != CHOLMOD_INT) return;
+  const int n = static_cast<int>(f->n);
+  std::vector<int> node_of_column;
+  if (f->is_super) {
+    node_of_column.resize(n);
+    const int* super = static_cast<const int*>(f->super);
+    for (size_t s = 0; s < f->nsuper; ++s)
+      for (int j = super[s]; j < super[s + 1]; ++j) node_of_column[j] = static_cast<int>(s);
+  }
+  copy_ = ParallelTriangularSolve::Create(
+      n, static_cast<const int*>(f->Perm), [&](int j) { return FactorColumn(*f, node_of_column, j); },
+      solve_threads_);
+}
+
+void CholmodSolver::set_solve_threads(int threads) {
+  DIFFPD_CHECK(threads >= 1, "CholmodSolver: " << threads << " solve threads");
+  if (threads == solve_threads_) return;
+  solve_threads_ = threads;
+  if (copy_) MakeCopy();
 }
 
 double CholmodSolver::factor_nonzeros() const {
@@ -77,11 +125,23 @@ double CholmodSolver::factor_nonzeros() const {
 
 MatrixXd CholmodSolver::Solve(const MatrixXd& b) const {
   DIFFPD_CHECK(factorized_, "CholmodSolver::Solve before a successful Factorize");
+  if (copy_) {
+    DIFFPD_CHECK(b.rows() == rows_, "CholmodSolver::Solve: " << b.rows() << " rows for " << rows_);
+    MatrixXd x(b.rows(), b.cols());
+    copy_->Solve(b.data(), x.data(), static_cast<int>(b.cols()));
+    return x;
+  }
   return impl_->With(layout_, [&](auto& llt) -> MatrixXd { return llt.solve(b); });
 }
 
 VectorXd CholmodSolver::Solve(const VectorXd& b) const {
   DIFFPD_CHECK(factorized_, "CholmodSolver::Solve before a successful Factorize");
+  if (copy_) {
+    DIFFPD_CHECK(b.rows() == rows_, "CholmodSolver::Solve: " << b.rows() << " rows for " << rows_);
+    VectorXd x(b.rows());
+    copy_->Solve(b.data(), x.data(), 1);
+    return x;
+  }
   return impl_->With(layout_, [&](auto& llt) -> VectorXd { return llt.solve(b); });
 }
 

@@ -84,7 +84,8 @@ PdSystem::PdSystem(const FemModel& fem, const std::vector<char>& fixed, const st
       if (groups_[g].fixed_node == mask) found = static_cast<int>(g);
     if (found < 0) {
       groups_.push_back(Group{{}, mask, SparseMatrix(),
-                              std::make_unique<CholmodSolver>(PdFactorLayout(n), CholmodOrdering::kNestedDissection)});
+                              std::make_unique<CholmodSolver>(PdFactorLayout(n), CholmodOrdering::kNestedDissection,
+                                                              CholmodSolveKernel::kParallelCopy)});
       found = static_cast<int>(groups_.size()) - 1;
     }
     groups_[found].axes.push_back(d);
@@ -149,6 +150,10 @@ bool PdSystem::Update(double h, const std::vector<double>& densities, const std:
     SetActiveNodes(std::vector<int>(active_nodes_), active_mode_);
   }
   return true;
+}
+
+void PdSystem::SetSolveThreads(int threads) {
+  for (Group& g : groups_) g.solver->set_solve_threads(threads);
 }
 
 void PdSystem::SetAuxiliaryMatrix(const SparseMatrix& auxiliary) {

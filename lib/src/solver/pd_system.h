@@ -48,6 +48,10 @@ class PdSystem {
   // Entries of r at fixed DoFs are ignored. Several vectors: columns of R.
   VectorXd Solve(const VectorXd& r) const;
   MatrixXd Solve(const MatrixXd& r) const;
+  // Threads of Solve's triangular solves (>= 1; default 1): the factor's
+  // copy is solved in parallel over subtrees of its elimination tree
+  // (solver/parallel_triangular_solve.h).
+  void SetSolveThreads(int threads);
   // y = A x over the free DoFs (fixed rows and columns erased).
   VectorXd Apply(const VectorXd& x) const;
 

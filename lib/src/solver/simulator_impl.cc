@@ -1,5 +1,7 @@
 #include "solver/simulator_impl.h"
 
+#include <omp.h>
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -103,6 +105,7 @@ PdSystem& SimulatorImpl::pd_system() {
     densities.push_back(m.density);
     weights.push_back(scale * elastic.PdWeight(m.mu(), m.lambda()));
   }
+  pd_->SetSolveThreads(threads() > 0 ? threads() : omp_get_max_threads());
   pd_->Update(h(), densities, weights);
   return *pd_;
 }
