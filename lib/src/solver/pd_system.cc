@@ -8,13 +8,18 @@
 namespace diffpd::internal {
 namespace {
 
-// The PD factor is computed once and solved with at every iteration, so its
-// layout is chosen for the solve. Simplicial solves (no BLAS call per
-// supernode) measured faster on the cantilever from 2 673 to 18 785 nodes
-// (bench --scaling, 2 threads: forward 5-16% and backward 14-25% faster per
-// run); above that range the supernodal layout, measured up to 140 481 nodes,
-// is kept. Its ordering is nested dissection, whatever the size (fewer
-// factor entries than CHOLMOD's automatic choice: solver/cholmod_solver.h).
+// The PD factor is computed once and solved with at every iteration, by a
+// blocked copy in parallel over subtrees (CholmodSolveKernel::kParallelCopy).
+// The copy of the simplicial layout has no explicit zeros, the supernodal
+// one has CHOLMOD's relaxed supernodes: with the simplicial one the cantilever
+// (2 673 nodes, 25 steps, 2 threads) ran 5% faster in alternating runs, at
+// the cost of a slower factorisation, once (26 vs 21 ms; at 18 785 nodes
+// 0.70 vs 0.36 s). CHOLMOD's own solves were also faster from the simplicial
+// layout (bench --scaling, 2 threads: forward 5-16% and backward 14-25% per
+// run from 2 673 to 18 785 nodes). Above 20 000 nodes the supernodal layout
+// is kept (measured up to 140 481 nodes). Its ordering is nested dissection,
+// whatever the size (fewer factor entries than CHOLMOD's automatic choice:
+// solver/cholmod_solver.h).
 constexpr int kSimplicialMaxNodes = 20000;
 CholmodLayout PdFactorLayout(int num_nodes) {
   return num_nodes <= kSimplicialMaxNodes ? CholmodLayout::kSimplicial : CholmodLayout::kSupernodal;
