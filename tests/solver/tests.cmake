@@ -11,3 +11,4 @@ diffpd_add_test(energy_bounded_step_test ${CMAKE_CURRENT_LIST_DIR}/energy_bounde
 diffpd_add_test(rounding_floor_test ${CMAKE_CURRENT_LIST_DIR}/rounding_floor_test.cc)
 diffpd_add_test(newton_fallback_test ${CMAKE_CURRENT_LIST_DIR}/newton_fallback_test.cc)
 diffpd_add_test(parallel_triangular_solve_test ${CMAKE_CURRENT_LIST_DIR}/parallel_triangular_solve_test.cc)
+diffpd_add_test(lbfgs_pairs_test ${CMAKE_CURRENT_LIST_DIR}/lbfgs_pairs_test.cc)

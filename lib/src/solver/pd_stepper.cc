@@ -6,7 +6,6 @@
 // algebraically identical (grad g(x) = A x - M y/h^2 - sum w G^T p(x)) and
 // gives the convergence test's residual for free.
 #include <cstdio>
-#include <deque>
 #include <optional>
 
 #include "diffpd/error.h"
@@ -52,34 +51,23 @@ VectorXd NewtonAfterStall(StepObjective& objective, const VectorXd& x, const Sol
 VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* report) {
   SimulatorImpl& sim = objective.sim();
   PdSystem& pd = sim.pd_system();
-  const int m = sim.options.lbfgs_history;
-  std::deque<VectorXd> s_list, y_list;
-  std::deque<double> rho_list;
+  LbfgsPairs& pairs = sim.empty_lbfgs_pairs();
   VectorXd x = x0;
   VectorXd grad;
   double value = objective.Evaluate(x, &grad);
   report->initial_residual = objective.ReferenceResidual(grad.norm());
-  std::vector<double> alpha(m);
+  std::vector<double> alpha;
   for (int it = 0;; ++it) {
     if (IterationConverged(objective, it, x, grad.norm(), report)) return x;
     // Two-loop recursion with H0 = A^{-1}.
     VectorXd q = grad;
-    const int k = static_cast<int>(s_list.size());
-    for (int j = k - 1; j >= 0; --j) {
-      alpha[j] = rho_list[j] * s_list[j].dot(q);
-      q -= alpha[j] * y_list[j];
-    }
+    pairs.FirstLoop(&q, &alpha);
     VectorXd r = pd.Solve(q);
-    for (int j = 0; j < k; ++j) {
-      const double beta = rho_list[j] * y_list[j].dot(r);
-      r += (alpha[j] - beta) * s_list[j];
-    }
+    pairs.SecondLoop(alpha, &r);
     VectorXd d = -r;
     sim.ZeroFixed(&d);
     if (!(grad.dot(d) < 0)) {  // lost descent: restart from the PD direction
-      s_list.clear();
-      y_list.clear();
-      rho_list.clear();
+      pairs.Clear();
       d = -pd.Solve(grad);
     }
     const VectorXd x_old = x, grad_old = grad;
@@ -95,12 +83,10 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
       }
     };
     line_search(d);
-    if (stall && !s_list.empty()) {
+    if (stall && pairs.size() > 0) {
       // Stale curvature pairs can spoil the direction near convergence:
       // restart once from the plain PD direction.
-      s_list.clear();
-      y_list.clear();
-      rho_list.clear();
+      pairs.Clear();
       d = -pd.Solve(grad);
       sim.ZeroFixed(&d);
       line_search(d);
@@ -108,18 +94,9 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
     if (stall) return NewtonAfterStall(objective, x, *stall, report);
     report->line_search_steps += search.halvings;
     if (search.at_rounding_floor) return EndAtRoundingFloor(x, grad.norm(), report);
-    VectorXd s = x - x_old, y = grad - grad_old;
+    const VectorXd s = x - x_old, y = grad - grad_old;
     const double sy = s.dot(y);
-    if (sy > 1e-12 * s.norm() * y.norm()) {
-      if (static_cast<int>(s_list.size()) == m) {
-        s_list.pop_front();
-        y_list.pop_front();
-        rho_list.pop_front();
-      }
-      s_list.push_back(std::move(s));
-      y_list.push_back(std::move(y));
-      rho_list.push_back(1.0 / sy);
-    }
+    if (sy > 1e-12 * s.norm() * y.norm()) pairs.Push(s, y, 1.0 / sy);
   }
 }
 

@@ -1,7 +1,8 @@
 #include "solver/preconditioned_iteration.h"
 
+#include "solver/lbfgs_pairs.h"
+
 #include <cmath>
-#include <deque>
 #include <memory>
 
 namespace diffpd::internal {
@@ -67,21 +68,18 @@ class LbfgsColumn final : public ColumnIteration {
  public:
   LbfgsColumn(const VectorXd& b, double rel_tolerance, const std::function<VectorXd(const VectorXd&)>& apply_h,
               int history)
-      : ColumnIteration(b, rel_tolerance, apply_h), history_(history), alpha_(history) {}
+      : ColumnIteration(b, rel_tolerance, apply_h), pairs_(history, b.size()) {}
 
   // First loop of the two-loop recursion on the gradient -r.
   const VectorXd& PreconditionerInput() override {
     q_ = -r_;
-    for (int j = static_cast<int>(s_.size()) - 1; j >= 0; --j) {
-      alpha_[j] = rho_[j] * s_[j].dot(q_);
-      q_ -= alpha_[j] * y_[j];
-    }
+    pairs_.FirstLoop(&q_, &alpha_);
     return q_;
   }
 
   ColumnStatus Advance(const VectorXd& preconditioned) override {
     VectorXd p = preconditioned;
-    for (size_t j = 0; j < s_.size(); ++j) p += (alpha_[j] - rho_[j] * y_[j].dot(p)) * s_[j];
+    pairs_.SecondLoop(alpha_, &p);
     p = -p;
     const VectorXd hp = apply_h_(p);
     const double curvature = p.dot(hp);
@@ -90,21 +88,12 @@ class LbfgsColumn final : public ColumnIteration {
     z_ += step * p;
     r_ -= step * hp;
     const ColumnStatus status = CheckRecurredResidual();
-    if (static_cast<int>(s_.size()) == history_) {
-      s_.pop_front();
-      y_.pop_front();
-      rho_.pop_front();
-    }
-    s_.push_back(step * p);
-    y_.push_back(step * hp);
-    rho_.push_back(1.0 / (step * step * curvature));
+    pairs_.Push(step * p, step * hp, 1.0 / (step * step * curvature));
     return status;
   }
 
  private:
-  const int history_;
-  std::deque<VectorXd> s_, y_;
-  std::deque<double> rho_;
+  LbfgsPairs pairs_;
   std::vector<double> alpha_;
   VectorXd q_;
 };

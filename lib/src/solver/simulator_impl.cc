@@ -110,6 +110,14 @@ PdSystem& SimulatorImpl::pd_system() {
   return *pd_;
 }
 
+LbfgsPairs& SimulatorImpl::empty_lbfgs_pairs() {
+  const int capacity = options.lbfgs_history;
+  if (!lbfgs_pairs_ || lbfgs_pairs_->capacity() != capacity || lbfgs_pairs_->dimension() != num_dofs())
+    lbfgs_pairs_ = std::make_unique<LbfgsPairs>(capacity, num_dofs());
+  lbfgs_pairs_->Clear();
+  return *lbfgs_pairs_;
+}
+
 namespace {
 
 bool SameMaterial(const MaterialParameters& a, const MaterialParameters& b) {

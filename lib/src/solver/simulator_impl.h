@@ -16,6 +16,7 @@
 #include "forces/state_forces.h"
 #include "solver/cholmod_solver.h"
 #include "solver/hessian_assembler.h"
+#include "solver/lbfgs_pairs.h"
 #include "solver/pd_system.h"
 
 namespace diffpd::internal {
@@ -74,6 +75,9 @@ class SimulatorImpl {
   // Lazily built solvers.
   HessianAssembler& hessian_assembler();
   PdSystem& pd_system();  // factor made current for (h, rho, PD weight)
+  // PD-LBFGS's pairs, emptied, for options.lbfgs_history pairs of 3n-vectors
+  // (kept between steps: no allocation per step).
+  LbfgsPairs& empty_lbfgs_pairs();
   CholmodSolver& newton_solver() { return newton_llt_; }
   int pd_factorizations() const { return pd_ ? pd_->num_factorizations() : 0; }
   double pd_factorization_seconds() const { return pd_ ? pd_->factorization_seconds() : 0.0; }
@@ -85,6 +89,7 @@ class SimulatorImpl {
   std::vector<double> element_mu_, element_lambda_;  // per element when !uniform_lame_
   std::unique_ptr<HessianAssembler> hessian_;
   std::unique_ptr<PdSystem> pd_;
+  std::unique_ptr<LbfgsPairs> lbfgs_pairs_;
   CholmodSolver newton_llt_;
 };
 

@@ -1,6 +1,7 @@
 # Sources of the solver area (paths relative to lib/).
 list(APPEND DIFFPD_LIB_SOURCES ${CMAKE_CURRENT_LIST_DIR}/cholmod_solver.cc)
 list(APPEND DIFFPD_LIB_SOURCES ${CMAKE_CURRENT_LIST_DIR}/hessian_assembler.cc)
+list(APPEND DIFFPD_LIB_SOURCES ${CMAKE_CURRENT_LIST_DIR}/lbfgs_pairs.cc)
 list(APPEND DIFFPD_LIB_SOURCES ${CMAKE_CURRENT_LIST_DIR}/parallel_triangular_solve.cc)
 list(APPEND DIFFPD_LIB_SOURCES ${CMAKE_CURRENT_LIST_DIR}/pd_system.cc)
 list(APPEND DIFFPD_LIB_SOURCES ${CMAKE_CURRENT_LIST_DIR}/preconditioned_iteration.cc)
