@@ -1,8 +1,10 @@
-// PD-LBFGS hands a step whose line search stalls above the rounding floor to
-// Newton from where it stalled (SolverOptions::pd_lbfgs_newton_fallback),
-// which meets the same convergence test; without the fallback the stall is
-// an error.
+// PD-LBFGS hands a step whose line search stalls above the rounding floor,
+// or that reaches max_iterations, to Newton from where it stopped
+// (SolverOptions::pd_lbfgs_newton_fallback), which meets the same
+// convergence test; without the fallback the stall or the limit is an error.
 #include <gtest/gtest.h>
+
+#include <string>
 
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
@@ -64,6 +66,67 @@ TEST(NewtonFallbackTest, OrdinaryStepsNeverFallBack) {
   Simulator sim(testing::SmallBeamScene(), o);
   const Rollout r = sim.Simulate(testing::MovingStart(sim), std::vector<StepInput>(20));
   for (const StepReport& report : r.reports) EXPECT_FALSE(report.newton_fallback);
+}
+
+// Five PD-LBFGS iterations cannot reach rtol 1e-10 on the moving beam;
+// five Newton iterations can.
+SolverOptions IterationLimitedOptions(bool fallback) {
+  SolverOptions o;
+  o.method = Method::kPdLbfgs;
+  o.time_step = 0.01;
+  o.rel_tolerance = 1e-10;
+  o.abs_tolerance = 1e-12;
+  o.num_threads = 1;
+  o.max_iterations = 5;
+  o.pd_lbfgs_newton_fallback = fallback;
+  return o;
+}
+
+TEST(NewtonFallbackTest, WithoutTheFallbackTheIterationLimitIsAnError) {
+  Simulator sim(testing::SmallBeamScene(), IterationLimitedOptions(false));
+  try {
+    sim.Step(testing::MovingStart(sim), StepInput());
+    ADD_FAILURE() << "expected the iteration limit";
+  } catch (const SolverError& e) {
+    EXPECT_EQ(e.status(), SolverStatus::kMaxIterations) << e.what();
+    EXPECT_NE(std::string(e.what()).find("pd-lbfgs: the step did not converge in 5 iterations"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(NewtonFallbackTest, NewtonFinishesAStepThatReachedTheIterationLimit) {
+  Simulator sim(testing::SmallBeamScene(), IterationLimitedOptions(true));
+  const State start = testing::MovingStart(sim);
+  StepReport report;
+  const State next = sim.Step(start, StepInput(), &report);
+  EXPECT_TRUE(report.newton_fallback);
+  EXPECT_GT(report.iterations, 5);  // PD-LBFGS's 5 and Newton's
+  EXPECT_LE(report.final_residual, 1e-12 + 1e-10 * report.initial_residual);
+
+  SolverOptions newton = testing::TightOptions(Method::kNewtonCholesky);
+  newton.time_step = 0.01;
+  Simulator reference(testing::SmallBeamScene(), newton);
+  const State expected = reference.Step(start, StepInput());
+  EXPECT_LT((next.x - expected.x).norm(), 1e-9 * expected.x.norm());
+}
+
+// When Newton cannot finish either, the error says so and what it took over from.
+TEST(NewtonFallbackTest, AFallbackThatFailsNamesBothSolves) {
+  SolverOptions o = IterationLimitedOptions(true);
+  o.max_iterations = 1;
+  Simulator sim(testing::SmallBeamScene(), o);
+  try {
+    sim.Step(testing::MovingStart(sim), StepInput());
+    ADD_FAILURE() << "expected the iteration limit";
+  } catch (const SolverError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.status(), SolverStatus::kMaxIterations) << what;
+    EXPECT_NE(what.find("Newton fallback of pd-lbfgs: the step did not converge in 1 iterations"), std::string::npos)
+        << what;
+    EXPECT_NE(what.find("; Newton took over after: pd-lbfgs: the step did not converge in 1 iterations"),
+              std::string::npos)
+        << what;
+  }
 }
 
 }  // namespace

@@ -37,8 +37,9 @@ struct StepReport {
   // The solve ended at g's rounding floor above the tolerance
   // (SolverOptions::accept_rounding_floor); final_residual is what it reached.
   bool rounding_floor_stop = false;
-  // PD-LBFGS's line search stalled and Newton finished the step
-  // (SolverOptions::pd_lbfgs_newton_fallback); iterations include Newton's.
+  // PD-LBFGS's line search stalled, or it reached max_iterations, and Newton
+  // finished the step (SolverOptions::pd_lbfgs_newton_fallback); iterations
+  // include Newton's.
   bool newton_fallback = false;
   // Frictional contact (contact.h): the step's final active set (sorted node
   // indices), the contact force on each of those nodes (3 x |set|, N, the

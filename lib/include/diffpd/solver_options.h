@@ -93,11 +93,14 @@ struct SolverOptions {
   double lbfgs_weight_scale = 0.3;
   // PD-LBFGS: when the line search stalls (no acceptable step along the
   // quasi-Newton direction nor the plain PD one) above the rounding-floor
-  // band (accept_rounding_floor), the step goes on with Newton iterations
-  // (projected Hessian, CHOLMOD) from where it stalled, to the same test
+  // band (accept_rounding_floor), or the step reaches max_iterations, it goes
+  // on with Newton iterations (projected Hessian, CHOLMOD; at most
+  // max_iterations more) from where it stopped, to the same test
   // (StepReport::newton_fallback). Stiff or nearly incompressible material
-  // at large h, where g can no longer resolve PD-LBFGS's progress (README
-  // stress report); ordinary steps never stall. false: the stall is an error.
+  // at large h, where g can no longer resolve PD-LBFGS's progress, or where
+  // PD-LBFGS needs close to 1000 iterations per step (nu = 0.499, h = 0.1 s;
+  // README stress report); ordinary steps never get there. false: the stall
+  // or the iteration limit is an error.
   bool pd_lbfgs_newton_fallback = true;
 
   // Backward (adjoint) linear solves: relative residual ||H z - b|| / ||b||.

@@ -7,6 +7,7 @@
 // gives the convergence test's residual for free.
 #include <cstdio>
 #include <optional>
+#include <string>
 
 #include "diffpd/error.h"
 #include "solver/line_search.h"
@@ -33,14 +34,20 @@ VectorXd PdSolve(StepObjective& objective, const VectorXd& x0, StepReport* repor
 namespace {
 
 // PD-LBFGS's line search stalled at x above g's rounding floor band (both
-// the quasi-Newton and the plain PD direction): Newton from x, with the
-// same convergence test (SolverOptions::pd_lbfgs_newton_fallback), or the
-// stall's error.
+// the quasi-Newton and the plain PD direction), or it reached max_iterations:
+// Newton from x, with the same convergence test
+// (SolverOptions::pd_lbfgs_newton_fallback), or the stall's error.
 VectorXd NewtonAfterStall(StepObjective& objective, const VectorXd& x, const SolverError& stall, StepReport* report) {
   if (!objective.sim().options.pd_lbfgs_newton_fallback) throw stall;
   objective.SetReferenceResidual(report->initial_residual);
   StepReport newton;
-  const VectorXd out = NewtonSolve(objective, x, &newton);
+  VectorXd out;
+  try {
+    out = NewtonSolve(objective, x, &newton);
+  } catch (const SolverError& e) {
+    throw SolverError(e.status(), std::string("Newton fallback of ") + e.what() + "; Newton took over after: " +
+                                      stall.what());
+  }
   AppendSolve(newton, report);
   report->newton_fallback = true;
   return out;
@@ -58,7 +65,12 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
   report->initial_residual = objective.ReferenceResidual(grad.norm());
   std::vector<double> alpha;
   for (int it = 0;; ++it) {
-    if (IterationConverged(objective, it, x, grad.norm(), report)) return x;
+    try {
+      if (IterationConverged(objective, it, x, grad.norm(), report)) return x;
+    } catch (const SolverError& e) {
+      if (e.status() != SolverStatus::kMaxIterations) throw;
+      return NewtonAfterStall(objective, x, e, report);  // max_iterations reached
+    }
     // Two-loop recursion with H0 = A^{-1}.
     VectorXd q = grad;
     pairs.FirstLoop(&q, &alpha);
