@@ -184,6 +184,17 @@ std::unique_ptr<ParallelTriangularSolve> ParallelTriangularSolve::Create(int n, 
       top_entries += entries[sn];
     }
     s->serial_fraction_ = top_entries / total;
+    // Every row a subtree's block sends to a buffer must be a top column
+    // (true for an elimination tree; checked, since a wrong slot would
+    // write outside the buffers).
+    for (const Range& task : s->tasks_)
+      for (int bi = task.first; bi < task.second; ++bi) {
+        const Block& b = s->blocks_[bi];
+        for (int r = b.num_own_rows; r < b.num_rows; ++r)
+          DIFFPD_CHECK(s->top_slot_[s->rows_[b.rows_at + r]] >= 0,
+                       "ParallelTriangularSolve: row " << s->rows_[b.rows_at + r] << " of column " << b.col
+                                                       << " is neither in its subtree nor in the top");
+      }
   }
   return s;
 }
