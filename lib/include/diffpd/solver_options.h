@@ -108,8 +108,9 @@ struct SolverOptions {
   double backward_rel_tolerance = 1e-10;
   int backward_max_iterations = 1000;
 
-  // Threads for the element loops (0: OpenMP's default). Never changes the
-  // process-wide OpenMP setting.
+  // Threads for the element loops and PD's triangular solves (0: OpenMP's
+  // default). Never changes the process-wide OpenMP setting. Results do not
+  // depend on it beyond rounding (the solves' sums run in another order).
   int num_threads = 0;
   // 0: silent; 1: one line per step on stderr; 2: one line per iteration.
   int verbosity = 0;
