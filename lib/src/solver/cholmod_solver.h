@@ -33,8 +33,8 @@ enum class CholmodOrdering { kAutomatic, kNestedDissection };
 // factor made after each factorisation (ParallelTriangularSolve: blocked
 // columns, subtrees of the elimination tree on set_solve_threads() threads;
 // for a factor solved with at every iteration, PD's). On the cantilever's PD
-// factor (2 673 nodes, 217 k entries, 3 right-hand sides) measured 1.1x
-// CHOLMOD's speed on one thread and 1.7x on two.
+// factor (2 673 nodes, 217 k entries, 3 right-hand sides) measured about
+// CHOLMOD's speed on one thread and 1.2-1.7x faster on two.
 enum class CholmodSolveKernel { kCholmod, kParallelCopy };
 
 class CholmodSolver {

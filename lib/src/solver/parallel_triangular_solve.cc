@@ -12,8 +12,9 @@ namespace diffpd::internal {
 namespace {
 
 // Below this many entries of L a solve is done on one thread: two parallel
-// regions per solve cost more than they save (the cantilever's factor has
-// 217 k entries and solves 1.7x faster on 2 threads).
+// regions per solve cost more than they save (the rolling sphere's factor,
+// 47.8 k entries, solves 1.25x faster on 2 threads; the cantilever's, 217 k,
+// 1.2-1.7x).
 constexpr double kMinParallelEntries = 40000;
 // Subtrees split at most this often while searching the partition.
 constexpr int kMaxSplits = 64;
