@@ -9,7 +9,8 @@
 // cantilever). Tried and not kept: the update of pair j and the dot product
 // of pair j -/+ 1 in one pass over slices of the vectors, on 2 threads:
 // 0.13-0.19 ms on 2 threads but 0.21-0.26 ms on one (Eigen's whole-vector
-// passes stream better than interleaved slices).
+// passes ran faster than interleaved slices); pairs stored as floats (slower
+// at this size, README).
 #pragma once
 
 #include <vector>
