@@ -12,3 +12,4 @@ diffpd_add_test(rounding_floor_test ${CMAKE_CURRENT_LIST_DIR}/rounding_floor_tes
 diffpd_add_test(newton_fallback_test ${CMAKE_CURRENT_LIST_DIR}/newton_fallback_test.cc)
 diffpd_add_test(parallel_triangular_solve_test ${CMAKE_CURRENT_LIST_DIR}/parallel_triangular_solve_test.cc)
 diffpd_add_test(lbfgs_pairs_test ${CMAKE_CURRENT_LIST_DIR}/lbfgs_pairs_test.cc)
+diffpd_add_test(thread_count_test ${CMAKE_CURRENT_LIST_DIR}/thread_count_test.cc)
