@@ -13,6 +13,18 @@
 namespace diffpd {
 namespace {
 
+// PD-LBFGS to rtol 1e-10 on one thread, with or without the fallback.
+SolverOptions TightPdLbfgs(bool fallback) {
+  SolverOptions o;
+  o.method = Method::kPdLbfgs;
+  o.time_step = 0.01;
+  o.rel_tolerance = 1e-10;
+  o.abs_tolerance = 1e-12;
+  o.num_threads = 1;
+  o.pd_lbfgs_newton_fallback = fallback;
+  return o;
+}
+
 // A preconditioner with almost no elastic stiffness (A ~ M / h^2) makes the
 // first PD-LBFGS directions far too long in the stiff modes; with two
 // halvings allowed the line search stalls on the first iteration, far above
@@ -20,35 +32,40 @@ namespace {
 // incompressible material at large h (README stress report), which depend
 // on rounding paths.
 SolverOptions StallingOptions(bool fallback) {
-  SolverOptions o;
-  o.method = Method::kPdLbfgs;
-  o.time_step = 0.01;
-  o.rel_tolerance = 1e-10;
-  o.abs_tolerance = 1e-12;
-  o.num_threads = 1;
+  SolverOptions o = TightPdLbfgs(fallback);
   o.lbfgs_weight_scale = 1e-6;
   o.max_line_search_steps = 2;
-  o.pd_lbfgs_newton_fallback = fallback;
   return o;
 }
 
-TEST(NewtonFallbackTest, WithoutTheFallbackTheStallIsALineSearchError) {
-  Simulator sim(testing::SmallBeamScene(), StallingOptions(false));
-  try {
-    sim.Step(testing::MovingStart(sim), StepInput());
-    ADD_FAILURE() << "expected a line search failure";
-  } catch (const SolverError& e) {
-    EXPECT_EQ(e.status(), SolverStatus::kLineSearchFailed) << e.what();
-  }
+// Five PD-LBFGS iterations cannot reach rtol 1e-10 on the moving beam;
+// five Newton iterations can.
+SolverOptions IterationLimitedOptions(bool fallback) {
+  SolverOptions o = TightPdLbfgs(fallback);
+  o.max_iterations = 5;
+  return o;
 }
 
-TEST(NewtonFallbackTest, NewtonFinishesTheStalledStepAtTheSameTest) {
-  Simulator sim(testing::SmallBeamScene(), StallingOptions(true));
+// The error of one step of the moving beam (a failure if it succeeds).
+SolverError StepError(const SolverOptions& options) {
+  Simulator sim(testing::SmallBeamScene(), options);
+  try {
+    sim.Step(testing::MovingStart(sim), StepInput());
+  } catch (const SolverError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "expected the step to fail";
+  return SolverError(SolverStatus::kConverged, "");
+}
+
+// One step of the moving beam with the fallback: Newton finished it, to the
+// PD-LBFGS test, at the state a tight Newton-Cholesky step reaches.
+StepReport ExpectNewtonFinishesTheStep(const SolverOptions& options) {
+  Simulator sim(testing::SmallBeamScene(), options);
   const State start = testing::MovingStart(sim);
   StepReport report;
   const State next = sim.Step(start, StepInput(), &report);
   EXPECT_TRUE(report.newton_fallback);
-  EXPECT_FALSE(report.rounding_floor_stop);
   EXPECT_LE(report.final_residual, 1e-12 + 1e-10 * report.initial_residual);
 
   SolverOptions newton = testing::TightOptions(Method::kNewtonCholesky);
@@ -56,6 +73,17 @@ TEST(NewtonFallbackTest, NewtonFinishesTheStalledStepAtTheSameTest) {
   Simulator reference(testing::SmallBeamScene(), newton);
   const State expected = reference.Step(start, StepInput());
   EXPECT_LT((next.x - expected.x).norm(), 1e-9 * expected.x.norm());
+  return report;
+}
+
+TEST(NewtonFallbackTest, WithoutTheFallbackTheStallIsALineSearchError) {
+  const SolverError e = StepError(StallingOptions(false));
+  EXPECT_EQ(e.status(), SolverStatus::kLineSearchFailed) << e.what();
+}
+
+TEST(NewtonFallbackTest, NewtonFinishesTheStalledStepAtTheSameTest) {
+  const StepReport report = ExpectNewtonFinishesTheStep(StallingOptions(true));
+  EXPECT_FALSE(report.rounding_floor_stop);
 }
 
 TEST(NewtonFallbackTest, OrdinaryStepsNeverFallBack) {
@@ -68,65 +96,30 @@ TEST(NewtonFallbackTest, OrdinaryStepsNeverFallBack) {
   for (const StepReport& report : r.reports) EXPECT_FALSE(report.newton_fallback);
 }
 
-// Five PD-LBFGS iterations cannot reach rtol 1e-10 on the moving beam;
-// five Newton iterations can.
-SolverOptions IterationLimitedOptions(bool fallback) {
-  SolverOptions o;
-  o.method = Method::kPdLbfgs;
-  o.time_step = 0.01;
-  o.rel_tolerance = 1e-10;
-  o.abs_tolerance = 1e-12;
-  o.num_threads = 1;
-  o.max_iterations = 5;
-  o.pd_lbfgs_newton_fallback = fallback;
-  return o;
-}
-
 TEST(NewtonFallbackTest, WithoutTheFallbackTheIterationLimitIsAnError) {
-  Simulator sim(testing::SmallBeamScene(), IterationLimitedOptions(false));
-  try {
-    sim.Step(testing::MovingStart(sim), StepInput());
-    ADD_FAILURE() << "expected the iteration limit";
-  } catch (const SolverError& e) {
-    EXPECT_EQ(e.status(), SolverStatus::kMaxIterations) << e.what();
-    EXPECT_NE(std::string(e.what()).find("pd-lbfgs: the step did not converge in 5 iterations"), std::string::npos)
-        << e.what();
-  }
+  const SolverError e = StepError(IterationLimitedOptions(false));
+  EXPECT_EQ(e.status(), SolverStatus::kMaxIterations) << e.what();
+  EXPECT_NE(std::string(e.what()).find("pd-lbfgs: the step did not converge in 5 iterations"), std::string::npos)
+      << e.what();
 }
 
 TEST(NewtonFallbackTest, NewtonFinishesAStepThatReachedTheIterationLimit) {
-  Simulator sim(testing::SmallBeamScene(), IterationLimitedOptions(true));
-  const State start = testing::MovingStart(sim);
-  StepReport report;
-  const State next = sim.Step(start, StepInput(), &report);
-  EXPECT_TRUE(report.newton_fallback);
+  const StepReport report = ExpectNewtonFinishesTheStep(IterationLimitedOptions(true));
   EXPECT_GT(report.iterations, 5);  // PD-LBFGS's 5 and Newton's
-  EXPECT_LE(report.final_residual, 1e-12 + 1e-10 * report.initial_residual);
-
-  SolverOptions newton = testing::TightOptions(Method::kNewtonCholesky);
-  newton.time_step = 0.01;
-  Simulator reference(testing::SmallBeamScene(), newton);
-  const State expected = reference.Step(start, StepInput());
-  EXPECT_LT((next.x - expected.x).norm(), 1e-9 * expected.x.norm());
 }
 
 // When Newton cannot finish either, the error says so and what it took over from.
 TEST(NewtonFallbackTest, AFallbackThatFailsNamesBothSolves) {
   SolverOptions o = IterationLimitedOptions(true);
   o.max_iterations = 1;
-  Simulator sim(testing::SmallBeamScene(), o);
-  try {
-    sim.Step(testing::MovingStart(sim), StepInput());
-    ADD_FAILURE() << "expected the iteration limit";
-  } catch (const SolverError& e) {
-    const std::string what = e.what();
-    EXPECT_EQ(e.status(), SolverStatus::kMaxIterations) << what;
-    EXPECT_NE(what.find("Newton fallback of pd-lbfgs: the step did not converge in 1 iterations"), std::string::npos)
-        << what;
-    EXPECT_NE(what.find("; Newton took over after: pd-lbfgs: the step did not converge in 1 iterations"),
-              std::string::npos)
-        << what;
-  }
+  const SolverError e = StepError(o);
+  const std::string what = e.what();
+  EXPECT_EQ(e.status(), SolverStatus::kMaxIterations) << what;
+  EXPECT_NE(what.find("Newton fallback of pd-lbfgs: the step did not converge in 1 iterations"), std::string::npos)
+      << what;
+  EXPECT_NE(what.find("; Newton took over after: pd-lbfgs: the step did not converge in 1 iterations"),
+            std::string::npos)
+      << what;
 }
 
 }  // namespace

@@ -80,6 +80,7 @@ nlohmann::json Measure(const Grid& grid) {
           {"copy_2_threads_ms", ms_two},
           {"speedup_2_threads", ms_cholmod / ms_two},
           {"serial_fraction", two.parallel_copy() ? two.parallel_copy()->serial_fraction() : 1.0},
+          {"copy_mib", two.parallel_copy() ? two.parallel_copy()->bytes() / 1048576.0 : 0.0},
           {"rel_difference", (x_two - x_cholmod).norm() / x_cholmod.norm()}};
 }
 
@@ -97,17 +98,18 @@ int Main(int argc, char** argv) {
   if (large) grids.push_back({"64x", 129, 33, 33});
   nlohmann::json rows = nlohmann::json::array();
   if (!json)
-    std::printf("%-4s %8s %11s %10s %10s %10s %10s %8s %7s %9s\n", "grid", "nodes", "L entries", "cholmod ms",
-                "copy 1t ms", "copy 2t ms", "2t speedup", "serial", "fact s", "+copy s");
+    std::printf("%-4s %8s %11s %10s %10s %10s %10s %8s %7s %9s %9s\n", "grid", "nodes", "L entries", "cholmod ms",
+                "copy 1t ms", "copy 2t ms", "2t speedup", "serial", "fact s", "+copy s", "copy MiB");
   for (const Grid& g : grids) {
     const nlohmann::json row = Measure(g);
     rows.push_back(row);
     if (!json)
-      std::printf("%-4s %8d %11.0f %10.3f %10.3f %10.3f %10.2f %8.3f %7.3f %9.3f\n", g.name, row["nodes"].get<int>(),
+      std::printf("%-4s %8d %11.0f %10.3f %10.3f %10.3f %10.2f %8.3f %7.3f %9.3f %9.1f\n", g.name, row["nodes"].get<int>(),
                   row["factor_entries"].get<double>(), row["cholmod_ms"].get<double>(),
                   row["copy_1_thread_ms"].get<double>(), row["copy_2_threads_ms"].get<double>(),
                   row["speedup_2_threads"].get<double>(), row["serial_fraction"].get<double>(),
-                  row["factorization_s"].get<double>(), row["factorization_and_copy_s"].get<double>());
+                  row["factorization_s"].get<double>(), row["factorization_and_copy_s"].get<double>(),
+                  row["copy_mib"].get<double>());
   }
   rusage usage;
   getrusage(RUSAGE_SELF, &usage);

@@ -338,6 +338,14 @@ void ParallelTriangularSolve::SolveColumns(const double* b, double* x) const {
     for (int d = 0; d < K; ++d) x[perm_[i] + static_cast<long>(d) * n] = y[K * i + d];
 }
 
+std::size_t ParallelTriangularSolve::bytes() const {
+  std::size_t tasks = 0;
+  for (const std::vector<int>& t : thread_tasks_) tasks += t.capacity() * sizeof(int);
+  return perm_.capacity() * sizeof(int) + blocks_.capacity() * sizeof(Block) + rows_.capacity() * sizeof(int) +
+         values_.capacity() * sizeof(double) + triangle_.capacity() * sizeof(double) +
+         (tasks_.capacity() + top_.capacity()) * sizeof(Range) + tasks + top_slot_.capacity() * sizeof(int);
+}
+
 void ParallelTriangularSolve::Solve(const double* b, double* x, int m) const {
   const long n = n_;
   for (int c = 0; c < m;) {

@@ -19,6 +19,7 @@
 // differs, so results agree with CHOLMOD's solve to rounding.
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <memory>
 #include <utility>
@@ -49,6 +50,8 @@ class ParallelTriangularSolve {
   void Solve(const double* b, double* x, int m) const;
 
   int num_threads() const { return num_threads_; }
+  // Bytes held by the copy (values, row indices, triangles, partition).
+  std::size_t bytes() const;
   // Share of L's entries in the serial top (0 when solved serially: all of
   // it runs on one thread, none of it waits).
   double serial_fraction() const { return serial_fraction_; }

@@ -37,7 +37,7 @@ namespace {
 // the quasi-Newton and the plain PD direction), or it reached max_iterations:
 // Newton from x, with the same convergence test
 // (SolverOptions::pd_lbfgs_newton_fallback), or the stall's error.
-VectorXd NewtonAfterStall(StepObjective& objective, const VectorXd& x, const SolverError& stall, StepReport* report) {
+VectorXd NewtonFallback(StepObjective& objective, const VectorXd& x, const SolverError& stall, StepReport* report) {
   if (!objective.sim().options.pd_lbfgs_newton_fallback) throw stall;
   objective.SetReferenceResidual(report->initial_residual);
   StepReport newton;
@@ -69,7 +69,7 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
       if (IterationConverged(objective, it, x, grad.norm(), report)) return x;
     } catch (const SolverError& e) {
       if (e.status() != SolverStatus::kMaxIterations) throw;
-      return NewtonAfterStall(objective, x, e, report);  // max_iterations reached
+      return NewtonFallback(objective, x, e, report);  // max_iterations reached
     }
     // Two-loop recursion with H0 = A^{-1}.
     VectorXd q = grad;
@@ -103,7 +103,7 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
       sim.ZeroFixed(&d);
       line_search(d);
     }
-    if (stall) return NewtonAfterStall(objective, x, *stall, report);
+    if (stall) return NewtonFallback(objective, x, *stall, report);
     report->line_search_steps += search.halvings;
     if (search.at_rounding_floor) return EndAtRoundingFloor(x, grad.norm(), report);
     const VectorXd s = x - x_old, y = grad - grad_old;
