@@ -46,6 +46,7 @@ SolverOptions MethodOptions(Method method, const BenchOptions& o, double time_st
   s.num_threads = o.threads;
   s.max_iterations = o.max_iterations;
   s.lbfgs_weight_scale = o.lbfgs_weight_scale;
+  s.rigid_mode_correction = o.rigid_mode_correction;
   return s;
 }
 

@@ -110,6 +110,7 @@ struct BenchOptions {
   int threads = 0;                       // SolverOptions::num_threads
   int max_iterations = 1000;             // SolverOptions::max_iterations of each step
   double lbfgs_weight_scale = SolverOptions().lbfgs_weight_scale;  // pd-lbfgs preconditioner
+  bool rigid_mode_correction = SolverOptions().rigid_mode_correction;  // pd-lbfgs, PD backward
   int repeat = 1;                        // runs per method (median), >= 1
   int refine = 0;                        // MakeRefinedProblem doublings
   std::uint64_t seed = 20211;            // loss vectors

@@ -160,6 +160,8 @@ Subcommand AddBenchCommand(CLI::App* parent) {
   cmd->add_option("--lbfgs-scale", args->options.lbfgs_weight_scale,
                   "pd-lbfgs: elastic weight factor of its initial Hessian A, in (0, 1]")
       ->capture_default_str();
+  cmd->add_flag("--no-rigid-correction{false}", args->options.rigid_mode_correction,
+                "pd-lbfgs and the PD backward: without the rigid modes' coarse correction");
   cmd->add_option("--steps", args->options.steps, "number of time steps (default: the problem's)");
   cmd->add_option("--dt", args->options.time_step, "time step in seconds (default: the problem's)");
   cmd->add_option("--refine", args->options.refine,

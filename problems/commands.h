@@ -24,6 +24,7 @@ struct CommandArgs {
   double dt = -1;        // -1: the problem's default (s)
   double rel_tolerance = -1;  // -1: the command's default
   double lbfgs_weight_scale = SolverOptions().lbfgs_weight_scale;  // pd-lbfgs preconditioner
+  bool rigid_mode_correction = SolverOptions().rigid_mode_correction;  // pd-lbfgs, PD backward
   int verbosity = 0;     // SolverOptions::verbosity: 0 silent, 1 per step, 2 per iteration
   std::string out_dir;   // "" : no files
   bool json = false;

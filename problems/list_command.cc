@@ -24,6 +24,7 @@ SolverOptions OptionsFromArgs(const CommandArgs& args, double default_dt, double
   o.time_step = args.dt > 0 ? args.dt : default_dt;
   o.rel_tolerance = args.rel_tolerance > 0 ? args.rel_tolerance : default_rel_tolerance;
   o.lbfgs_weight_scale = args.lbfgs_weight_scale;
+  o.rigid_mode_correction = args.rigid_mode_correction;
   o.verbosity = args.verbosity;
   return o;
 }

@@ -26,6 +26,8 @@ void AddCommonOptions(CLI::App* cmd, CommandArgs* args, std::string* method) {
   cmd->add_option("--lbfgs-scale", args->lbfgs_weight_scale,
                   "pd-lbfgs: elastic weight factor of its initial Hessian A, in (0, 1]")
       ->capture_default_str();
+  cmd->add_flag("--no-rigid-correction{false}", args->rigid_mode_correction,
+                "pd-lbfgs and the PD backward: without the rigid modes' coarse correction");
   cmd->add_option("--verbosity", args->verbosity,
                   "solver log on stderr: 0 none, 1 a line per step, 2 a line per iteration and contact pass")
       ->check(CLI::Range(0, 2))

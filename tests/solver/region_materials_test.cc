@@ -221,7 +221,11 @@ TEST_P(RegionDerivativeTest, BackwardAndTangentsMatchCentralFiniteDifferences) {
     const Rollout minus = minus_sim.Simulate(start, std::vector<StepInput>(steps));
     const double fd = (loss_of(plus) - loss_of(minus)) / (2 * eps);
     const double adjoint = GradientAlong(g, p);
-    EXPECT_NEAR(adjoint, fd, 1e-5 * std::abs(fd) + 1e-12) << what;
+    // The differences carry the forward solves' stopping points: measured
+    // ~5e-11 here (two equally valid preconditioners move fd by that much),
+    // hence the absolute 2e-10; the smallest gradient (the tip's nu) is
+    // 4e-6, so a wrong one still errs far beyond it.
+    EXPECT_NEAR(adjoint, fd, 1e-5 * std::abs(fd) + 2e-10) << what;
     EXPECT_NE(adjoint, 0.0) << what;
     if (c.damping) continue;
     double scale_x = 0;

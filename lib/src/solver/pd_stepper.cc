@@ -11,6 +11,7 @@
 
 #include "diffpd/error.h"
 #include "solver/line_search.h"
+#include "solver/rigid_mode_correction.h"
 #include "solver/simulator_impl.h"
 
 namespace diffpd::internal {
@@ -64,6 +65,18 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
   double value = objective.Evaluate(x, &grad);
   report->initial_residual = objective.ReferenceResidual(grad.norm());
   std::vector<double> alpha;
+  // H0 = A^-1, plus the rigid modes' correction (rigid_mode_correction.h)
+  // with H's Galerkin matrix at the start.
+  std::optional<RigidModeCorrection> rigid;
+  if (sim.options.rigid_mode_correction && !objective.is_static()) {
+    rigid.emplace(x, sim.fixed);
+    rigid->SetHessianProducts(objective.GradientDifferences(x, grad, rigid->modes()));
+  }
+  const auto initial_inverse = [&](const VectorXd& q) {
+    VectorXd r = pd.Solve(q);
+    if (rigid) rigid->Add(q, &r);
+    return r;
+  };
   for (int it = 0;; ++it) {
     try {
       if (IterationConverged(objective, it, x, grad.norm(), report)) return x;
@@ -71,16 +84,17 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
       if (e.status() != SolverStatus::kMaxIterations) throw;
       return NewtonFallback(objective, x, e, report);  // max_iterations reached
     }
-    // Two-loop recursion with H0 = A^{-1}.
+    // Two-loop recursion.
     VectorXd q = grad;
     pairs.FirstLoop(&q, &alpha);
-    VectorXd r = pd.Solve(q);
+    VectorXd r = initial_inverse(q);
     pairs.SecondLoop(alpha, &r);
     VectorXd d = -r;
     sim.ZeroFixed(&d);
-    if (!(grad.dot(d) < 0)) {  // lost descent: restart from the PD direction
+    if (!(grad.dot(d) < 0)) {  // lost descent: restart from H0's direction
       pairs.Clear();
-      d = -pd.Solve(grad);
+      d = -initial_inverse(grad);
+      sim.ZeroFixed(&d);
     }
     const VectorXd x_old = x, grad_old = grad;
     LineSearchResult search;
@@ -97,9 +111,9 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
     line_search(d);
     if (stall && pairs.size() > 0) {
       // Stale curvature pairs can spoil the direction near convergence:
-      // restart once from the plain PD direction.
+      // restart once from H0's direction.
       pairs.Clear();
-      d = -pd.Solve(grad);
+      d = -initial_inverse(grad);
       sim.ZeroFixed(&d);
       line_search(d);
     }

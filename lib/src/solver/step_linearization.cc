@@ -9,18 +9,20 @@
 // fallback to a direct solve of the assembled H (CHOLMOD, then sparse LU
 // when H is indefinite).
 #include <cstdio>
+#include <optional>
 
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseLU>
 
 #include "diffpd/error.h"
 #include "solver/preconditioned_iteration.h"
+#include "solver/rigid_mode_correction.h"
 #include "solver/simulator_impl.h"
 
 namespace diffpd::internal {
 
 StepLinearization::StepLinearization(SimulatorImpl& sim, const VectorXd& x, bool static_problem)
-    : sim_(sim), x_(x) {
+    : sim_(sim), x_(x), static_(static_problem) {
   inertia_ = static_problem ? VectorXd::Zero(sim.num_dofs()) : VectorXd(sim.Mass() / (sim.h() * sim.h()));
   const Method m = sim.options.method;
   if (m == Method::kPd || m == Method::kPdLbfgs) PackedBlocks();
@@ -92,9 +94,23 @@ void StepLinearization::IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, st
   iteration.rel_tolerance = opt.backward_rel_tolerance;
   iteration.max_iterations = opt.backward_max_iterations;
   iteration.lbfgs_history = opt.lbfgs_history;
+  // A^-1, plus the rigid modes' correction (rigid_mode_correction.h) for the
+  // Krylov methods; the fixed point keeps DiffPD's A^-1.
+  std::optional<RigidModeCorrection> rigid;
+  if (opt.rigid_mode_correction && !static_ && opt.pd_backward != PdBackwardMethod::kFixedPoint) {
+    rigid.emplace(x_, sim_.fixed);
+    MatrixXd hz(rhs.rows(), RigidModeCorrection::kModes);
+    for (int k = 0; k < RigidModeCorrection::kModes; ++k) hz.col(k) = Apply(rigid->modes().col(k));
+    rigid->SetHessianProducts(hz);
+  }
   SolvePreconditioned(
       iteration, rhs, [this](const VectorXd& v) { return Apply(v); },
-      [&pd](const MatrixXd& r) { return pd.Solve(r); }, z, ok, iterations);
+      [&pd, &rigid](const MatrixXd& r) {
+        MatrixXd out = pd.Solve(r);
+        if (rigid) rigid->Add(r, &out);
+        return out;
+      },
+      z, ok, iterations);
 }
 
 bool StepLinearization::IterativeSolve(const VectorXd& b, VectorXd* z, int* iterations) {

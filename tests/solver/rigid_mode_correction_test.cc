@@ -1,0 +1,176 @@
+// RigidModeCorrection (solver/rigid_mode_correction.h) and
+// SolverOptions::rigid_mode_correction.
+//
+// Properties: the modes are infinitesimal rigid motions (every pair of free
+// nodes keeps its distance to first order), unit columns, zero at fixed DoFs;
+// the correction Z E^+ Z^T inverts H exactly on the coarse space (H Z c maps
+// to Z c); with H negative along a mode the correction stays positive
+// semi-definite; on a spinning free body PD-LBFGS's forward and the PD
+// backward need markedly fewer iterations with it, and the states and
+// gradients agree with the uncorrected solves within their tolerances.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "diffpd/simulator.h"
+#include "solver/rigid_mode_correction.h"
+#include "test_scenes.h"
+
+namespace diffpd {
+namespace {
+
+using internal::RigidModeCorrection;
+
+VectorXd SomePositions(int nodes) {
+  std::mt19937_64 rng(3);
+  return testing::RandomVector(3 * nodes, &rng, 0.2);
+}
+
+TEST(RigidModeCorrectionTest, ModesAreUnitRigidMotionsZeroAtFixedDofs) {
+  const int nodes = 9;
+  const VectorXd x = SomePositions(nodes);
+  std::vector<char> fixed(3 * nodes, 0);
+  fixed[3 * 4 + 0] = fixed[3 * 4 + 1] = fixed[3 * 4 + 2] = 1;  // node 4 pinned
+  const RigidModeCorrection rigid(x, fixed);
+  const MatrixXd& z = rigid.modes();
+  ASSERT_EQ(z.rows(), 3 * nodes);
+  ASSERT_EQ(z.cols(), RigidModeCorrection::kModes);
+  for (int k = 0; k < z.cols(); ++k) {
+    EXPECT_NEAR(z.col(k).norm(), 1.0, 1e-14) << "mode " << k;
+    EXPECT_EQ(z.col(k).segment<3>(3 * 4).norm(), 0.0) << "mode " << k;
+    for (int i = 0; i < nodes; ++i) {
+      if (i == 4) continue;
+      for (int j = i + 1; j < nodes; ++j) {
+        if (j == 4) continue;
+        const Vec3 dx = x.segment<3>(3 * i) - x.segment<3>(3 * j);
+        const Vec3 dz = z.col(k).segment<3>(3 * i) - z.col(k).segment<3>(3 * j);
+        EXPECT_NEAR(dx.dot(dz), 0.0, 1e-14) << "mode " << k << " nodes " << i << ", " << j;
+      }
+    }
+  }
+  // Translations and rotations are independent: Z has full column rank.
+  Eigen::JacobiSVD<MatrixXd> svd(z);
+  EXPECT_GT(svd.singularValues().minCoeff(), 0.1);
+}
+
+TEST(RigidModeCorrectionTest, InvertsTheHessianOnTheCoarseSpace) {
+  const int nodes = 7;
+  const VectorXd x = SomePositions(nodes);
+  const MatrixXd r = MatrixXd::Random(3 * nodes, 3 * nodes);
+  const MatrixXd h = r * r.transpose() + MatrixXd::Identity(3 * nodes, 3 * nodes);
+  RigidModeCorrection rigid(x, std::vector<char>(3 * nodes, 0));
+  rigid.SetHessianProducts(h * rigid.modes());
+  Eigen::Matrix<double, RigidModeCorrection::kModes, 1> c;
+  c << 1, -2, 0.5, 3, -1, 2;
+  const VectorXd coarse = rigid.modes() * c;
+  VectorXd out = VectorXd::Zero(3 * nodes);
+  rigid.Add(VectorXd(h * coarse), &out);
+  EXPECT_LT((out - coarse).norm(), 1e-10 * coarse.norm());
+  // The matrix form agrees column by column.
+  MatrixXd outs = MatrixXd::Zero(3 * nodes, 2);
+  MatrixXd ins(3 * nodes, 2);
+  ins.col(0) = h * coarse;
+  ins.col(1) = VectorXd::Random(3 * nodes);
+  rigid.Add(ins, &outs);
+  VectorXd second = VectorXd::Zero(3 * nodes);
+  rigid.Add(VectorXd(ins.col(1)), &second);
+  EXPECT_LT((outs.col(0) - coarse).norm(), 1e-10 * coarse.norm());
+  EXPECT_LT((outs.col(1) - second).norm(), 1e-12 * second.norm());
+}
+
+TEST(RigidModeCorrectionTest, DropsModesWhereTheHessianIsNotPositive) {
+  const int nodes = 6;
+  const VectorXd x = SomePositions(nodes);
+  RigidModeCorrection rigid(x, std::vector<char>(3 * nodes, 0));
+  // H = I - 3 z0 z0^T: negative along the first mode, positive elsewhere.
+  const VectorXd z0 = rigid.modes().col(0);
+  const MatrixXd h = MatrixXd::Identity(3 * nodes, 3 * nodes) - 3 * z0 * z0.transpose();
+  rigid.SetHessianProducts(h * rigid.modes());
+  std::mt19937_64 rng(11);
+  for (int trial = 0; trial < 20; ++trial) {
+    const VectorXd r = testing::RandomVector(3 * nodes, &rng, 1.0);
+    VectorXd out = VectorXd::Zero(3 * nodes);
+    rigid.Add(r, &out);
+    EXPECT_GE(r.dot(out), -1e-12 * r.squaredNorm()) << "trial " << trial;
+  }
+  VectorXd along = VectorXd::Zero(3 * nodes);
+  rigid.Add(z0, &along);
+  EXPECT_LT(along.dot(z0), 1e-12);  // the indefinite direction gets no correction
+}
+
+// A free hex block without gravity or fixed nodes: its rigid motion is what
+// A^-1 misrepresents.
+Scene FreeBlockScene() {
+  Scene scene;
+  scene.mesh = testing::BoxHexMesh(4, 3, 3, 0.12, 0.09, 0.09);
+  scene.material.youngs_modulus = 1e6;
+  scene.material.poissons_ratio = 0.4;
+  scene.material.density = 1e3;
+  scene.energies = {ElasticEnergy::kPdCorotated, ElasticEnergy::kPdVolume};
+  return scene;
+}
+
+// The rest state with a slight bend, a spin and a drift.
+State SpinningStart(const Simulator& sim) {
+  State s = sim.RestState();
+  for (int i = 0; i < s.x.size() / 3; ++i) s.x(3 * i + 2) += 0.05 * s.x(3 * i) * s.x(3 * i);
+  const Vec3 omega(4.0, -10.0, 16.0);  // rad/s
+  const Vec3 centre(0.06, 0.045, 0.045);
+  for (int i = 0; i < s.x.size() / 3; ++i)
+    s.v.segment<3>(3 * i) += omega.cross(Vec3(s.x.segment<3>(3 * i)) - centre) + Vec3(0.1, 0, 0);
+  return s;
+}
+
+SolverOptions LbfgsOptions(bool rigid) {
+  SolverOptions options;
+  options.method = Method::kPdLbfgs;
+  options.time_step = 0.005;
+  options.rel_tolerance = 1e-10;
+  options.abs_tolerance = 1e-12;
+  options.backward_rel_tolerance = 1e-9;
+  options.num_threads = 1;
+  options.rigid_mode_correction = rigid;
+  return options;
+}
+
+struct SpinRun {
+  Rollout rollout;
+  RolloutGradient gradient;
+  int forward_iterations = 0;
+};
+
+SpinRun Simulate(bool rigid) {
+  Simulator sim(FreeBlockScene(), LbfgsOptions(rigid));
+  const int steps = 6;
+  SpinRun run;
+  run.rollout = sim.Simulate(SpinningStart(sim), std::vector<StepInput>(steps));
+  for (const StepReport& r : run.rollout.reports) run.forward_iterations += r.iterations;
+  LossGradient loss(steps);
+  std::mt19937_64 rng(7);
+  loss.dx[steps] = testing::RandomVector(sim.num_dofs(), &rng, 1.0);
+  loss.dv[steps] = testing::RandomVector(sim.num_dofs(), &rng, 0.1);
+  run.gradient = sim.Backward(run.rollout, loss);
+  return run;
+}
+
+TEST(RigidModeCorrectionTest, SpinningFreeBodyConvergesInFewerIterationsToTheSameResult) {
+  const SpinRun plain = Simulate(false), corrected = Simulate(true);
+  // Measured (6 steps): forward 288 -> 197 iterations, backward 272 -> 199;
+  // a correction that did nothing would leave them equal.
+  EXPECT_LT(corrected.forward_iterations, 0.8 * plain.forward_iterations)
+      << corrected.forward_iterations << " vs " << plain.forward_iterations;
+  EXPECT_LT(corrected.gradient.report.linear_iterations, 0.8 * plain.gradient.report.linear_iterations)
+      << corrected.gradient.report.linear_iterations << " vs " << plain.gradient.report.linear_iterations;
+  EXPECT_EQ(corrected.gradient.report.fallbacks, 0);
+  const VectorXd& xa = plain.rollout.states.back().x;
+  const VectorXd& xb = corrected.rollout.states.back().x;
+  const double travel = (xa - plain.rollout.states.front().x).norm();
+  EXPECT_LT((xa - xb).norm(), 1e-7 * travel);
+  EXPECT_LT((plain.gradient.x0 - corrected.gradient.x0).norm(), 1e-6 * plain.gradient.x0.norm());
+  EXPECT_LT((plain.gradient.v0 - corrected.gradient.v0).norm(), 1e-6 * plain.gradient.v0.norm());
+  EXPECT_NEAR(corrected.gradient.youngs_modulus, plain.gradient.youngs_modulus,
+              1e-6 * std::abs(plain.gradient.youngs_modulus));
+}
+
+}  // namespace
+}  // namespace diffpd
