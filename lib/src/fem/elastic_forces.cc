@@ -416,6 +416,21 @@ void ElasticForces::ApplyElementMatrices(const std::vector<double>& packed, cons
 }
 
 template <int K>
+void ElasticForces::ElementStiffness(int e, const Mat3* F, const Svd3* svd, const VolumeProjection* volume,
+                                     const LameField& lame, double* block) const {
+  constexpr int N = 3 * K;
+  const int q_per = fem_.samples_per_element();
+  const double mu = lame.mu_of(e), lambda = lame.lambda_of(e);
+  Eigen::Map<Eigen::Matrix<double, N, N>> ke(block);
+  ke.setZero();
+  for (int q = 0; q < q_per; ++q) {
+    Mat9 dP;
+    EvaluateDensity(energies_, F[q], svd[q], mu, lambda, nullptr, &dP, needs_volume_ ? &volume[q] : nullptr);
+    AddSampleStiffness<K>(fem_.grad(e * q_per + q), fem_.sample_volume(e * q_per + q), dP, ke);
+  }
+}
+
+template <int K>
 void ElasticForces::ElementHessiansImpl(const VectorXd& x, const LameField& lame, bool project_spd,
                                         std::vector<double>* blocks, int threads) {
   constexpr int N = 3 * K;
@@ -428,19 +443,12 @@ void ElasticForces::ElementHessiansImpl(const VectorXd& x, const LameField& lame
     Svd3 svd[kSvdBatch];
     VolumeProjection volume[kSvdBatch];
     SampleDecompositions<K>(x, e0, count, F, svd, volume, /*warm_start=*/false);
-    const int s0 = e0 * q_per;
     for (int j = 0; j < count; ++j) {
       const int e = e0 + j;
-      const double mu = lame.mu_of(e), lambda = lame.lambda_of(e);
-      Eigen::Map<Eigen::Matrix<double, N, N>> ke(blocks->data() + static_cast<size_t>(e) * N * N);
-      ke.setZero();
-      for (int q = 0; q < q_per; ++q) {
-        const int i = j * q_per + q;
-        Mat9 dP;
-        EvaluateDensity(energies_, F[i], svd[i], mu, lambda, nullptr, &dP, needs_volume_ ? &volume[i] : nullptr);
-        AddSampleStiffness<K>(fem_.grad(s0 + i), fem_.sample_volume(s0 + i), dP, ke);
-      }
+      double* block = blocks->data() + static_cast<size_t>(e) * N * N;
+      ElementStiffness<K>(e, F + j * q_per, svd + j * q_per, volume + j * q_per, lame, block);
       if (project_spd) {
+        Eigen::Map<Eigen::Matrix<double, N, N>> ke(block);
         const Eigen::Matrix<double, N, N> sym = 0.5 * (ke + ke.transpose());
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> eig(sym);
         if (eig.eigenvalues().minCoeff() < 0) {
@@ -450,6 +458,36 @@ void ElasticForces::ElementHessiansImpl(const VectorXd& x, const LameField& lame
       }
     }
   });
+}
+
+template <int K>
+void ElasticForces::AddElementHessianProductsImpl(const VectorXd& x, const LameField& lame,
+                                                  const std::vector<int>& elements, const MatrixXd& z,
+                                                  MatrixXd* out) {
+  constexpr int N = 3 * K;
+  const Mesh& mesh = fem_.mesh();
+  Mat3 F[kSvdBatch];
+  Svd3 svd[kSvdBatch];
+  VolumeProjection volume[kSvdBatch];
+  Eigen::Matrix<double, N, N> ke;
+  Eigen::Matrix<double, N, Eigen::Dynamic> ze(N, z.cols());
+  for (const int e : elements) {
+    DIFFPD_CHECK(e >= 0 && e < fem_.num_elements(), "AddElementHessianProducts: element " << e);
+    SampleDecompositions<K>(x, e, 1, F, svd, volume, /*warm_start=*/false);
+    ElementStiffness<K>(e, F, svd, volume, lame, ke.data());
+    for (int a = 0; a < K; ++a) ze.template middleRows<3>(3 * a) = z.middleRows<3>(3 * mesh.elements(a, e));
+    const Eigen::Matrix<double, N, Eigen::Dynamic> ye = ke * ze;
+    for (int a = 0; a < K; ++a) out->middleRows<3>(3 * mesh.elements(a, e)) += ye.template middleRows<3>(3 * a);
+  }
+}
+
+void ElasticForces::AddElementHessianProducts(const VectorXd& x, const LameField& lame,
+                                              const std::vector<int>& elements, const MatrixXd& z, MatrixXd* out) {
+  DIFFPD_CHECK(z.rows() == x.size() && out->rows() == x.size() && out->cols() == z.cols(),
+               "AddElementHessianProducts: shapes " << z.rows() << "x" << z.cols() << ", " << out->rows() << "x"
+                                                    << out->cols());
+  if (fem_.nodes_per_element() == 4) AddElementHessianProductsImpl<4>(x, lame, elements, z, out);
+  else AddElementHessianProductsImpl<8>(x, lame, elements, z, out);
 }
 
 void ElasticForces::ElementHessians(const VectorXd& x, const LameField& lame, bool project_spd,

@@ -59,6 +59,11 @@ class ElasticForces {
   // is replaced by its projection onto the PSD cone (negative eigenvalues
   // clamped to zero), the definiteness fix of Newton. Depends on x only (the
   // SVDs are cold started).
+  // out += sum over the listed elements of K_e z_e for each column of z
+  // (3n x P): the element Hessians at x (not projected), computed for those
+  // elements only (serial; for a few elements, e.g. those around fixed nodes).
+  void AddElementHessianProducts(const VectorXd& x, const LameField& lame, const std::vector<int>& elements,
+                                 const MatrixXd& z, MatrixXd* out);
   void ElementHessians(const VectorXd& x, const LameField& lame, bool project_spd, std::vector<double>* blocks,
                        int threads);
   // The upper triangle of each (symmetric) element block by 3 x 3 node
@@ -84,6 +89,14 @@ class ElasticForces {
   void ApplyHessianImpl(const std::vector<Mat9>& d, const VectorXd& z, VectorXd* out, int threads);
   template <int K>
   void ApplyElementMatricesImpl(const std::vector<double>& packed, const VectorXd& z, VectorXd* out, int threads);
+  // Element e's Hessian (3K x 3K, column-major) from its samples' F, SVD
+  // and volume projection (e's samples_per_element() entries each).
+  template <int K>
+  void ElementStiffness(int e, const Mat3* F, const Svd3* svd, const VolumeProjection* volume, const LameField& lame,
+                        double* block) const;
+  template <int K>
+  void AddElementHessianProductsImpl(const VectorXd& x, const LameField& lame, const std::vector<int>& elements,
+                                     const MatrixXd& z, MatrixXd* out);
   template <int K>
   void ElementHessiansImpl(const VectorXd& x, const LameField& lame, bool project_spd, std::vector<double>* blocks,
                            int threads);

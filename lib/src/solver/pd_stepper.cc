@@ -70,7 +70,7 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
   std::optional<RigidModeCorrection> rigid;
   if (sim.options.rigid_mode_correction && !objective.is_static()) {
     rigid.emplace(x, sim.fixed);
-    rigid->SetHessianProducts(objective.GradientDifferences(x, grad, rigid->modes()));
+    rigid->SetHessianProducts(RigidModeHessianProducts(sim, *rigid, x, objective.inertia_diagonal()));
   }
   const auto initial_inverse = [&](const VectorXd& q) {
     VectorXd r = pd.Solve(q);

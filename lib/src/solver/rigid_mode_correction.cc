@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "diffpd/error.h"
+#include "solver/simulator_impl.h"
 
 namespace diffpd::internal {
 namespace {
@@ -21,19 +22,21 @@ RigidModeCorrection::RigidModeCorrection(const VectorXd& x, const std::vector<ch
   Vec3 centre = Vec3::Zero();
   for (Eigen::Index i = 0; i < n; ++i) centre += x.segment<3>(3 * i);
   if (n > 0) centre /= static_cast<double>(n);
-  modes_ = MatrixXd::Zero(dofs, kModes);
+  uncut_ = MatrixXd::Zero(dofs, kModes);
   for (Eigen::Index i = 0; i < n; ++i) {
     const Vec3 p = x.segment<3>(3 * i) - centre;
     for (int a = 0; a < 3; ++a) {
-      modes_(3 * i + a, a) = 1;                                          // translation along a
-      modes_.block<3, 1>(3 * i, 3 + a) = Vec3::Unit(a).cross(p);         // rotation about a
+      uncut_(3 * i + a, a) = 1;                                  // translation along a
+      uncut_.block<3, 1>(3 * i, 3 + a) = Vec3::Unit(a).cross(p);  // rotation about a
     }
   }
+  modes_ = uncut_;
   for (Eigen::Index d = 0; d < dofs; ++d)
     if (fixed[d]) modes_.row(d).setZero();
   for (int k = 0; k < kModes; ++k) {
     const double norm = modes_.col(k).norm();
-    if (norm > 0) modes_.col(k) /= norm;
+    scale_(k) = norm > 0 ? 1 / norm : 0.0;
+    modes_.col(k) *= scale_(k);
   }
 }
 
@@ -57,6 +60,55 @@ void RigidModeCorrection::Add(const MatrixXd& r, MatrixXd* out) const {
 
 void RigidModeCorrection::Add(const VectorXd& r, VectorXd* out) const {
   *out += modes_ * (pseudo_inverse_ * (modes_.transpose() * r));
+}
+
+MatrixXd RigidModeHessianProducts(SimulatorImpl& sim, const RigidModeCorrection& rigid, const VectorXd& x,
+                                  const VectorXd& inertia) {
+  const Eigen::Index dofs = x.size();
+  const int k = RigidModeCorrection::kModes;
+  const MatrixXd& uncut = rigid.uncut_modes();
+  // Elastic part on the uncut modes, from the frame indifference of E.
+  VectorXd grad_e;
+  sim.elastic.EnergyAndGradient(x, sim.lame(), &grad_e, sim.threads());
+  MatrixXd h = MatrixXd::Zero(dofs, k);
+  for (Eigen::Index i = 0; i < dofs / 3; ++i)
+    for (int a = 0; a < 3; ++a) h.block<3, 1>(3 * i, 3 + a) = Vec3::Unit(a).cross(Vec3(grad_e.segment<3>(3 * i)));
+  // Minus its product with the cut part (uncut - Z's support), which lives
+  // on the fixed DoFs: only elements with a fixed DoF contribute.
+  MatrixXd cut = MatrixXd::Zero(dofs, k);
+  bool any_fixed = false;
+  for (Eigen::Index d = 0; d < dofs; ++d)
+    if (sim.fixed[d]) {
+      cut.row(d) = uncut.row(d);
+      any_fixed = true;
+    }
+  if (any_fixed) {
+    const Mesh& mesh = sim.fem.mesh();
+    std::vector<int> elements;
+    for (int e = 0; e < mesh.num_elements(); ++e) {
+      bool touches = false;
+      for (int a = 0; a < mesh.elements.rows() && !touches; ++a) {
+        const int node = mesh.elements(a, e);
+        touches = sim.fixed[3 * node] || sim.fixed[3 * node + 1] || sim.fixed[3 * node + 2];
+      }
+      if (touches) elements.push_back(e);
+    }
+    MatrixXd h_cut = MatrixXd::Zero(dofs, k);
+    sim.elastic.AddElementHessianProducts(x, sim.lame(), elements, cut, &h_cut);
+    h -= h_cut;
+  }
+  h *= rigid.scale().asDiagonal();
+  // Inertia and the auxiliary energies (penalty contact is not frame
+  // indifferent) on Z itself.
+  const MatrixXd& z = rigid.modes();
+  for (int c = 0; c < k; ++c) {
+    VectorXd hz = VectorXd::Zero(dofs);
+    sim.aux.AddHessianProduct(x, sim.activation, z.col(c), &hz);
+    h.col(c) += hz + inertia.cwiseProduct(z.col(c));
+  }
+  for (Eigen::Index d = 0; d < dofs; ++d)
+    if (sim.fixed[d]) h.row(d).setZero();
+  return h;
 }
 
 }  // namespace diffpd::internal

@@ -147,26 +147,6 @@ StepObjective::StepObjective(SimulatorImpl& sim, VectorXd xhat, VectorXd force, 
   inertia_ = static_problem ? VectorXd::Zero(sim.num_dofs()) : VectorXd(sim.Mass() / (sim.h() * sim.h()));
 }
 
-MatrixXd StepObjective::GradientDifferences(const VectorXd& x, const VectorXd& grad, const MatrixXd& z) {
-  // Each column moves the nodes by at most kRelativeStep times the body's
-  // extent: far above grad g's rounding, far below its curvature scale.
-  constexpr double kRelativeStep = 1e-7;
-  const Eigen::Index n = x.size() / 3;
-  const Eigen::Map<const Eigen::Matrix3Xd> nodes(x.data(), 3, n);
-  const double extent = n > 0 ? (nodes.rowwise().maxCoeff() - nodes.rowwise().minCoeff()).norm() : 0.0;
-  MatrixXd out = MatrixXd::Zero(z.rows(), z.cols());
-  VectorXd moved_grad;
-  for (Eigen::Index c = 0; c < z.cols(); ++c) {
-    VectorXd zc = z.col(c);
-    sim_.ZeroFixed(&zc);
-    const double largest = zc.cwiseAbs().maxCoeff();
-    if (!(largest > 0) || !(extent > 0)) continue;
-    const double step = kRelativeStep * extent / largest;
-    Evaluate(x + step * zc, &moved_grad);
-    out.col(c) = (moved_grad - grad) / step;
-  }
-  return out;
-}
 
 namespace {
 

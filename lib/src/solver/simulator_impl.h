@@ -114,12 +114,6 @@ class StepObjective {
   // Diagonal of the inertia term (3n): M / h^2, or zero for a static problem.
   const VectorXd& inertia_diagonal() const { return inertia_; }
   bool is_static() const { return static_; }
-  // hess g(x) z for each column of z (3n x P) by one-sided differences of
-  // grad g from grad = grad g(x): one Evaluate per column (the fused PD
-  // kernel's gradient is several times cheaper than exact products through
-  // stress differentials), relative error ~1e-7; over the free DoFs (z's
-  // fixed entries ignored, fixed rows zero). Zero columns give zero.
-  MatrixXd GradientDifferences(const VectorXd& x, const VectorXd& grad, const MatrixXd& z);
   SimulatorImpl& sim() { return sim_; }
 
   // An optional checkpoint of the forward solve (frictional contact's
