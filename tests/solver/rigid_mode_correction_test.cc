@@ -5,7 +5,7 @@
 // nodes keeps its distance to first order), unit columns, zero at fixed DoFs;
 // the correction Z E^+ Z^T inverts H exactly on the coarse space (H Z c maps
 // to Z c); with H negative along a mode the correction stays positive
-// semi-definite; the products H Z from the energy's frame indifference (plus
+// semi-definite; clamped bodies are solved without it; the products H Z from the energy's frame indifference (plus
 // the cut elements' Hessians) equal the exact step Hessian's, with fixed
 // nodes, muscles and penalty contact declared; on a spinning free body PD-LBFGS's forward and the PD
 // backward need markedly fewer iterations with it, and the states and
@@ -209,6 +209,25 @@ TEST(RigidModeCorrectionTest, SpinningFreeBodyConvergesInFewerIterationsToTheSam
   EXPECT_LT((plain.gradient.v0 - corrected.gradient.v0).norm(), 1e-6 * plain.gradient.v0.norm());
   EXPECT_NEAR(corrected.gradient.youngs_modulus, plain.gradient.youngs_modulus,
               1e-6 * std::abs(plain.gradient.youngs_modulus));
+}
+
+// A clamped body's cut rigid modes are not soft: the option leaves it alone
+// (the same iterates, bit for bit).
+TEST(RigidModeCorrectionTest, ClampedBodiesAreSolvedWithoutIt) {
+  const Scene scene = testing::SmallBeamScene();
+  std::vector<Rollout> rollouts;
+  std::vector<RolloutGradient> gradients;
+  for (const bool rigid : {false, true}) {
+    SolverOptions options = LbfgsOptions(rigid);
+    Simulator sim(scene, options);
+    rollouts.push_back(sim.Simulate(testing::MovingStart(sim), std::vector<StepInput>(3)));
+    LossGradient loss(3);
+    loss.dx[3] = VectorXd::Ones(sim.num_dofs());
+    gradients.push_back(sim.Backward(rollouts.back(), loss));
+  }
+  EXPECT_EQ(rollouts[0].states.back().x, rollouts[1].states.back().x);
+  EXPECT_EQ(gradients[0].x0, gradients[1].x0);
+  EXPECT_EQ(gradients[0].report.linear_iterations, gradients[1].report.linear_iterations);
 }
 
 }  // namespace

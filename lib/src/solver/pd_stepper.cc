@@ -68,7 +68,7 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
   // H0 = A^-1, plus the rigid modes' correction (rigid_mode_correction.h)
   // with H's Galerkin matrix at the start.
   std::optional<RigidModeCorrection> rigid;
-  if (sim.options.rigid_mode_correction && !objective.is_static()) {
+  if (sim.UseRigidModeCorrection(objective.is_static())) {
     rigid.emplace(x, sim.fixed);
     rigid->SetHessianProducts(RigidModeHessianProducts(sim, *rigid, x, objective.inertia_diagonal()));
   }

@@ -78,6 +78,13 @@ class SimulatorImpl {
   // PD-LBFGS's pairs, emptied, for options.lbfgs_history pairs of 3n-vectors
   // (kept between steps: no allocation per step).
   LbfgsPairs& empty_lbfgs_pairs();
+  // Whether PD's preconditioners add the rigid modes' correction
+  // (rigid_mode_correction.h): the option is on, the body has no Dirichlet
+  // DoFs of its own (frictional contact's pins do not count) and the solve
+  // is dynamic.
+  bool UseRigidModeCorrection(bool static_problem) const {
+    return options.rigid_mode_correction && scene.dirichlet.dofs.empty() && !static_problem;
+  }
   CholmodSolver& newton_solver() { return newton_llt_; }
   int pd_factorizations() const { return pd_ ? pd_->num_factorizations() : 0; }
   double pd_factorization_seconds() const { return pd_ ? pd_->factorization_seconds() : 0.0; }

@@ -97,7 +97,7 @@ void StepLinearization::IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, st
   // A^-1, plus the rigid modes' correction (rigid_mode_correction.h) for the
   // Krylov methods; the fixed point keeps DiffPD's A^-1.
   std::optional<RigidModeCorrection> rigid;
-  if (opt.rigid_mode_correction && !static_ && opt.pd_backward != PdBackwardMethod::kFixedPoint) {
+  if (sim_.UseRigidModeCorrection(static_) && opt.pd_backward != PdBackwardMethod::kFixedPoint) {
     rigid.emplace(x_, sim_.fixed);
     MatrixXd hz(rhs.rows(), RigidModeCorrection::kModes);
     for (int k = 0; k < RigidModeCorrection::kModes; ++k) hz.col(k) = Apply(rigid->modes().col(k));
