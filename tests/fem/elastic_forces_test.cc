@@ -260,6 +260,12 @@ TEST(ElasticForcesTest, PackedProductMatchesTheDenseBlocksForPartialGroups) {
     std::vector<double> blocks, packed;
     forces.ElementHessians(x, LameField::Uniform(mu, lambda), false, &blocks, 1);
     forces.PackElementMatrices(blocks, &packed);
+    // Packing element by element straight from x gives the same entries.
+    for (const int threads : {1, 2}) {
+      std::vector<double> direct;
+      forces.PackedElementHessians(x, LameField::Uniform(mu, lambda), &direct, threads);
+      EXPECT_EQ(direct, packed) << (tets ? "tets" : "hexes") << ", " << threads << " threads";
+    }
     std::mt19937 rng(15);
     const VectorXd z = NormalVector(static_cast<int>(x.size()), &rng);
     VectorXd product;

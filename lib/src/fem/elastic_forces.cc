@@ -360,21 +360,54 @@ void ElasticForces::ApplyHessian(const std::vector<Mat9>& d, const VectorXd& z, 
   else ApplyHessianImpl<8>(d, z, out, threads);
 }
 
+namespace {
+
+// Writes element e's upper 3 x 3 node blocks of ke (3k x 3k, column-major)
+// into its lane of the packed layout (packed_element_matrices.h).
+void PackElement(int k, int e, const double* ke, double* packed) {
+  const int n = 3 * k;
+  double* out = packed + static_cast<size_t>(e / kElementLanes) * PackedEntries(k) * kElementLanes + e % kElementLanes;
+  for (int b = 0; b < k; ++b)
+    for (int a = 0; a <= b; ++a)
+      for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r, out += kElementLanes) *out = ke[(3 * b + c) * n + 3 * a + r];
+}
+
+}  // namespace
+
 void ElasticForces::PackElementMatrices(const std::vector<double>& blocks, std::vector<double>* packed) const {
   const int k = fem_.nodes_per_element(), n = 3 * k, m = fem_.num_elements();
   DIFFPD_CHECK(blocks.size() == static_cast<size_t>(m) * n * n,
                "PackElementMatrices: " << blocks.size() << " block entries for " << m << " elements");
-  const size_t entries = PackedEntries(k);
   const int groups = (m + kElementLanes - 1) / kElementLanes;
-  packed->assign(static_cast<size_t>(groups) * entries * kElementLanes, 0.0);
-  for (int e = 0; e < m; ++e) {
-    const Eigen::Map<const MatrixXd> ke(blocks.data() + static_cast<size_t>(e) * n * n, n, n);
-    double* out = packed->data() + static_cast<size_t>(e / kElementLanes) * entries * kElementLanes + e % kElementLanes;
-    for (int b = 0; b < k; ++b)
-      for (int a = 0; a <= b; ++a)
-        for (int c = 0; c < 3; ++c)
-          for (int r = 0; r < 3; ++r, out += kElementLanes) *out = ke(3 * a + r, 3 * b + c);
-  }
+  packed->assign(static_cast<size_t>(groups) * PackedEntries(k) * kElementLanes, 0.0);
+  for (int e = 0; e < m; ++e) PackElement(k, e, blocks.data() + static_cast<size_t>(e) * n * n, packed->data());
+}
+
+template <int K>
+void ElasticForces::PackedElementHessiansImpl(const VectorXd& x, const LameField& lame, std::vector<double>* packed,
+                                              int threads) {
+  constexpr int N = 3 * K;
+  const int q_per = fem_.samples_per_element(), m = fem_.num_elements();
+  const int groups = (m + kElementLanes - 1) / kElementLanes;
+  packed->assign(static_cast<size_t>(groups) * PackedEntries(K) * kElementLanes, 0.0);
+  ParallelForSampleBatches(m, q_per, threads, [&](int e0, int count) {
+    Mat3 F[kSvdBatch];
+    Svd3 svd[kSvdBatch];
+    VolumeProjection volume[kSvdBatch];
+    SampleDecompositions<K>(x, e0, count, F, svd, volume, /*warm_start=*/false);
+    Eigen::Matrix<double, N, N> ke;
+    for (int j = 0; j < count; ++j) {
+      ElementStiffness<K>(e0 + j, F + j * q_per, svd + j * q_per, volume + j * q_per, lame, ke.data());
+      PackElement(K, e0 + j, ke.data(), packed->data());
+    }
+  });
+}
+
+void ElasticForces::PackedElementHessians(const VectorXd& x, const LameField& lame, std::vector<double>* packed,
+                                          int threads) {
+  if (fem_.nodes_per_element() == 4) PackedElementHessiansImpl<4>(x, lame, packed, threads);
+  else PackedElementHessiansImpl<8>(x, lame, packed, threads);
 }
 
 template <int K>

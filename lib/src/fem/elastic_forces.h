@@ -70,6 +70,10 @@ class ElasticForces {
   // blocks, interleaved across groups of elements (layout in
   // packed_element_matrices.h; 1296 of 2304 bytes per hexahedron).
   void PackElementMatrices(const std::vector<double>& blocks, std::vector<double>* packed) const;
+  // The same packed matrices straight from x (ElementHessians, unprojected,
+  // then PackElementMatrices), element by element in parallel, without the
+  // full blocks.
+  void PackedElementHessians(const VectorXd& x, const LameField& lame, std::vector<double>* packed, int threads);
   // out = sum_e K_e z_e with packed element Hessians: the Hessian product for
   // many products at one x ((3K)^2 multiply-adds per element and product,
   // against about 3 (3K)^2 through StressDifferentials for hexahedra, and
@@ -97,6 +101,8 @@ class ElasticForces {
   template <int K>
   void AddElementHessianProductsImpl(const VectorXd& x, const LameField& lame, const std::vector<int>& elements,
                                      const MatrixXd& z, MatrixXd* out);
+  template <int K>
+  void PackedElementHessiansImpl(const VectorXd& x, const LameField& lame, std::vector<double>* packed, int threads);
   template <int K>
   void ElementHessiansImpl(const VectorXd& x, const LameField& lame, bool project_spd, std::vector<double>* blocks,
                            int threads);

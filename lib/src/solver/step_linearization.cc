@@ -29,11 +29,7 @@ StepLinearization::StepLinearization(SimulatorImpl& sim, const VectorXd& x, bool
 }
 
 const std::vector<double>& StepLinearization::PackedBlocks() {
-  if (packed_blocks_.empty()) {
-    std::vector<double> blocks;
-    sim_.elastic.ElementHessians(x_, sim_.lame(), /*project_spd=*/false, &blocks, sim_.threads());
-    sim_.elastic.PackElementMatrices(blocks, &packed_blocks_);
-  }
+  if (packed_blocks_.empty()) sim_.elastic.PackedElementHessians(x_, sim_.lame(), &packed_blocks_, sim_.threads());
   return packed_blocks_;
 }
 
