@@ -55,7 +55,9 @@ void ParallelForSampleBatches(int num_elements, int samples_per_element, int thr
 // and ke(3a + i, 3b + k) += vol sum_{j,l} G(a, j) dP(i + 3j, k + 3l) G(b, l):
 // 27 (3K + K^2) multiply-adds, against 243 K + 81 K^2 for the dense products
 // with the 9 x 3K matrix dF/dx.
-template <int K>
+// With kUpper only the node blocks (a, b >= a) are accumulated (the packed
+// layout's; 27 K (K + 1) / 2 instead of 27 K^2 in the second stage).
+template <int K, bool kUpper = false>
 inline void AddSampleStiffness(const double* g, double vol, const Mat9& dP,
                                Eigen::Map<Eigen::Matrix<double, 3 * K, 3 * K>>& ke) {
   const Eigen::Map<const Eigen::Matrix<double, K, 3>> G(g);
@@ -63,6 +65,14 @@ inline void AddSampleStiffness(const double* g, double vol, const Mat9& dP,
   for (int b = 0; b < K; ++b)
     t.template middleCols<3>(3 * b) = (vol * G(b, 0)) * dP.middleCols<3>(0) + (vol * G(b, 1)) * dP.middleCols<3>(3) +
                                       (vol * G(b, 2)) * dP.middleCols<3>(6);
+  if (kUpper) {
+    for (int b = 0; b < K; ++b)
+      for (int a = 0; a <= b; ++a)
+        ke.template block<3, 3>(3 * a, 3 * b) += G(a, 0) * t.template block<3, 3>(0, 3 * b) +
+                                                 G(a, 1) * t.template block<3, 3>(3, 3 * b) +
+                                                 G(a, 2) * t.template block<3, 3>(6, 3 * b);
+    return;
+  }
   for (int a = 0; a < K; ++a)
     ke.template middleRows<3>(3 * a) += G(a, 0) * t.template middleRows<3>(0) + G(a, 1) * t.template middleRows<3>(3) +
                                         G(a, 2) * t.template middleRows<3>(6);
@@ -398,7 +408,8 @@ void ElasticForces::PackedElementHessiansImpl(const VectorXd& x, const LameField
     SampleDecompositions<K>(x, e0, count, F, svd, volume, /*warm_start=*/false);
     Eigen::Matrix<double, N, N> ke;
     for (int j = 0; j < count; ++j) {
-      ElementStiffness<K>(e0 + j, F + j * q_per, svd + j * q_per, volume + j * q_per, lame, ke.data());
+      ElementStiffness<K, /*kUpper=*/true>(e0 + j, F + j * q_per, svd + j * q_per, volume + j * q_per, lame,
+                                           ke.data());
       PackElement(K, e0 + j, ke.data(), packed->data());
     }
   });
@@ -448,7 +459,7 @@ void ElasticForces::ApplyElementMatrices(const std::vector<double>& packed, cons
   else ApplyElementMatricesImpl<8>(packed, z, out, threads);
 }
 
-template <int K>
+template <int K, bool kUpper>
 void ElasticForces::ElementStiffness(int e, const Mat3* F, const Svd3* svd, const VolumeProjection* volume,
                                      const LameField& lame, double* block) const {
   constexpr int N = 3 * K;
@@ -459,7 +470,7 @@ void ElasticForces::ElementStiffness(int e, const Mat3* F, const Svd3* svd, cons
   for (int q = 0; q < q_per; ++q) {
     Mat9 dP;
     EvaluateDensity(energies_, F[q], svd[q], mu, lambda, nullptr, &dP, needs_volume_ ? &volume[q] : nullptr);
-    AddSampleStiffness<K>(fem_.grad(e * q_per + q), fem_.sample_volume(e * q_per + q), dP, ke);
+    AddSampleStiffness<K, kUpper>(fem_.grad(e * q_per + q), fem_.sample_volume(e * q_per + q), dP, ke);
   }
 }
 

@@ -94,8 +94,9 @@ class ElasticForces {
   template <int K>
   void ApplyElementMatricesImpl(const std::vector<double>& packed, const VectorXd& z, VectorXd* out, int threads);
   // Element e's Hessian (3K x 3K, column-major) from its samples' F, SVD
-  // and volume projection (e's samples_per_element() entries each).
-  template <int K>
+  // and volume projection (e's samples_per_element() entries each); with
+  // kUpper only its upper node blocks (the rest left zero).
+  template <int K, bool kUpper = false>
   void ElementStiffness(int e, const Mat3* F, const Svd3* svd, const VolumeProjection* volume, const LameField& lame,
                         double* block) const;
   template <int K>
