@@ -70,7 +70,8 @@ VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* 
   std::optional<RigidModeCorrection> rigid;
   if (sim.UseRigidModeCorrection(objective.is_static())) {
     rigid.emplace(x, sim.fixed);
-    rigid->SetHessianProducts(RigidModeHessianProducts(sim, *rigid, x, objective.inertia_diagonal()));
+    rigid->SetHessianProducts(
+        RigidModeHessianProducts(sim, *rigid, x, objective.ElasticGradient(x, grad), objective.inertia_diagonal()));
   }
   const auto initial_inverse = [&](const VectorXd& q) {
     VectorXd r = pd.Solve(q);

@@ -63,16 +63,17 @@ void RigidModeCorrection::Add(const VectorXd& r, VectorXd* out) const {
 }
 
 MatrixXd RigidModeHessianProducts(SimulatorImpl& sim, const RigidModeCorrection& rigid, const VectorXd& x,
-                                  const VectorXd& inertia) {
+                                  const VectorXd& elastic_gradient, const VectorXd& inertia) {
   const Eigen::Index dofs = x.size();
   const int k = RigidModeCorrection::kModes;
   const MatrixXd& uncut = rigid.uncut_modes();
-  // Elastic part on the uncut modes, from the frame indifference of E.
-  VectorXd grad_e;
-  sim.elastic.EnergyAndGradient(x, sim.lame(), &grad_e, sim.threads());
+  DIFFPD_CHECK(elastic_gradient.size() == dofs, "RigidModeHessianProducts: gradient of size " << elastic_gradient.size());
+  // Elastic part on the uncut modes, from the frame indifference of E (rows
+  // of fixed DoFs are zeroed at the end).
   MatrixXd h = MatrixXd::Zero(dofs, k);
   for (Eigen::Index i = 0; i < dofs / 3; ++i)
-    for (int a = 0; a < 3; ++a) h.block<3, 1>(3 * i, 3 + a) = Vec3::Unit(a).cross(Vec3(grad_e.segment<3>(3 * i)));
+    for (int a = 0; a < 3; ++a)
+      h.block<3, 1>(3 * i, 3 + a) = Vec3::Unit(a).cross(Vec3(elastic_gradient.segment<3>(3 * i)));
   // Minus its product with the cut part (uncut - Z's support), which lives
   // on the fixed DoFs: only elements with a fixed DoF contribute.
   MatrixXd cut = MatrixXd::Zero(dofs, k);

@@ -61,10 +61,11 @@ class RigidModeCorrection {
 // indifferent, E has H_E t = 0 for a translation t and, for a rotation,
 // H_E (e_a x (x_i - c))_i = (e_a x grad_i E)_i. Only the elements with a
 // fixed DoF, where Z was cut, need their Hessians (the cut part
-// uncut - P uncut lives on the fixed DoFs). Costs one elastic gradient, those
-// elements' Hessians and 6 auxiliary Hessian products: about 1/6 of
-// differencing the gradient along the 6 modes.
+// uncut - P uncut lives on the fixed DoFs). `elastic_gradient` is grad E(x)
+// (3n; its fixed rows are not read). Costs those elements' Hessians and 6
+// auxiliary Hessian products, far less than differencing the gradient along
+// the 6 modes (6 gradient evaluations).
 MatrixXd RigidModeHessianProducts(SimulatorImpl& sim, const RigidModeCorrection& rigid, const VectorXd& x,
-                                  const VectorXd& inertia);
+                                  const VectorXd& elastic_gradient, const VectorXd& inertia);
 
 }  // namespace diffpd::internal

@@ -148,6 +148,14 @@ StepObjective::StepObjective(SimulatorImpl& sim, VectorXd xhat, VectorXd force, 
 }
 
 
+VectorXd StepObjective::ElasticGradient(const VectorXd& x, const VectorXd& grad) const {
+  VectorXd aux = VectorXd::Zero(x.size());
+  sim_.aux.AddEnergyAndGradient(x, sim_.activation, &aux);
+  VectorXd out = grad - aux - inertia_.cwiseProduct(x - xhat_) + force_;
+  sim_.ZeroFixed(&out);
+  return out;
+}
+
 namespace {
 
 // Per node (n, N): how much one relative rounding of the deformation

@@ -121,6 +121,10 @@ class StepObjective {
   // Diagonal of the inertia term (3n): M / h^2, or zero for a static problem.
   const VectorXd& inertia_diagonal() const { return inertia_; }
   bool is_static() const { return static_; }
+  // grad E(x), the elastic part of grad = grad g(x) as Evaluate returned it,
+  // on the free DoFs (fixed rows zero): grad minus the inertia, explicit
+  // force and auxiliary terms (the last evaluated again; no elastic pass).
+  VectorXd ElasticGradient(const VectorXd& x, const VectorXd& grad) const;
   SimulatorImpl& sim() { return sim_; }
 
   // An optional checkpoint of the forward solve (frictional contact's
