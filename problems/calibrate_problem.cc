@@ -355,6 +355,7 @@ nlohmann::json CalibrationProblem::Report(const std::vector<CalibrationFit>& fit
 int CalibrationProblem::Run(const CommandArgs& args) const {
   if (args.steps > 0 || args.dt > 0)
     throw InvalidInputError("--steps and --dt are fixed by the captured motion of " + name());
+  RefuseSimulatorTuning(args, name());
   FILE* log = args.json ? stderr : stdout;
   const std::string data_path = args.data_file.empty() ? DefaultDataPath() : args.data_file;
   const CapturedMotion motion = ReadCapturedMotion(data_path);

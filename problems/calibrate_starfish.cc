@@ -629,6 +629,7 @@ void StarfishCalibration::ActuationToCoordinates(const StarfishActuation& a, dou
 }
 
 int StarfishCalibration::Run(const CommandArgs& args) const {
+  RefuseSimulatorTuning(args, name());
   if (!args.regions.empty()) {  // a copy with the regions, run without the option
     StarfishCalibration with_regions = *this;
     with_regions.set_regions(ParseStarfishRegions(args.regions));

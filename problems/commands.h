@@ -65,6 +65,10 @@ Subcommand AddTradeoffCommand(CLI::App* parent);  // tradeoff_command.cc
 Subcommand AddStressCommand(CLI::App* parent);    // stress_command.cc
 Subcommand AddSynthCommand(CLI::App* parent);     // synth_command.cc
 
+// Calibration problems fit with the library's PD-LBFGS settings: throws
+// InvalidInputError if --lbfgs-scale or --no-rigid-correction was given.
+void RefuseSimulatorTuning(const CommandArgs& args, const std::string& problem);
+
 // Solver options for a problem from the shared arguments.
 SolverOptions OptionsFromArgs(const CommandArgs& args, double default_dt, double default_rel_tolerance);
 

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "diffpd/error.h"
 #include "problem_registry.h"
 
 namespace diffpd::problems {
@@ -15,6 +16,12 @@ int ListCommand(bool json) {
   }
   if (json) std::printf("%s\n", out.dump(2).c_str());
   return 0;
+}
+
+void RefuseSimulatorTuning(const CommandArgs& args, const std::string& problem) {
+  if (args.lbfgs_weight_scale != SolverOptions().lbfgs_weight_scale || !args.rigid_mode_correction)
+    throw InvalidInputError("--lbfgs-scale and --no-rigid-correction are not used by the calibration problem '" +
+                            problem + "' (it fits with the library's default solver settings)");
 }
 
 SolverOptions OptionsFromArgs(const CommandArgs& args, double default_dt, double default_rel_tolerance) {

@@ -126,6 +126,8 @@ OptimizationReport RunOptimization(const TrajectoryOptimizationProblem& problem,
     options.time_step = problem.time_step(settings.size);
     options.num_threads = settings.threads;
     if (settings.rel_tolerance > 0) options.rel_tolerance = settings.rel_tolerance;
+    options.lbfgs_weight_scale = settings.lbfgs_weight_scale;
+    options.rigid_mode_correction = settings.rigid_mode_correction;
     Simulator sim(problem.MakeScene(settings.size), options);
     Ipopt::SmartPtr<solvers::RolloutNlp> nlp = problem.MakeNlp(&sim, settings.size);
     IpoptOptions ipopt = problem.DefaultIpoptOptions(settings.size);
@@ -291,6 +293,8 @@ int TrajectoryOptimizationProblem::Run(const CommandArgs& args) const {
   settings.compare_newton = args.compare_newton;
   settings.threads = args.threads;
   settings.rel_tolerance = args.rel_tolerance;
+  settings.lbfgs_weight_scale = args.lbfgs_weight_scale;
+  settings.rigid_mode_correction = args.rigid_mode_correction;
   settings.out_dir = args.out_dir.empty() ? DefaultOutputDirectory(name()) : args.out_dir;
   FILE* text = args.json ? stderr : stdout;
   settings.log = text;

@@ -69,6 +69,8 @@ struct OptimizationSettings {
   bool compare_newton = true;   // also solve with newton-cholesky (skipped if that is the main method)
   int threads = 0;              // element-loop threads (0: OpenMP default)
   double rel_tolerance = -1;    // simulator rel_tolerance (-1: the problem's)
+  double lbfgs_weight_scale = SolverOptions().lbfgs_weight_scale;      // SolverOptions' field of that name
+  bool rigid_mode_correction = SolverOptions().rigid_mode_correction;  // SolverOptions' field of that name
   std::string out_dir;          // "": write no files
   FILE* log = stdout;           // Ipopt's iteration log (nullptr: none); not owned
   solvers::IpoptOptions ipopt;  // passed to Ipopt after the problem's defaults

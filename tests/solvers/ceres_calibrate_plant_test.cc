@@ -9,6 +9,7 @@
 
 #include "calibrate_plant.h"
 #include "commands.h"
+#include "diffpd/error.h"
 
 namespace diffpd::problems {
 namespace {
@@ -64,6 +65,24 @@ TEST(CalibratePlantTest, FitOfNoiseFreeMotionRecoversTheTrueMaterial) {
   EXPECT_LT(fit.final_cost, 1e-3 * fit.initial_cost);
   EXPECT_EQ(fit.rollout.num_steps(), 30);
   EXPECT_GT(fit.statistics.forward_seconds, 0.0);
+}
+
+// The simulator-tuning flags of `run` are refused, not silently ignored.
+TEST(CalibratePlantTest, SimulatorTuningFlagsAreRefusedWithAMessage) {
+  const PlantCalibration problem;
+  for (const bool rigid : {false, true}) {
+    CommandArgs args;
+    if (rigid) args.lbfgs_weight_scale = 0.5;
+    else args.rigid_mode_correction = false;
+    try {
+      problem.Run(args);
+      FAIL() << "no throw";
+    } catch (const InvalidInputError& e) {
+      EXPECT_EQ(std::string(e.what()),
+                "--lbfgs-scale and --no-rigid-correction are not used by the calibration problem 'calibrate-plant' (it "
+                "fits with the library's default solver settings)");
+    }
+  }
 }
 
 TEST(CalibratePlantTest, RunWritesTheJsonReportAndItsFiles) {
