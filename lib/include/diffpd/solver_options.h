@@ -112,9 +112,9 @@ struct SolverOptions {
   // while H resists it with inertia alone, so free bodies converge slowly
   // without it (rolling sphere: forward iterations per step 39.7 -> 20.1,
   // backward 35.5 -> 18.9, and smaller errors at the same tolerance;
-  // README). Costs per solve one elastic gradient, the Hessians of the
-  // elements at contact pins and 6 Hessian products (backward), and 12
-  // vector passes per iteration. Clamped bodies never use it: their cut
+  // README). Costs per solve the Hessians of the elements at contact pins
+  // (forward; grad E comes from the solve's first gradient) or 6 Hessian
+  // products (backward), and 12 vector passes per iteration. Clamped bodies never use it: their cut
   // rigid modes are not soft (cantilever: 5% fewer iterations but 3-6x
   // larger errors at the same tolerance, README). Dynamic steps only.
   bool rigid_mode_correction = true;

@@ -59,13 +59,13 @@ class ElasticForces {
   // is replaced by its projection onto the PSD cone (negative eigenvalues
   // clamped to zero), the definiteness fix of Newton. Depends on x only (the
   // SVDs are cold started).
+  void ElementHessians(const VectorXd& x, const LameField& lame, bool project_spd, std::vector<double>* blocks,
+                       int threads);
   // out += sum over the listed elements of K_e z_e for each column of z
   // (3n x P): the element Hessians at x (not projected), computed for those
   // elements only (serial; for a few elements, e.g. those around fixed nodes).
   void AddElementHessianProducts(const VectorXd& x, const LameField& lame, const std::vector<int>& elements,
                                  const MatrixXd& z, MatrixXd* out);
-  void ElementHessians(const VectorXd& x, const LameField& lame, bool project_spd, std::vector<double>* blocks,
-                       int threads);
   // The upper triangle of each (symmetric) element block by 3 x 3 node
   // blocks, interleaved across groups of elements (layout in
   // packed_element_matrices.h; 1296 of 2304 bytes per hexahedron).

@@ -15,8 +15,9 @@
 // matrix. P^-1 is symmetric positive definite (A^-1 is, the correction is
 // positive semi-definite), so it is a valid L-BFGS initial inverse Hessian
 // and CG preconditioner. E = Z^T H Z's non-positive eigenvalues (H indefinite
-// along a mode) are dropped from the pseudo-inverse. Clamped bodies gain
-// little (their rigid modes are blocked), free ones much (README).
+// along a mode) are dropped from the pseudo-inverse. Used for bodies without
+// Dirichlet DoFs only (SimulatorImpl::UseRigidModeCorrection): a clamped
+// body's cut modes are not soft, and there it cost accuracy (README).
 #pragma once
 
 #include <vector>

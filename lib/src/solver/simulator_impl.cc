@@ -147,7 +147,6 @@ StepObjective::StepObjective(SimulatorImpl& sim, VectorXd xhat, VectorXd force, 
   inertia_ = static_problem ? VectorXd::Zero(sim.num_dofs()) : VectorXd(sim.Mass() / (sim.h() * sim.h()));
 }
 
-
 VectorXd StepObjective::ElasticGradient(const VectorXd& x, const VectorXd& grad) const {
   VectorXd aux = VectorXd::Zero(x.size());
   sim_.aux.AddEnergyAndGradient(x, sim_.activation, &aux);

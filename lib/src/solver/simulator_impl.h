@@ -219,8 +219,8 @@ class StepLinearization {
   VectorXd x_;
   bool static_;
   VectorXd inertia_;
-  // Elastic element Hessians at x_ (ElasticForces::ElementHessians, not
-  // projected), packed: every product with H uses them.
+  // Elastic element Hessians at x_, not projected, packed
+  // (ElasticForces::PackedElementHessians): every product with H uses them.
   std::vector<double> packed_blocks_;
   SparseMatrix matrix_;  // assembled exact H (lazily)
   bool have_matrix_ = false;
