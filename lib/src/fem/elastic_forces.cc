@@ -17,6 +17,7 @@ namespace diffpd::internal {
 namespace {
 
 constexpr int kMinParallelElements = 256;
+constexpr int kMaxSamplesPerElement = 8;  // hexahedra's 2 x 2 x 2 Gauss points
 
 // Runs body(e) for e in [0, m) in parallel and rethrows the first exception
 // after the loop (exceptions must not leave an OpenMP region).
@@ -128,6 +129,8 @@ ElasticForces::ElasticForces(const FemModel& fem, std::vector<ElasticEnergy> ene
     : fem_(fem), energies_(std::move(energies)) {
   for (const ElasticEnergy e : energies_) all_projective_ = all_projective_ && IsProjective(e);
   needs_svd_ = AnyNeedsSvd(energies_);
+  coefficient_form_ = !energies_.empty();
+  for (const ElasticEnergy e : energies_) coefficient_form_ = coefficient_form_ && NeedsSvd(e);
   for (const ElasticEnergy e : energies_) {
     rotation_terms_ += e == ElasticEnergy::kPdCorotated;
     volume_terms_ += e == ElasticEnergy::kPdVolume;
@@ -401,6 +404,54 @@ void ElasticForces::PackedElementHessiansImpl(const VectorXd& x, const LameField
   const int q_per = fem_.samples_per_element(), m = fem_.num_elements();
   const int groups = (m + kElementLanes - 1) / kElementLanes;
   packed->assign(static_cast<size_t>(groups) * PackedEntries(K) * kElementLanes, 0.0);
+  if (coefficient_form_) {
+    DIFFPD_CHECK(q_per <= kMaxSamplesPerElement, "PackedElementHessians: " << q_per << " samples per element");
+    // Lane by lane over each group's elements, one sample index at a time:
+    // the decompositions in SVD batches, the differential coefficients per
+    // sample, then AddPackedSampleStiffness.
+    const int per_batch = std::max(1, kSvdBatch / q_per);
+    ParallelForElements(
+        groups, threads,
+        [&](int g) {
+          const int e0 = g * kElementLanes, count = std::min(kElementLanes, m - e0);
+          Mat3 F[kElementLanes * kMaxSamplesPerElement];
+          Svd3 svd[kElementLanes * kMaxSamplesPerElement];
+          VolumeProjection volume[kElementLanes * kMaxSamplesPerElement];
+          for (int j = 0; j < count; j += per_batch)
+            SampleDecompositions<K>(x, e0 + j, std::min(per_batch, count - j), F + j * q_per, svd + j * q_per,
+                                    volume + j * q_per, /*warm_start=*/false);
+          PackedSampleLanes lanes{};  // lanes without an element stay zero
+          double* out = packed->data() + static_cast<size_t>(g) * PackedEntries(K) * kElementLanes;
+          for (int q = 0; q < q_per; ++q) {
+            for (int j = 0; j < count; ++j) {
+              const int e = e0 + j, i = j * q_per + q, sample = e * q_per + q;
+              IsotropicDifferentialCoefficients sum;
+              for (const ElasticEnergy energy : energies_) {
+                const IsotropicDifferentialCoefficients c = StressDifferentialCoefficients(
+                    energy, svd[i], lame.mu_of(e), lame.lambda_of(e), needs_volume_ ? &volume[i] : nullptr);
+                sum.dp_dsigma += c.dp_dsigma;
+                sum.symmetric += c.symmetric;
+                sum.skew += c.skew;
+              }
+              for (int k = 0; k < 9; ++k) {
+                lanes.u[k][j] = svd[i].U(k);
+                lanes.v[k][j] = svd[i].V(k);
+                lanes.dp_dsigma[k][j] = sum.dp_dsigma(k);
+              }
+              for (int k = 0; k < 3; ++k) {
+                lanes.symmetric[k][j] = sum.symmetric(k);
+                lanes.skew[k][j] = sum.skew(k);
+              }
+              lanes.volume[j] = fem_.sample_volume(sample);
+              const double* grad = fem_.grad(sample);
+              for (int k = 0; k < 3 * K; ++k) lanes.grad[k][j] = grad[k];
+            }
+            AddPackedSampleStiffness(K, lanes, out);
+          }
+        },
+        std::max(1, kMinParallelElements / kElementLanes));
+    return;
+  }
   ParallelForSampleBatches(m, q_per, threads, [&](int e0, int count) {
     Mat3 F[kSvdBatch];
     Svd3 svd[kSvdBatch];

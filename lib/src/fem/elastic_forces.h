@@ -134,6 +134,9 @@ class ElasticForces {
   bool all_projective_ = true;
   bool needs_svd_ = false;
   bool needs_volume_ = false;  // pd-volume declared (volume_terms_ > 0)
+  // Every energy's stress differential is isotropic-coefficient based
+  // (NeedsSvd): PackedElementHessians runs lane by lane (AddPackedSampleStiffness).
+  bool coefficient_form_ = false;
   std::vector<double> element_buffer_;  // 3 * K per element
   std::vector<double> element_energy_;  // per element
   std::vector<double> element_dot_;     // per element (PartLameDots' lambda dots)
