@@ -190,8 +190,8 @@ struct SpinRun {
   int forward_iterations = 0;
 };
 
-SpinRun Simulate(bool rigid) {
-  Simulator sim(FreeBlockScene(), LbfgsOptions(rigid));
+SpinRun Simulate(const SolverOptions& options) {
+  Simulator sim(FreeBlockScene(), options);
   const int steps = 6;
   SpinRun run;
   run.rollout = sim.Simulate(SpinningStart(sim), std::vector<StepInput>(steps));
@@ -205,7 +205,7 @@ SpinRun Simulate(bool rigid) {
 }
 
 TEST(RigidModeCorrectionTest, SpinningFreeBodyConvergesInFewerIterationsToTheSameResult) {
-  const SpinRun plain = Simulate(false), corrected = Simulate(true);
+  const SpinRun plain = Simulate(LbfgsOptions(false)), corrected = Simulate(LbfgsOptions(true));
   // Measured (6 steps): forward 288 -> 197 iterations, backward 272 -> 199;
   // a correction that did nothing would leave them equal.
   EXPECT_LT(corrected.forward_iterations, 0.8 * plain.forward_iterations)
@@ -219,8 +219,18 @@ TEST(RigidModeCorrectionTest, SpinningFreeBodyConvergesInFewerIterationsToTheSam
   EXPECT_LT((xa - xb).norm(), 1e-7 * travel);
   EXPECT_LT((plain.gradient.x0 - corrected.gradient.x0).norm(), 1e-6 * plain.gradient.x0.norm());
   EXPECT_LT((plain.gradient.v0 - corrected.gradient.v0).norm(), 1e-6 * plain.gradient.v0.norm());
-  EXPECT_NEAR(corrected.gradient.youngs_modulus, plain.gradient.youngs_modulus,
-              1e-6 * std::abs(plain.gradient.youngs_modulus));
+  // The modulus gradient is a sum with cancellation: at these tolerances
+  // each run's is within ~1e-6 of the converged value (measured: plain
+  // 3.7e-7, corrected 8.3e-7 relative to Newton-Cholesky at 1e-12), so each
+  // is checked against that reference rather than against the other.
+  SolverOptions converged = LbfgsOptions(false);
+  converged.method = Method::kNewtonCholesky;
+  converged.rel_tolerance = converged.backward_rel_tolerance = 1e-12;
+  converged.abs_tolerance = 1e-14;
+  const double reference = Simulate(converged).gradient.youngs_modulus;
+  for (const SpinRun* run : {&plain, &corrected})
+    EXPECT_NEAR(run->gradient.youngs_modulus, reference, 2e-6 * std::abs(reference))
+        << (run == &plain ? "without" : "with") << " the correction";
 }
 
 // A clamped body's cut rigid modes are not soft: the option leaves it alone

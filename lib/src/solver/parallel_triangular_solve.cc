@@ -155,6 +155,9 @@ std::unique_ptr<ParallelTriangularSolve> ParallelTriangularSolve::Create(int n, 
       for (int k = 0; k < b.width; ++k) {
         const Column c = column(b.col + k);  // rows: b.col + k .. b.col + width - 1, then the block's rows
         for (int q = 0; q < b.width - k; ++q) s->triangle_[b.triangle_at + k * b.width + k + q] = c.values[q];
+        // The diagonal is kept as its reciprocal: the solves multiply
+        // (a division per column and right-hand side is on the critical path).
+        s->triangle_[b.triangle_at + k * b.width + k] = 1.0 / c.values[0];
         for (int r = 0; r < b.num_rows; ++r)
           s->values_[b.values_at + static_cast<long>(r) * b.width + k] = c.values[b.width - k + r];
       }
@@ -215,7 +218,7 @@ struct BlockKernel {
     for (int k = 0; k < W; ++k)
       for (int d = 0; d < K; ++d) v[k][d] = yc[K * k + d];
     for (int k = 0; k < W; ++k) {
-      const double inv = 1.0 / tri[k * W + k];
+      const double inv = tri[k * W + k];  // 1 / L(k, k)
       for (int d = 0; d < K; ++d) v[k][d] *= inv;
       for (int k2 = k + 1; k2 < W; ++k2)
         for (int d = 0; d < K; ++d) v[k2][d] -= tri[k * W + k2] * v[k][d];
@@ -248,7 +251,7 @@ struct BlockKernel {
       for (int d = 0; d < K; ++d) {
         double t = yc[K * k + d] - a[k][d];
         for (int k2 = k + 1; k2 < W; ++k2) t -= tri[k * W + k2] * yc[K * k2 + d];
-        yc[K * k + d] = t / tri[k * W + k];
+        yc[K * k + d] = t * tri[k * W + k];  // tri's diagonal holds 1 / L(k, k)
       }
     }
   }

@@ -68,7 +68,7 @@ class ParallelTriangularSolve {
     int num_own_rows;  // in a subtree task: the leading rows inside its subtree
     long rows_at;      // into rows_
     long values_at;    // into values_: num_rows x width, row-major
-    long triangle_at;  // into triangle_: width x width, column-major
+    long triangle_at;  // into triangle_: width x width, column-major, 1 / L(k, k) on the diagonal
   };
   using Range = std::pair<int, int>;  // blocks [first, second)
 
