@@ -260,7 +260,8 @@ TEST(ElasticForcesTest, PackedHessiansFromPositionsMatchThePackedDenseBlocks) {
   const double mu = 7e4, lambda = 2.8e5;
   using E = ElasticEnergy;
   const std::vector<std::vector<E>> sets = {
-      {E::kPdCorotated, E::kPdVolume}, {E::kCorotated}, {E::kPdCorotated}, {E::kNeoHookean}, {E::kCorotated, E::kLinear}};
+      {E::kPdCorotated, E::kPdVolume}, {E::kCorotated}, {E::kPdCorotated}, {E::kNeoHookean},
+      {E::kCorotated, E::kLinear}};
   for (const bool tets : {false, true}) {
     for (const auto& energies : sets) {
       Scene scene = testing::SmallBeamScene(tets, energies);

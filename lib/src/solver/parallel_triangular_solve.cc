@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <numeric>
-#include <type_traits>
 
 #include "diffpd/error.h"
+#include "material/simd_dispatch.h"
 
 namespace diffpd::internal {
 namespace {
@@ -18,6 +18,10 @@ namespace {
 constexpr double kMinParallelEntries = 40000;
 // Subtrees split at most this often while searching the partition.
 constexpr int kMaxSplits = 64;
+// The rectangles' rows are processed kRowLanes at a time (vector lanes); each
+// column is padded with zeros to a multiple of it.
+constexpr int kRowLanes = 8;
+inline int PaddedRows(int rows) { return (rows + kRowLanes - 1) / kRowLanes * kRowLanes; }
 
 bool IsLowerFactor(int n, const std::function<ParallelTriangularSolve::Column(int)>& column) {
   for (int j = 0; j < n; ++j) {
@@ -148,9 +152,11 @@ std::unique_ptr<ParallelTriangularSolve> ParallelTriangularSolve::Create(int n, 
       b.num_own_rows = b.num_rows;
       b.rows_at = static_cast<long>(s->rows_.size());
       b.values_at = static_cast<long>(s->values_.size());
+      b.values_by_row_at = static_cast<long>(s->values_by_row_.size());
       b.triangle_at = static_cast<long>(s->triangle_.size());
       s->rows_.insert(s->rows_.end(), lead.rows + b.width, lead.rows + lead.count);
-      s->values_.resize(s->values_.size() + static_cast<size_t>(b.num_rows) * b.width);
+      s->values_.resize(s->values_.size() + static_cast<size_t>(PaddedRows(b.num_rows)) * b.width, 0.0);
+      s->values_by_row_.resize(s->values_by_row_.size() + static_cast<size_t>(b.num_rows) * b.width);
       s->triangle_.resize(s->triangle_.size() + static_cast<size_t>(b.width) * b.width, 0.0);
       for (int k = 0; k < b.width; ++k) {
         const Column c = column(b.col + k);  // rows: b.col + k .. b.col + width - 1, then the block's rows
@@ -158,8 +164,10 @@ std::unique_ptr<ParallelTriangularSolve> ParallelTriangularSolve::Create(int n, 
         // The diagonal is kept as its reciprocal: the solves multiply
         // (a division per column and right-hand side is on the critical path).
         s->triangle_[b.triangle_at + k * b.width + k] = 1.0 / c.values[0];
-        for (int r = 0; r < b.num_rows; ++r)
-          s->values_[b.values_at + static_cast<long>(r) * b.width + k] = c.values[b.width - k + r];
+        for (int r = 0; r < b.num_rows; ++r) {
+          s->values_[b.values_at + static_cast<long>(k) * PaddedRows(b.num_rows) + r] = c.values[b.width - k + r];
+          s->values_by_row_[b.values_by_row_at + static_cast<long>(r) * b.width + k] = c.values[b.width - k + r];
+        }
       }
       s->blocks_.push_back(b);
     }
@@ -205,105 +213,220 @@ std::unique_ptr<ParallelTriangularSolve> ParallelTriangularSolve::Create(int n, 
 
 namespace {
 
-// One block of width W (compile time: the loops unroll) for K right-hand
-// sides, y row-interleaved (row i at y[K i]).
-template <int K, int W>
-struct BlockKernel {
-  // Forward: solves the triangle for the block's rows of y, then subtracts
-  // the block's rows times them, rows [0, own) from y and [own, num_rows)
-  // from top_buffer at top_slot[row].
-  static void Forward(const double* tri, const int* rows, const double* values, int num_rows, int own, double* y,
-                      double* yc, double* top_buffer, const int* top_slot) {
-    double v[W][K];
-    for (int k = 0; k < W; ++k)
-      for (int d = 0; d < K; ++d) v[k][d] = yc[K * k + d];
-    for (int k = 0; k < W; ++k) {
-      const double inv = tri[k * W + k];  // 1 / L(k, k)
-      for (int d = 0; d < K; ++d) v[k][d] *= inv;
-      for (int k2 = k + 1; k2 < W; ++k2)
-        for (int d = 0; d < K; ++d) v[k2][d] -= tri[k * W + k2] * v[k][d];
-    }
-    for (int k = 0; k < W; ++k)
-      for (int d = 0; d < K; ++d) yc[K * k + d] = v[k][d];
-    const auto update = [&](int r, double* dst) {
-      const double* l = values + static_cast<long>(r) * W;
-      for (int d = 0; d < K; ++d) {
-        double a = 0;
-        for (int k = 0; k < W; ++k) a += l[k] * v[k][d];
-        dst[d] -= a;
-      }
-    };
-    for (int r = 0; r < own; ++r) update(r, y + static_cast<long>(K) * rows[r]);
-    for (int r = own; r < num_rows; ++r) update(r, top_buffer + static_cast<long>(K) * top_slot[rows[r]]);
-  }
-  // Backward: subtracts the block's rows (transposed) times x, then solves
-  // the transposed triangle.
-  static void Backward(const double* tri, const int* rows, const double* values, int num_rows, const double* y,
-                       double* yc) {
-    double a[W][K] = {};
-    for (int r = 0; r < num_rows; ++r) {
-      const double* l = values + static_cast<long>(r) * W;
-      const double* xr = y + static_cast<long>(K) * rows[r];
-      for (int k = 0; k < W; ++k)
-        for (int d = 0; d < K; ++d) a[k][d] += l[k] * xr[d];
-    }
-    for (int k = W - 1; k >= 0; --k) {
-      for (int d = 0; d < K; ++d) {
-        double t = yc[K * k + d] - a[k][d];
-        for (int k2 = k + 1; k2 < W; ++k2) t -= tri[k * W + k2] * yc[K * k2 + d];
-        yc[K * k + d] = t * tri[k * W + k];  // tri's diagonal holds 1 / L(k, k)
-      }
-    }
-  }
-};
+// kRowLanes doubles as one value (GCC/Clang vector extension): each clone
+// (simd_dispatch.h) maps it to its widest registers; the baseline splits it.
+typedef double RowLanes __attribute__((vector_size(8 * kRowLanes)));
+typedef double RowLanesUnaligned __attribute__((vector_size(8 * kRowLanes), aligned(8)));
 
-// Calls body(std::integral_constant<int, w>) for w in [1, 8].
-template <class Body>
-void WithWidth(int w, Body&& body) {
-  switch (w) {
-    case 1: body(std::integral_constant<int, 1>()); break;
-    case 2: body(std::integral_constant<int, 2>()); break;
-    case 3: body(std::integral_constant<int, 3>()); break;
-    case 4: body(std::integral_constant<int, 4>()); break;
-    case 5: body(std::integral_constant<int, 5>()); break;
-    case 6: body(std::integral_constant<int, 6>()); break;
-    case 7: body(std::integral_constant<int, 7>()); break;
-    default: body(std::integral_constant<int, 8>()); break;
+// (Through a pointer: returning the type by value would warn that its ABI
+// differs between the clones.)
+DIFFPD_SIMD_INLINE void LoadRowLanes(const double* p, RowLanes* out) {
+  *out = *reinterpret_cast<const RowLanesUnaligned*>(p);
+}
+
+// One block of W columns for K right-hand sides, y row-interleaved (row i at
+// y[K i]). The rectangle is column-major with each column padded with zeros
+// to a multiple of kRowLanes rows (PaddedRows), so both products run on
+// groups of kRowLanes rows as vector operations.
+// Forward: solves the triangle for the block's rows of y, then subtracts the
+// rectangle times them, rows [0, own) from y and [own, num_rows) from
+// top_buffer at top_slot[row].
+template <int K, int W>
+DIFFPD_SIMD_INLINE void ForwardBlock(const double* tri, const int* rows, const double* values, int num_rows, int own,
+                                     double* y, double* yc, double* top_buffer, const int* top_slot) {
+  double v[W][K];
+  for (int k = 0; k < W; ++k)
+    for (int d = 0; d < K; ++d) v[k][d] = yc[K * k + d];
+  for (int k = 0; k < W; ++k) {
+    const double inv = tri[k * W + k];  // 1 / L(k, k)
+    for (int d = 0; d < K; ++d) v[k][d] *= inv;
+    for (int k2 = k + 1; k2 < W; ++k2)
+      for (int d = 0; d < K; ++d) v[k2][d] -= tri[k * W + k2] * v[k][d];
+  }
+  for (int k = 0; k < W; ++k)
+    for (int d = 0; d < K; ++d) yc[K * k + d] = v[k][d];
+  const int ld = PaddedRows(num_rows);
+  for (int r0 = 0; r0 < num_rows; r0 += kRowLanes) {
+    RowLanes acc[K] = {};
+    for (int k = 0; k < W; ++k) {
+      RowLanes l;
+      LoadRowLanes(values + static_cast<long>(k) * ld + r0, &l);
+      for (int d = 0; d < K; ++d) acc[d] += l * v[k][d];
+    }
+    const int count = std::min(kRowLanes, num_rows - r0);
+    for (int i = 0; i < count; ++i) {
+      const int r = r0 + i, row = rows[r];
+      double* dst = r < own ? y + static_cast<long>(K) * row : top_buffer + static_cast<long>(K) * top_slot[row];
+      for (int d = 0; d < K; ++d) dst[d] -= acc[d][i];
+    }
   }
 }
-static_assert(ParallelTriangularSolve::kBlockWidth == 8, "WithWidth covers widths 1..8");
+
+// Backward: subtracts the rectangle (transposed) times x, then solves the
+// transposed triangle. Reads the row-major copy of the rectangle: a full-width
+// row (W = kRowLanes) is one vector, so each row costs K vector
+// multiply-adds with no sums across lanes.
+template <int K, int W>
+DIFFPD_SIMD_INLINE void BackwardBlock(const double* tri, const int* rows, const double* values_by_row, int num_rows,
+                                      const double* y, double* yc) {
+  // Two sets of accumulators (even and odd rows): each sum is a chain of
+  // dependent multiply-adds, so two chains per entry halve the latency bound.
+  double a[W][K] = {};
+  if constexpr (W == kRowLanes) {
+    RowLanes even[K] = {}, odd[K] = {};  // [d][k]
+    int r = 0;
+    for (; r + 1 < num_rows; r += 2) {
+      RowLanes l0;
+      LoadRowLanes(values_by_row + static_cast<long>(r) * W, &l0);
+      RowLanes l1;
+      LoadRowLanes(values_by_row + static_cast<long>(r + 1) * W, &l1);
+      const double* x0 = y + static_cast<long>(K) * rows[r];
+      const double* x1 = y + static_cast<long>(K) * rows[r + 1];
+      for (int d = 0; d < K; ++d) {
+        even[d] += l0 * x0[d];
+        odd[d] += l1 * x1[d];
+      }
+    }
+    if (r < num_rows) {
+      RowLanes l0;
+      LoadRowLanes(values_by_row + static_cast<long>(r) * W, &l0);
+      const double* x0 = y + static_cast<long>(K) * rows[r];
+      for (int d = 0; d < K; ++d) even[d] += l0 * x0[d];
+    }
+    for (int d = 0; d < K; ++d) even[d] += odd[d];
+    for (int k = 0; k < W; ++k)
+      for (int d = 0; d < K; ++d) a[k][d] = even[d][k];
+  } else {
+    double odd[W][K] = {};
+    int r = 0;
+    for (; r + 1 < num_rows; r += 2) {
+      const double* l0 = values_by_row + static_cast<long>(r) * W;
+      const double* x0 = y + static_cast<long>(K) * rows[r];
+      const double* x1 = y + static_cast<long>(K) * rows[r + 1];
+      for (int k = 0; k < W; ++k)
+        for (int d = 0; d < K; ++d) {
+          a[k][d] += l0[k] * x0[d];
+          odd[k][d] += l0[W + k] * x1[d];
+        }
+    }
+    if (r < num_rows) {
+      const double* l0 = values_by_row + static_cast<long>(r) * W;
+      const double* x0 = y + static_cast<long>(K) * rows[r];
+      for (int k = 0; k < W; ++k)
+        for (int d = 0; d < K; ++d) a[k][d] += l0[k] * x0[d];
+    }
+    for (int k = 0; k < W; ++k)
+      for (int d = 0; d < K; ++d) a[k][d] += odd[k][d];
+  }
+  for (int k = W - 1; k >= 0; --k) {
+    for (int d = 0; d < K; ++d) {
+      double t = yc[K * k + d] - a[k][d];
+      for (int k2 = k + 1; k2 < W; ++k2) t -= tri[k * W + k2] * yc[K * k2 + d];
+      yc[K * k + d] = t * tri[k * W + k];  // tri's diagonal holds 1 / L(k, k)
+    }
+  }
+}
+
+// The kernels for a block of width w (1..kBlockWidth), compile-time widths:
+// a switch, not a lambda, so that everything stays inlined in the caller's
+// clone (simd_dispatch.h).
+static_assert(ParallelTriangularSolve::kBlockWidth == 8, "the switches cover widths 1..8");
+#define DIFFPD_WIDTH_CASES(CALL) \
+  switch (w) {                   \
+    case 1: CALL(1); break;      \
+    case 2: CALL(2); break;      \
+    case 3: CALL(3); break;      \
+    case 4: CALL(4); break;      \
+    case 5: CALL(5); break;      \
+    case 6: CALL(6); break;      \
+    case 7: CALL(7); break;      \
+    default: CALL(8); break;     \
+  }
+
+template <int K>
+DIFFPD_SIMD_INLINE void ForwardBlockK(const double* tri, int w, const int* rows, const double* values, int num_rows,
+                                      int own, double* y, double* yc, double* top_buffer, const int* top_slot) {
+#define DIFFPD_FORWARD(W) ForwardBlock<K, W>(tri, rows, values, num_rows, own, y, yc, top_buffer, top_slot)
+  DIFFPD_WIDTH_CASES(DIFFPD_FORWARD)
+#undef DIFFPD_FORWARD
+}
+
+template <int K>
+DIFFPD_SIMD_INLINE void BackwardBlockK(const double* tri, int w, const int* rows, const double* values, int num_rows,
+                                       const double* y, double* yc) {
+#define DIFFPD_BACKWARD(W) BackwardBlock<K, W>(tri, rows, values, num_rows, y, yc)
+  DIFFPD_WIDTH_CASES(DIFFPD_BACKWARD)
+#undef DIFFPD_BACKWARD
+}
+#undef DIFFPD_WIDTH_CASES
+
+// The arrays the block kernels read (not owned).
+struct FactorArrays {
+  const ParallelTriangularSolve::Block* blocks;
+  const double* triangle;
+  const int* rows;
+  const double* values;         // column-major rectangles
+  const double* values_by_row;  // row-major rectangles
+  const int* top_slot;
+};
+
+template <int K>
+DIFFPD_SIMD_INLINE void ForwardBlocksK(const FactorArrays& f, int first, int last, double* y, double* top_buffer) {
+  for (int bi = first; bi < last; ++bi) {
+    const ParallelTriangularSolve::Block& b = f.blocks[bi];
+    ForwardBlockK<K>(f.triangle + b.triangle_at, b.width, f.rows + b.rows_at, f.values + b.values_at, b.num_rows,
+                     top_buffer ? b.num_own_rows : b.num_rows, y, y + static_cast<long>(K) * b.col, top_buffer,
+                     f.top_slot);
+  }
+}
+
+template <int K>
+DIFFPD_SIMD_INLINE void BackwardBlocksK(const FactorArrays& f, int first, int last, double* y) {
+  for (int bi = last - 1; bi >= first; --bi) {
+    const ParallelTriangularSolve::Block& b = f.blocks[bi];
+    BackwardBlockK<K>(f.triangle + b.triangle_at, b.width, f.rows + b.rows_at, f.values_by_row + b.values_by_row_at,
+                      b.num_rows, y, y + static_cast<long>(K) * b.col);
+  }
+}
+
+// Forward substitution over blocks [first, last) in ascending order, and the
+// backward over them in descending order, for K = 1..4 right-hand sides; one
+// clone per vector width (simd_dispatch.h), called per range of blocks.
+DIFFPD_SIMD_CLONES
+void ForwardBlocks(int k_rhs, const FactorArrays& f, int first, int last, double* y, double* top_buffer) {
+  switch (k_rhs) {
+    case 1: ForwardBlocksK<1>(f, first, last, y, top_buffer); break;
+    case 2: ForwardBlocksK<2>(f, first, last, y, top_buffer); break;
+    case 3: ForwardBlocksK<3>(f, first, last, y, top_buffer); break;
+    default: ForwardBlocksK<4>(f, first, last, y, top_buffer); break;
+  }
+}
+
+DIFFPD_SIMD_CLONES
+void BackwardBlocks(int k_rhs, const FactorArrays& f, int first, int last, double* y) {
+  switch (k_rhs) {
+    case 1: BackwardBlocksK<1>(f, first, last, y); break;
+    case 2: BackwardBlocksK<2>(f, first, last, y); break;
+    case 3: BackwardBlocksK<3>(f, first, last, y); break;
+    default: BackwardBlocksK<4>(f, first, last, y); break;
+  }
+}
 
 }  // namespace
 
 template <int K>
-void ParallelTriangularSolve::Forward(const Block& block, double* y, double* top_buffer) const {
-  WithWidth(block.width, [&](auto width) {
-    BlockKernel<K, decltype(width)::value>::Forward(
-        triangle_.data() + block.triangle_at, rows_.data() + block.rows_at, values_.data() + block.values_at,
-        block.num_rows, top_buffer ? block.num_own_rows : block.num_rows, y, y + static_cast<long>(K) * block.col,
-        top_buffer, top_slot_.data());
-  });
-}
-
-template <int K>
-void ParallelTriangularSolve::Backward(const Block& block, double* y) const {
-  WithWidth(block.width, [&](auto width) {
-    BlockKernel<K, decltype(width)::value>::Backward(triangle_.data() + block.triangle_at, rows_.data() + block.rows_at,
-                                                     values_.data() + block.values_at, block.num_rows, y,
-                                                     y + static_cast<long>(K) * block.col);
-  });
-}
-
-template <int K>
 void ParallelTriangularSolve::SolveColumns(const double* b, double* x) const {
+  static_assert(K >= 1 && K <= 4, "1 to 4 right-hand sides per solve");
+  const FactorArrays f{blocks_.data(), triangle_.data(), rows_.data(),
+                       values_.data(), values_by_row_.data(), top_slot_.data()};
   const int n = n_;
   std::vector<double> y(static_cast<size_t>(K) * n);
   for (int i = 0; i < n; ++i)
     for (int d = 0; d < K; ++d) y[K * i + d] = b[perm_[i] + static_cast<long>(d) * n];
   const int num_blocks = static_cast<int>(blocks_.size());
   if (num_threads_ == 1) {
-    for (int bi = 0; bi < num_blocks; ++bi) Forward<K>(blocks_[bi], y.data(), nullptr);
-    for (int bi = num_blocks - 1; bi >= 0; --bi) Backward<K>(blocks_[bi], y.data());
+    ForwardBlocks(K, f, 0, num_blocks, y.data(), nullptr);
+    BackwardBlocks(K, f, 0, num_blocks, y.data());
   } else {
     const int threads = num_threads_;
     std::vector<double> buffers(static_cast<size_t>(threads) * K * num_top_rows_, 0.0);
@@ -314,8 +437,7 @@ void ParallelTriangularSolve::SolveColumns(const double* b, double* x) const {
     {
       for (int t = omp_get_thread_num(); t < threads; t += omp_get_num_threads())
         for (const int task : thread_tasks_[t])
-          for (int bi = tasks_[task].first; bi < tasks_[task].second; ++bi)
-            Forward<K>(blocks_[bi], y.data(), buffers.data() + t * buffer_size);
+          ForwardBlocks(K, f, tasks_[task].first, tasks_[task].second, y.data(), buffers.data() + t * buffer_size);
     }
     for (const Range& range : top_) {
       for (int bi = range.first; bi < range.second; ++bi) {
@@ -325,16 +447,16 @@ void ParallelTriangularSolve::SolveColumns(const double* b, double* x) const {
           for (int t = 0; t < threads; ++t)
             for (int d = 0; d < K; ++d) y[K * (block.col + k) + d] += buffers[t * buffer_size + slot + d];
         }
-        Forward<K>(block, y.data(), nullptr);
+        ForwardBlocks(K, f, bi, bi + 1, y.data(), nullptr);
       }
     }
     for (auto range = top_.rbegin(); range != top_.rend(); ++range)
-      for (int bi = range->second - 1; bi >= range->first; --bi) Backward<K>(blocks_[bi], y.data());
+      BackwardBlocks(K, f, range->first, range->second, y.data());
 #pragma omp parallel num_threads(threads)
     {
       for (int t = omp_get_thread_num(); t < threads; t += omp_get_num_threads())
         for (const int task : thread_tasks_[t])
-          for (int bi = tasks_[task].second - 1; bi >= tasks_[task].first; --bi) Backward<K>(blocks_[bi], y.data());
+          BackwardBlocks(K, f, tasks_[task].first, tasks_[task].second, y.data());
     }
   }
   for (int i = 0; i < n; ++i)
@@ -345,7 +467,7 @@ std::size_t ParallelTriangularSolve::bytes() const {
   std::size_t tasks = 0;
   for (const std::vector<int>& t : thread_tasks_) tasks += t.capacity() * sizeof(int);
   return perm_.capacity() * sizeof(int) + blocks_.capacity() * sizeof(Block) + rows_.capacity() * sizeof(int) +
-         values_.capacity() * sizeof(double) + triangle_.capacity() * sizeof(double) +
+         (values_.capacity() + values_by_row_.capacity() + triangle_.capacity()) * sizeof(double) +
          (tasks_.capacity() + top_.capacity()) * sizeof(Range) + tasks + top_slot_.capacity() * sizeof(int);
 }
 
