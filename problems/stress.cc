@@ -222,6 +222,7 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
     so.abs_tolerance = options.abs_tolerance > 0 ? options.abs_tolerance : AutoAbsTolerance(scene, time_step);
     so.num_threads = options.threads;
     so.max_iterations = options.max_iterations;
+    so.rigid_mode_correction = options.rigid_mode_correction;
     Simulator sim(scene, so);
     const int steps = options.steps;
     const VectorXd mass = sim.LumpedMass();

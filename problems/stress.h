@@ -59,6 +59,9 @@ struct StressOptions {
   // Allowed relative error of the check (CheckStressGradient's tolerance).
   double gradcheck_tolerance = 1e-4;
   std::uint64_t seed = 20211;
+  // SolverOptions::rigid_mode_correction of every case (used by PD-LBFGS and
+  // the PD backward on bodies without Dirichlet DoFs: the falling cube).
+  bool rigid_mode_correction = true;
 
   // Throws InvalidInputError naming the field, its value and the valid range.
   void Validate() const;

@@ -122,6 +122,8 @@ Subcommand AddStressCommand(CLI::App* parent) {
   cmd->add_option("--gradcheck-tol", o.gradcheck_tolerance, "allowed relative error of the gradient check")
       ->capture_default_str();
   cmd->add_option("--seed", o.seed, "seed of the loss and check directions")->capture_default_str();
+  cmd->add_flag("--no-rigid-correction{false}", o.rigid_mode_correction,
+                "pd-lbfgs and the PD backward: without the rigid modes' coarse correction");
   cmd->add_flag("--json", args->json, "print one JSON document (a list) on stdout");
   return {cmd, [args] { return RunStressArgs(*args); }};
 }
