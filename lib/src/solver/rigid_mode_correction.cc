@@ -1,5 +1,7 @@
 #include "solver/rigid_mode_correction.h"
 
+#include <algorithm>
+
 #include <Eigen/Eigenvalues>
 
 #include "diffpd/error.h"
@@ -84,16 +86,18 @@ MatrixXd RigidModeHessianProducts(SimulatorImpl& sim, const RigidModeCorrection&
       any_fixed = true;
     }
   if (any_fixed) {
-    const Mesh& mesh = sim.fem.mesh();
+    // The elements around the fixed nodes, ascending, from the node ->
+    // element adjacency (incidence e K + a).
+    const int per_element = sim.fem.nodes_per_element();
+    const std::vector<int>& offsets = sim.fem.node_offsets();
+    const std::vector<int>& incidences = sim.fem.node_incidences();
     std::vector<int> elements;
-    for (int e = 0; e < mesh.num_elements(); ++e) {
-      bool touches = false;
-      for (int a = 0; a < mesh.elements.rows() && !touches; ++a) {
-        const int node = mesh.elements(a, e);
-        touches = sim.fixed[3 * node] || sim.fixed[3 * node + 1] || sim.fixed[3 * node + 2];
-      }
-      if (touches) elements.push_back(e);
+    for (int node = 0; node < sim.fem.num_nodes(); ++node) {
+      if (!(sim.fixed[3 * node] || sim.fixed[3 * node + 1] || sim.fixed[3 * node + 2])) continue;
+      for (int j = offsets[node]; j < offsets[node + 1]; ++j) elements.push_back(incidences[j] / per_element);
     }
+    std::sort(elements.begin(), elements.end());
+    elements.erase(std::unique(elements.begin(), elements.end()), elements.end());
     MatrixXd h_cut = MatrixXd::Zero(dofs, k);
     sim.elastic.AddElementHessianProducts(x, sim.lame(), elements, cut, &h_cut);
     h -= h_cut;
