@@ -65,8 +65,9 @@ Subcommand AddTradeoffCommand(CLI::App* parent);  // tradeoff_command.cc
 Subcommand AddStressCommand(CLI::App* parent);    // stress_command.cc
 Subcommand AddSynthCommand(CLI::App* parent);     // synth_command.cc
 
-// Calibration problems fit with the library's PD-LBFGS settings: throws
-// InvalidInputError if --lbfgs-scale or --no-rigid-correction was given.
+// Calibration problems fit with the library's PD-LBFGS settings and a silent
+// simulator: throws InvalidInputError if --lbfgs-scale, --no-rigid-correction
+// or a non-zero --verbosity was given.
 void RefuseSimulatorTuning(const CommandArgs& args, const std::string& problem);
 
 // Solver options for a problem from the shared arguments.

@@ -22,6 +22,9 @@ void RefuseSimulatorTuning(const CommandArgs& args, const std::string& problem) 
   if (args.lbfgs_weight_scale != SolverOptions().lbfgs_weight_scale || !args.rigid_mode_correction)
     throw InvalidInputError("--lbfgs-scale and --no-rigid-correction are not used by the calibration problem '" +
                             problem + "' (it fits with the library's default solver settings)");
+  if (args.verbosity != 0)
+    throw InvalidInputError("--verbosity is not used by the calibration problem '" + problem +
+                            "' (its log is Ceres' iteration table; the simulator stays silent)");
 }
 
 SolverOptions OptionsFromArgs(const CommandArgs& args, double default_dt, double default_rel_tolerance) {

@@ -128,6 +128,7 @@ OptimizationReport RunOptimization(const TrajectoryOptimizationProblem& problem,
     if (settings.rel_tolerance > 0) options.rel_tolerance = settings.rel_tolerance;
     options.lbfgs_weight_scale = settings.lbfgs_weight_scale;
     options.rigid_mode_correction = settings.rigid_mode_correction;
+    options.verbosity = settings.verbosity;
     Simulator sim(problem.MakeScene(settings.size), options);
     Ipopt::SmartPtr<solvers::RolloutNlp> nlp = problem.MakeNlp(&sim, settings.size);
     IpoptOptions ipopt = problem.DefaultIpoptOptions(settings.size);
@@ -295,6 +296,7 @@ int TrajectoryOptimizationProblem::Run(const CommandArgs& args) const {
   settings.rel_tolerance = args.rel_tolerance;
   settings.lbfgs_weight_scale = args.lbfgs_weight_scale;
   settings.rigid_mode_correction = args.rigid_mode_correction;
+  settings.verbosity = args.verbosity;
   settings.out_dir = args.out_dir.empty() ? DefaultOutputDirectory(name()) : args.out_dir;
   FILE* text = args.json ? stderr : stdout;
   settings.log = text;

@@ -71,6 +71,7 @@ struct OptimizationSettings {
   double rel_tolerance = -1;    // simulator rel_tolerance (-1: the problem's)
   double lbfgs_weight_scale = SolverOptions().lbfgs_weight_scale;      // SolverOptions' field of that name
   bool rigid_mode_correction = SolverOptions().rigid_mode_correction;  // SolverOptions' field of that name
+  int verbosity = 0;            // SolverOptions::verbosity (the simulator's log on stderr)
   std::string out_dir;          // "": write no files
   FILE* log = stdout;           // Ipopt's iteration log (nullptr: none); not owned
   solvers::IpoptOptions ipopt;  // passed to Ipopt after the problem's defaults

@@ -67,7 +67,7 @@ TEST(CalibratePlantTest, FitOfNoiseFreeMotionRecoversTheTrueMaterial) {
   EXPECT_GT(fit.statistics.forward_seconds, 0.0);
 }
 
-// The simulator-tuning flags of `run` are refused, not silently ignored.
+// The simulator-tuning and verbosity flags of `run` are refused, not silently ignored.
 TEST(CalibratePlantTest, SimulatorTuningFlagsAreRefusedWithAMessage) {
   const PlantCalibration problem;
   for (const bool rigid : {false, true}) {
@@ -82,6 +82,16 @@ TEST(CalibratePlantTest, SimulatorTuningFlagsAreRefusedWithAMessage) {
                 "--lbfgs-scale and --no-rigid-correction are not used by the calibration problem 'calibrate-plant' (it "
                 "fits with the library's default solver settings)");
     }
+  }
+  CommandArgs args;
+  args.verbosity = 1;
+  try {
+    problem.Run(args);
+    FAIL() << "no throw for --verbosity";
+  } catch (const InvalidInputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "--verbosity is not used by the calibration problem 'calibrate-plant' (its log is Ceres' iteration "
+              "table; the simulator stays silent)");
   }
 }
 
