@@ -249,6 +249,30 @@ TEST(ElasticForcesTest, ElementHessiansDependOnThePositionsAloneAndAreSymmetric)
 namespace diffpd {
 namespace {
 
+// A 3-element beam (hexahedra) or 15-18 tetrahedra: the last group of 8
+// elements partly empty; its element Hessians at a deformed state, dense and
+// packed (mu = 7e4, lambda = 2.8e5).
+struct PartialGroupBeam {
+  static constexpr double kMu = 7e4, kLambda = 2.8e5;
+  PartialGroupBeam(bool tets, std::vector<ElasticEnergy> energies)
+      : scene(BeamScene(tets, std::move(energies))), fem(scene.mesh), forces(fem, scene.energies),
+        x(DeformedPositions(scene.mesh, 2e-3, 14)) {
+    EXPECT_NE(fem.num_elements() % 8, 0);
+    forces.ElementHessians(x, LameField::Uniform(kMu, kLambda), false, &blocks, 1);
+    forces.PackElementMatrices(blocks, &packed);
+  }
+  static Scene BeamScene(bool tets, std::vector<ElasticEnergy> energies) {
+    Scene s = testing::SmallBeamScene(tets, std::move(energies));
+    s.mesh = tets ? testing::BoxTetMesh(3, 1, 1, 0.12, 0.04, 0.04) : testing::BoxHexMesh(3, 1, 1, 0.12, 0.04, 0.04);
+    return s;
+  }
+  Scene scene;
+  FemModel fem;
+  ElasticForces forces;
+  VectorXd x;
+  std::vector<double> blocks, packed;
+};
+
 // Packed element Hessians built straight from x equal the dense element
 // blocks packed afterwards, also when the element count leaves the last group
 // of 8 partly empty (3 hexahedra; 5 tetrahedra per cube x 3 cubes = 15 or
@@ -257,30 +281,24 @@ namespace {
 // equal to rounding); a set with a non-SVD energy takes the per-element
 // build, bit for bit.
 TEST(ElasticForcesTest, PackedHessiansFromPositionsMatchThePackedDenseBlocks) {
-  const double mu = 7e4, lambda = 2.8e5;
   using E = ElasticEnergy;
   const std::vector<std::vector<E>> sets = {
       {E::kPdCorotated, E::kPdVolume}, {E::kCorotated}, {E::kPdCorotated}, {E::kNeoHookean},
       {E::kCorotated, E::kLinear}};
   for (const bool tets : {false, true}) {
     for (const auto& energies : sets) {
-      Scene scene = testing::SmallBeamScene(tets, energies);
-      scene.mesh =
-          tets ? testing::BoxTetMesh(3, 1, 1, 0.12, 0.04, 0.04) : testing::BoxHexMesh(3, 1, 1, 0.12, 0.04, 0.04);
-      FemModel fem(scene.mesh);
-      ASSERT_NE(fem.num_elements() % 8, 0);
-      ElasticForces forces(fem, scene.energies);
-      const VectorXd x = DeformedPositions(scene.mesh, 2e-3, 14);
-      std::vector<double> blocks, packed;
-      forces.ElementHessians(x, LameField::Uniform(mu, lambda), false, &blocks, 1);
-      forces.PackElementMatrices(blocks, &packed);
+      PartialGroupBeam beam(tets, energies);
+      ElasticForces& forces = beam.forces;
+      const VectorXd& x = beam.x;
+      const std::vector<double>& packed = beam.packed;
       bool all_svd = true;
       for (const E e : energies) all_svd = all_svd && internal::NeedsSvd(e);
       double largest = 0;
       for (const double v : packed) largest = std::max(largest, std::abs(v));
       for (const int threads : {1, 2}) {
         std::vector<double> direct;
-        forces.PackedElementHessians(x, LameField::Uniform(mu, lambda), &direct, threads);
+        forces.PackedElementHessians(x, LameField::Uniform(PartialGroupBeam::kMu, PartialGroupBeam::kLambda), &direct,
+                                     threads);
         ASSERT_EQ(direct.size(), packed.size());
         double worst = 0;
         for (size_t i = 0; i < packed.size(); ++i) worst = std::max(worst, std::abs(direct[i] - packed[i]));
@@ -297,17 +315,14 @@ TEST(ElasticForcesTest, PackedHessiansFromPositionsMatchThePackedDenseBlocks) {
 // The packed, element-interleaved product equals the dense element blocks'
 // product, also for a partly empty last group.
 TEST(ElasticForcesTest, PackedProductMatchesTheDenseBlocksForPartialGroups) {
-  const double mu = 7e4, lambda = 2.8e5;
   for (const bool tets : {false, true}) {
-    Scene scene = testing::SmallBeamScene(tets);
-    scene.mesh = tets ? testing::BoxTetMesh(3, 1, 1, 0.12, 0.04, 0.04) : testing::BoxHexMesh(3, 1, 1, 0.12, 0.04, 0.04);
-    FemModel fem(scene.mesh);
-    ASSERT_NE(fem.num_elements() % 8, 0);
-    ElasticForces forces(fem, scene.energies);
-    const VectorXd x = DeformedPositions(scene.mesh, 2e-3, 14);
-    std::vector<double> blocks, packed;
-    forces.ElementHessians(x, LameField::Uniform(mu, lambda), false, &blocks, 1);
-    forces.PackElementMatrices(blocks, &packed);
+    PartialGroupBeam beam(tets, testing::SmallBeamScene(tets).energies);
+    const Scene& scene = beam.scene;
+    const FemModel& fem = beam.fem;
+    ElasticForces& forces = beam.forces;
+    const VectorXd& x = beam.x;
+    const std::vector<double>& blocks = beam.blocks;
+    const std::vector<double>& packed = beam.packed;
     std::mt19937 rng(15);
     const VectorXd z = NormalVector(static_cast<int>(x.size()), &rng);
     VectorXd product;

@@ -115,10 +115,7 @@ double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F
       *dstress += internal::StressDifferential(energy, F, svd, mu, lambda);
       continue;
     }
-    const IsotropicDifferentialCoefficients c = StressDifferentialCoefficients(energy, svd, mu, lambda, volume);
-    sum.dp_dsigma += c.dp_dsigma;
-    sum.symmetric += c.symmetric;
-    sum.skew += c.skew;
+    sum += StressDifferentialCoefficients(energy, svd, mu, lambda, volume);
     any_svd = true;
   }
   if (any_svd) *dstress += AssembleIsotropicDifferential(svd, sum);
@@ -426,13 +423,9 @@ void ElasticForces::PackedElementHessiansImpl(const VectorXd& x, const LameField
             for (int j = 0; j < count; ++j) {
               const int e = e0 + j, i = j * q_per + q, sample = e * q_per + q;
               IsotropicDifferentialCoefficients sum;
-              for (const ElasticEnergy energy : energies_) {
-                const IsotropicDifferentialCoefficients c = StressDifferentialCoefficients(
-                    energy, svd[i], lame.mu_of(e), lame.lambda_of(e), needs_volume_ ? &volume[i] : nullptr);
-                sum.dp_dsigma += c.dp_dsigma;
-                sum.symmetric += c.symmetric;
-                sum.skew += c.skew;
-              }
+              for (const ElasticEnergy energy : energies_)
+                sum += StressDifferentialCoefficients(energy, svd[i], lame.mu_of(e), lame.lambda_of(e),
+                                                      needs_volume_ ? &volume[i] : nullptr);
               for (int k = 0; k < 9; ++k) {
                 lanes.u[k][j] = svd[i].U(k);
                 lanes.v[k][j] = svd[i].V(k);

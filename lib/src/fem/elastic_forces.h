@@ -71,8 +71,10 @@ class ElasticForces {
   // packed_element_matrices.h; 1296 of 2304 bytes per hexahedron).
   void PackElementMatrices(const std::vector<double>& blocks, std::vector<double>* packed) const;
   // The same packed matrices straight from x (ElementHessians, unprojected,
-  // then PackElementMatrices), element by element in parallel, without the
-  // full blocks.
+  // then PackElementMatrices, equal to rounding), in parallel, without the
+  // full blocks: 8 elements per vector operation when every energy is
+  // SVD-coefficient based (AddPackedSampleStiffness), else element by
+  // element (bit for bit).
   void PackedElementHessians(const VectorXd& x, const LameField& lame, std::vector<double>* packed, int threads);
   // out = sum_e K_e z_e with packed element Hessians: the Hessian product for
   // many products at one x ((3K)^2 multiply-adds per element and product,

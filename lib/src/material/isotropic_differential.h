@@ -25,6 +25,14 @@ struct IsotropicDifferentialCoefficients {
   Mat3 dp_dsigma = Mat3::Zero();  // (i, j) = dp_i / dsigma_j
   Vec3 symmetric = Vec3::Zero();  // c^sym per pair
   Vec3 skew = Vec3::Zero();       // c^skew per pair
+
+  // Differentials in the same U, V frame add coefficient by coefficient.
+  IsotropicDifferentialCoefficients& operator+=(const IsotropicDifferentialCoefficients& other) {
+    dp_dsigma += other.dp_dsigma;
+    symmetric += other.symmetric;
+    skew += other.skew;
+    return *this;
+  }
 };
 
 // dP/dF (9x9, column-major flattening, see types.h) from the coefficients.
