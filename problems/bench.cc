@@ -18,9 +18,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -215,8 +213,9 @@ void BenchOptions::Validate() const {
   if (methods.empty()) throw InvalidInputError("methods is empty: name at least one method");
   for (Method m : methods)
     if (m == Method::kSemiImplicit)
-      throw InvalidInputError("method semi-implicit is not benchmarked: it has no tolerance (use newton-cholesky, "
-                              "newton-pcg, pd or pd-lbfgs)");
+      throw InvalidInputError(
+          "method semi-implicit is not benchmarked: it has no tolerance (use newton-cholesky, "
+          "newton-pcg, pd or pd-lbfgs)");
   if (!(rel_tolerance > 0 && rel_tolerance < 1)) fail("rtol", rel_tolerance, "in (0, 1)");
   if (!(backward_rel_tolerance < 1)) fail("backward rtol", backward_rel_tolerance, "< 1 (<= 0: same as rtol)");
   if (repeat < 1) fail("repeat", repeat, ">= 1");
@@ -241,8 +240,8 @@ BenchResult RunBench(const std::string& problem, const BenchOptions& options, st
   ref.backward_rel_tolerance = kReferenceBackwardRelTolerance;
   {
     std::ostringstream line;
-    line << "[bench] " << problem << ": " << result.elements << " elements, " << result.dofs << " DoFs, "
-         << s.steps << " steps of " << s.time_step << " s; reference newton-cholesky rtol " << ref.rel_tolerance;
+    line << "[bench] " << problem << ": " << result.elements << " elements, " << result.dofs << " DoFs, " << s.steps
+         << " steps of " << s.time_step << " s; reference newton-cholesky rtol " << ref.rel_tolerance;
     Progress(progress, line.str());
   }
   const RolloutMeasurement reference = MeasureRollout(s.scene, ref, s.initial, s.inputs, s.loss, 1);
@@ -306,33 +305,33 @@ nlohmann::json BenchToJson(const BenchResult& result, const BenchOptions& option
     const bool ok = r.failure.empty();
     nlohmann::json by_input = nlohmann::json::object();
     for (const auto& [k, v] : r.grad_rel_error_by_input) by_input[k] = v;
-    rows.push_back({{"method", r.method},
-                    {"status", ok ? std::string("ok") : "failed: " + r.failure},
-                    {"forward_s", NumberOrNull(ok, r.forward_s)},
-                    {"backward_s", NumberOrNull(ok, r.backward_s)},
-                    {"iters_per_step", NumberOrNull(ok, r.iters_per_step)},
-                    {"backward_iters_per_step", NumberOrNull(ok, r.backward_iters_per_step)},
-                    {"backward_fallbacks", ok ? nlohmann::json(r.backward_fallbacks) : nlohmann::json(nullptr)},
-                    {"rounding_floor_steps", ok ? nlohmann::json(r.rounding_floor_steps) : nlohmann::json(nullptr)},
-                    {"newton_fallback_steps", ok ? nlohmann::json(r.newton_fallback_steps) : nlohmann::json(nullptr)},
-                    {"state_rel_error", NumberOrNull(ok, r.state_rel_error)},
-                    {"position_rel_error", NumberOrNull(ok, r.position_rel_error)},
-                    {"velocity_rel_error", NumberOrNull(ok, r.velocity_rel_error)},
-                    {"grad_rel_error", NumberOrNull(ok, r.grad_rel_error)},
-                    {"grad_rel_error_by_input", ok ? by_input : nlohmann::json(nullptr)},
-                    {"forward_per_iteration_ms", NumberOrNull(ok, r.forward_per_iteration_ms)},
-                    {"factorization_s", NumberOrNull(ok, r.factorization_s)},
-                    {"speedup_vs_newton_cholesky",
-                     r.speedup_vs_newton_cholesky ? nlohmann::json(*r.speedup_vs_newton_cholesky)
-                                                  : nlohmann::json(nullptr)},
-                    {"problem", result.problem},
-                    {"dofs", result.dofs},
-                    {"elements", result.elements},
-                    {"steps", result.steps},
-                    {"time_step", result.time_step},
-                    {"rel_tolerance", options.rel_tolerance},
-                    {"threads", options.threads},
-                    {"repeat", options.repeat}});
+    rows.push_back(
+        {{"method", r.method},
+         {"status", ok ? std::string("ok") : "failed: " + r.failure},
+         {"forward_s", NumberOrNull(ok, r.forward_s)},
+         {"backward_s", NumberOrNull(ok, r.backward_s)},
+         {"iters_per_step", NumberOrNull(ok, r.iters_per_step)},
+         {"backward_iters_per_step", NumberOrNull(ok, r.backward_iters_per_step)},
+         {"backward_fallbacks", ok ? nlohmann::json(r.backward_fallbacks) : nlohmann::json(nullptr)},
+         {"rounding_floor_steps", ok ? nlohmann::json(r.rounding_floor_steps) : nlohmann::json(nullptr)},
+         {"newton_fallback_steps", ok ? nlohmann::json(r.newton_fallback_steps) : nlohmann::json(nullptr)},
+         {"state_rel_error", NumberOrNull(ok, r.state_rel_error)},
+         {"position_rel_error", NumberOrNull(ok, r.position_rel_error)},
+         {"velocity_rel_error", NumberOrNull(ok, r.velocity_rel_error)},
+         {"grad_rel_error", NumberOrNull(ok, r.grad_rel_error)},
+         {"grad_rel_error_by_input", ok ? by_input : nlohmann::json(nullptr)},
+         {"forward_per_iteration_ms", NumberOrNull(ok, r.forward_per_iteration_ms)},
+         {"factorization_s", NumberOrNull(ok, r.factorization_s)},
+         {"speedup_vs_newton_cholesky",
+          r.speedup_vs_newton_cholesky ? nlohmann::json(*r.speedup_vs_newton_cholesky) : nlohmann::json(nullptr)},
+         {"problem", result.problem},
+         {"dofs", result.dofs},
+         {"elements", result.elements},
+         {"steps", result.steps},
+         {"time_step", result.time_step},
+         {"rel_tolerance", options.rel_tolerance},
+         {"threads", options.threads},
+         {"repeat", options.repeat}});
   }
   return rows;
 }
@@ -355,15 +354,14 @@ ScalingResult RunScaling(const std::string& problem, const BenchOptions& options
     const Setup s = MakeSetup(problem, options.refine + doublings, options);
     {
       std::ostringstream line;
-      line << "[scaling] " << f << "x: " << s.scene.mesh.num_elements() << " elements, "
-           << s.scene.mesh.num_dofs() << " DoFs";
+      line << "[scaling] " << f << "x: " << s.scene.mesh.num_elements() << " elements, " << s.scene.mesh.num_dofs()
+           << " DoFs";
       Progress(progress, line.str());
     }
     for (Method method : options.methods) {
       const RolloutMeasurement m = MeasureRollout(s.scene, MethodOptions(method, options, s.time_step), s.initial,
                                                   s.inputs, s.loss, options.repeat);
-      Progress(progress, std::string("[scaling] ") + std::to_string(f) + "x " + ToString(method) + ": " +
-                             Describe(m));
+      Progress(progress, std::string("[scaling] ") + std::to_string(f) + "x " + ToString(method) + ": " + Describe(m));
       ScalingRow row;
       row.method = ToString(method);
       row.factor = f;
@@ -377,8 +375,7 @@ ScalingResult RunScaling(const std::string& problem, const BenchOptions& options
         row.iters_per_step = m.iters_per_step;
         row.forward_per_iteration_ms = m.total_iterations > 0 ? 1e3 * m.forward_s / m.total_iterations : 0;
         row.factorization_s = m.factorization_s;
-        row.iteration_ms =
-            m.total_iterations > 0 ? 1e3 * (m.forward_s - m.factorization_s) / m.total_iterations : 0;
+        row.iteration_ms = m.total_iterations > 0 ? 1e3 * (m.forward_s - m.factorization_s) / m.total_iterations : 0;
         row.backward_per_step_ms = 1e3 * m.backward_s / s.steps;
       }
       row.peak_rss_mib = PeakRssMib();
@@ -410,26 +407,26 @@ nlohmann::json ScalingToJson(const ScalingResult& result) {
     const bool ok = r.failure.empty();
     const auto exponent = result.exponent_per_iteration.find(r.method);
     const auto with_factorization = result.exponent_with_factorization.find(r.method);
-    rows.push_back({{"method", r.method},
-                    {"status", ok ? std::string("ok") : "failed: " + r.failure},
-                    {"factor", r.factor},
-                    {"elements", r.elements},
-                    {"vertices", r.vertices},
-                    {"dofs", r.dofs},
-                    {"forward_s", NumberOrNull(ok, r.forward_s)},
-                    {"backward_s", NumberOrNull(ok, r.backward_s)},
-                    {"iters_per_step", NumberOrNull(ok, r.iters_per_step)},
-                    {"forward_per_iteration_ms", NumberOrNull(ok, r.forward_per_iteration_ms)},
-                    {"factorization_s", NumberOrNull(ok, r.factorization_s)},
-                    {"iteration_ms", NumberOrNull(ok, r.iteration_ms)},
-                    {"backward_per_step_ms", NumberOrNull(ok, r.backward_per_step_ms)},
-                    {"peak_rss_mib", r.peak_rss_mib},
-                    {"exponent_per_iteration", exponent == result.exponent_per_iteration.end()
-                                                   ? nlohmann::json(nullptr)
-                                                   : nlohmann::json(exponent->second)},
-                    {"exponent_with_factorization", with_factorization == result.exponent_with_factorization.end()
-                                                        ? nlohmann::json(nullptr)
-                                                        : nlohmann::json(with_factorization->second)}});
+    rows.push_back(
+        {{"method", r.method},
+         {"status", ok ? std::string("ok") : "failed: " + r.failure},
+         {"factor", r.factor},
+         {"elements", r.elements},
+         {"vertices", r.vertices},
+         {"dofs", r.dofs},
+         {"forward_s", NumberOrNull(ok, r.forward_s)},
+         {"backward_s", NumberOrNull(ok, r.backward_s)},
+         {"iters_per_step", NumberOrNull(ok, r.iters_per_step)},
+         {"forward_per_iteration_ms", NumberOrNull(ok, r.forward_per_iteration_ms)},
+         {"factorization_s", NumberOrNull(ok, r.factorization_s)},
+         {"iteration_ms", NumberOrNull(ok, r.iteration_ms)},
+         {"backward_per_step_ms", NumberOrNull(ok, r.backward_per_step_ms)},
+         {"peak_rss_mib", r.peak_rss_mib},
+         {"exponent_per_iteration",
+          exponent == result.exponent_per_iteration.end() ? nlohmann::json(nullptr) : nlohmann::json(exponent->second)},
+         {"exponent_with_factorization", with_factorization == result.exponent_with_factorization.end()
+                                             ? nlohmann::json(nullptr)
+                                             : nlohmann::json(with_factorization->second)}});
   }
   return rows;
 }
@@ -452,8 +449,7 @@ std::vector<ThreadsRow> RunThreadsCompare(const std::string& problem, const Benc
       o.threads = threads;
       const SolverOptions so = MethodOptions(method, o, s.time_step);
       const RolloutMeasurement m = MeasureRollout(s.scene, so, s.initial, s.inputs, s.loss, options.repeat);
-      Progress(progress, "[threads] " + row.method + " with " + std::to_string(threads) + " thread(s): " +
-                             Describe(m));
+      Progress(progress, "[threads] " + row.method + " with " + std::to_string(threads) + " thread(s): " + Describe(m));
       if (!m.ok()) {
         row.failure = m.failure;
         break;

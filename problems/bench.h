@@ -103,17 +103,17 @@ VectorXd StackState(const State& s);
 struct BenchOptions {
   // Methods measured, in this order.
   std::vector<Method> methods = {Method::kPd, Method::kPdLbfgs, Method::kNewtonPcg, Method::kNewtonCholesky};
-  double rel_tolerance = 1e-4;           // forward rel_tolerance of every method
-  double backward_rel_tolerance = -1;    // adjoint tolerance; <= 0: the same as rel_tolerance
-  int steps = -1;                        // <= 0: the problem's default
-  double time_step = -1;                 // <= 0: the problem's default (s)
-  int threads = 0;                       // SolverOptions::num_threads
-  int max_iterations = 1000;             // SolverOptions::max_iterations of each step
+  double rel_tolerance = 1e-4;                                     // forward rel_tolerance of every method
+  double backward_rel_tolerance = -1;                              // adjoint tolerance; <= 0: the same as rel_tolerance
+  int steps = -1;                                                  // <= 0: the problem's default
+  double time_step = -1;                                           // <= 0: the problem's default (s)
+  int threads = 0;                                                 // SolverOptions::num_threads
+  int max_iterations = 1000;                                       // SolverOptions::max_iterations of each step
   double lbfgs_weight_scale = SolverOptions().lbfgs_weight_scale;  // pd-lbfgs preconditioner
   bool rigid_mode_correction = SolverOptions().rigid_mode_correction;  // pd-lbfgs, PD backward
-  int repeat = 1;                        // runs per method (median), >= 1
-  int refine = 0;                        // MakeRefinedProblem doublings
-  std::uint64_t seed = 20211;            // loss vectors
+  int repeat = 1;                                                      // runs per method (median), >= 1
+  int refine = 0;                                                      // MakeRefinedProblem doublings
+  std::uint64_t seed = 20211;                                          // loss vectors
 
   // Throws InvalidInputError naming the field, its value and the valid range.
   void Validate() const;
@@ -121,7 +121,7 @@ struct BenchOptions {
 
 struct BenchRow {
   std::string method;
-  std::string failure;   // "" when the method succeeded
+  std::string failure;  // "" when the method succeeded
   double forward_s = 0;
   double backward_s = 0;
   double iters_per_step = 0;
@@ -131,9 +131,9 @@ struct BenchRow {
   int newton_fallback_steps = 0;        // PD-LBFGS steps finished by Newton after a stall
   double forward_per_iteration_ms = 0;  // forward_s / total iterations, ms
   double factorization_s = 0;           // RolloutMeasurement::factorization_s
-  double state_rel_error = 0;     // of [x; v] stacked
-  double position_rel_error = 0;  // of x alone
-  double velocity_rel_error = 0;  // of v alone (about |x error| / h: the strictest part)
+  double state_rel_error = 0;           // of [x; v] stacked
+  double position_rel_error = 0;        // of x alone
+  double velocity_rel_error = 0;        // of v alone (about |x error| / h: the strictest part)
   double grad_rel_error = 0;
   // Relative errors of the gradient's parts: "x0", "v0", "youngs_modulus",
   // "poissons_ratio", "density".
@@ -204,9 +204,9 @@ nlohmann::json ScalingToJson(const ScalingResult& result);
 struct ThreadsRow {
   std::string method;
   std::string failure;
-  double step_s_1 = 0, step_s_2 = 0;             // forward seconds per step
-  double backward_s_1 = 0, backward_s_2 = 0;     // whole backward pass
-  double local_ms_1 = 0, local_ms_2 = 0;         // one ElasticEnergy evaluation
+  double step_s_1 = 0, step_s_2 = 0;          // forward seconds per step
+  double backward_s_1 = 0, backward_s_2 = 0;  // whole backward pass
+  double local_ms_1 = 0, local_ms_2 = 0;      // one ElasticEnergy evaluation
   double step_speedup() const { return step_s_2 > 0 ? step_s_1 / step_s_2 : 0; }
   double backward_speedup() const { return backward_s_2 > 0 ? backward_s_1 / backward_s_2 : 0; }
   double local_speedup() const { return local_ms_2 > 0 ? local_ms_1 / local_ms_2 : 0; }

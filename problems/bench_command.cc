@@ -73,8 +73,10 @@ void PrintBenchTable(const BenchResult& r) {
     if (row.backward_fallbacks > 0) std::printf(" (%d adjoint fallbacks)", row.backward_fallbacks);
     if (row.rounding_floor_steps > 0) std::printf(" (%d steps at the rounding floor)", row.rounding_floor_steps);
     if (row.newton_fallback_steps > 0) std::printf(" (%d steps finished by Newton)", row.newton_fallback_steps);
-    if (row.speedup_vs_newton_cholesky) std::printf(" %10.2f\n", *row.speedup_vs_newton_cholesky);
-    else std::printf(" %10s\n", "-");
+    if (row.speedup_vs_newton_cholesky)
+      std::printf(" %10.2f\n", *row.speedup_vs_newton_cholesky);
+    else
+      std::printf(" %10s\n", "-");
   }
 }
 
@@ -120,16 +122,22 @@ int RunBenchArgs(const BenchArgs& args) {
   options.methods = ParseMethods(args.methods);
   if (args.scaling) {
     const ScalingResult r = RunScaling(args.problem, options, args.scales, &std::cerr);
-    if (args.json) std::printf("%s\n", ScalingToJson(r).dump(2).c_str());
-    else PrintScalingTable(r);
+    if (args.json)
+      std::printf("%s\n", ScalingToJson(r).dump(2).c_str());
+    else
+      PrintScalingTable(r);
   } else if (args.threads_compare) {
     const auto rows = RunThreadsCompare(args.problem, options, 200, &std::cerr);
-    if (args.json) std::printf("%s\n", ThreadsToJson(rows).dump(2).c_str());
-    else PrintThreadsTable(rows);
+    if (args.json)
+      std::printf("%s\n", ThreadsToJson(rows).dump(2).c_str());
+    else
+      PrintThreadsTable(rows);
   } else {
     const BenchResult r = RunBench(args.problem, options, &std::cerr);
-    if (args.json) std::printf("%s\n", BenchToJson(r, options).dump(2).c_str());
-    else PrintBenchTable(r);
+    if (args.json)
+      std::printf("%s\n", BenchToJson(r, options).dump(2).c_str());
+    else
+      PrintBenchTable(r);
   }
   return 0;
 }
@@ -174,8 +182,8 @@ Subcommand AddBenchCommand(CLI::App* parent) {
   cmd->add_option("--scales", args->scales, "comma-separated element-count factors, powers of 2 (with --scaling)")
       ->delimiter(',')
       ->capture_default_str();
-  CLI::Option* threads = cmd->add_flag("--threads-compare", args->threads_compare,
-                                       "1 vs 2 threads: whole step, backward and local step");
+  CLI::Option* threads =
+      cmd->add_flag("--threads-compare", args->threads_compare, "1 vs 2 threads: whole step, backward and local step");
   scaling->excludes(threads);
   return {cmd, [args] { return RunBenchArgs(*args); }};
 }

@@ -20,7 +20,7 @@ class BouncingBall : public Problem {
   int default_steps() const override { return 150; }
   double default_time_step() const override { return 0.002; }
 
-  static constexpr double kRadius = 0.05;  // m
+  static constexpr double kRadius = 0.05;     // m
   static constexpr double kDropHeight = 0.1;  // m, of the lowest node
 };
 

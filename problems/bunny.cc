@@ -63,10 +63,10 @@ Ipopt::SmartPtr<solvers::RolloutNlp> Bunny::MakeNlp(Simulator* sim, InstanceSize
   nlp->AddVariables(std::move(velocity));
   const TrackedPoint com = CentreOfMass(sim->LumpedMass());
   const Vec3 target = com.At(setup.initial.x) + Vec3(options_.target_offset.x(), options_.target_offset.y(), 0.0);
-  nlp->AddObjective(std::make_unique<PointDistanceSquared>(com, kFinalState, target, "landing_error",
-                                                           Vec3(1.0, 1.0, 0.0)));
-  nlp->AddConstraint(std::make_unique<PointCoordinate>(com, K / 4, Vec3::UnitZ(), "clear_wall"),
-                     options_.wall_height, 1e20);
+  nlp->AddObjective(
+      std::make_unique<PointDistanceSquared>(com, kFinalState, target, "landing_error", Vec3(1.0, 1.0, 0.0)));
+  nlp->AddConstraint(std::make_unique<PointCoordinate>(com, K / 4, Vec3::UnitZ(), "clear_wall"), options_.wall_height,
+                     1e20);
   return nlp;
 }
 

@@ -18,7 +18,7 @@ namespace diffpd::problems {
 
 struct BunnyOptions {
   Vec3 target_offset = Vec3(0.25, 0.1, 0.0);  // m, x and y used
-  double wall_height = 0.10;                   // m, centre-of-mass height at state K / 4
+  double wall_height = 0.10;                  // m, centre-of-mass height at state K / 4
 };
 
 class Bunny : public TrajectoryOptimizationProblem {

@@ -13,8 +13,8 @@ Scene BouncingBallCalibration::MakeScene() const {
   Scene scene = ball_.MakeScene();
   // The same ball on a coarser 6^3 grid (fits run many rollouts).
   const double r = BouncingBall::kRadius;
-  scene.mesh = VoxelizeSdf([r](const Vec3& p) { return p.norm() - r; }, Vec3::Constant(-r), Eigen::Vector3i(6, 6, 6),
-                           2 * r / 6);
+  scene.mesh =
+      VoxelizeSdf([r](const Vec3& p) { return p.norm() - r; }, Vec3::Constant(-r), Eigen::Vector3i(6, 6, 6), 2 * r / 6);
   scene.mesh.vertices.row(2).array() += BouncingBall::kDropHeight - scene.mesh.vertices.row(2).minCoeff();
   scene.frictional_contacts[0].nodes = BoundaryNodes(scene.mesh);
   scene.material = truth();

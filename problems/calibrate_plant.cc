@@ -11,11 +11,11 @@
 namespace diffpd::problems {
 namespace {
 
-constexpr double kFineCell = 0.01;   // OBJ units
-constexpr double kCoarseCell = 0.08; // OBJ units
-constexpr double kScale = 0.15;      // m per OBJ unit
-constexpr double kDuration = 0.3;    // s
-constexpr double kFrameRate = 30;    // Hz
+constexpr double kFineCell = 0.01;    // OBJ units
+constexpr double kCoarseCell = 0.08;  // OBJ units
+constexpr double kScale = 0.15;       // m per OBJ unit
+constexpr double kDuration = 0.3;     // s
+constexpr double kFrameRate = 30;     // Hz
 
 double LowestZ(const Mesh& mesh) { return mesh.vertices.row(2).minCoeff(); }
 
@@ -45,7 +45,8 @@ Mesh PlantCalibration::PlantMesh() {
   const double dx = kCoarseCell * kScale;
   return VoxelizeSdf(
       [&](const Vec3& p) {
-        const std::array<int, 3> key = {static_cast<int>(std::floor(p(0) / dx)), static_cast<int>(std::floor(p(1) / dx)),
+        const std::array<int, 3> key = {static_cast<int>(std::floor(p(0) / dx)),
+                                        static_cast<int>(std::floor(p(1) / dx)),
                                         static_cast<int>(std::floor(p(2) / dx))};
         return occupied.count(key) ? -1.0 : 1.0;
       },

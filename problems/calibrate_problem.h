@@ -29,17 +29,17 @@ namespace diffpd::problems {
 struct CalibrationFit {
   Method method = Method::kPd;
   std::vector<solvers::MaterialParameter> fitted;
-  std::vector<double> values;      // fitted values, in `fitted` order
-  std::vector<double> initial;     // starting values
-  double initial_cost = 0;         // 1/2 sum of squared weighted residuals
+  std::vector<double> values;   // fitted values, in `fitted` order
+  std::vector<double> initial;  // starting values
+  double initial_cost = 0;      // 1/2 sum of squared weighted residuals
   double final_cost = 0;
-  double marker_rmse_m = 0;        // sqrt(mean over samples of |simulated - captured|^2), unweighted
-  int iterations = 0;              // Ceres iterations
+  double marker_rmse_m = 0;                   // sqrt(mean over samples of |simulated - captured|^2), unweighted
+  int iterations = 0;                         // Ceres iterations
   solvers::CalibrationStatistics statistics;  // evaluations (rollouts), timings
   double total_seconds = 0;
-  bool usable = false;             // Ceres' solution is usable
-  std::string termination;         // Ceres' message
-  Rollout rollout;                 // the fitted trajectory
+  bool usable = false;      // Ceres' solution is usable
+  std::string termination;  // Ceres' message
+  Rollout rollout;          // the fitted trajectory
 };
 
 class CalibrationProblem : public Problem {

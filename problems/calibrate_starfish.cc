@@ -26,27 +26,27 @@ namespace {
 
 constexpr double kMm = 1e-3;
 constexpr const char* kTetgenSwitches = "pq2Y";
-constexpr double kDensity = 400;              // kg/m^3
-constexpr double kMuscleStiffness = 2e6;      // Pa
-constexpr double kCentralHalfWidth = 0.018;   // m: the fixed central column, |y|, |z| < 18 mm
-constexpr double kStripHalfWidth = 0.0075;    // m: an arm's central strip
-constexpr double kFaceDistance = 0.001;       // m: flat-face layer / markers
+constexpr double kDensity = 400;             // kg/m^3
+constexpr double kMuscleStiffness = 2e6;     // Pa
+constexpr double kCentralHalfWidth = 0.018;  // m: the fixed central column, |y|, |z| < 18 mm
+constexpr double kStripHalfWidth = 0.0075;   // m: an arm's central strip
+constexpr double kFaceDistance = 0.001;      // m: flat-face layer / markers
 // A muscle element has a face (>= 3 nodes) on the flat face: its fibre
 // stretch along the arm is then the flat face's own stretch, so contraction
 // shortens the face and curls the arm. (Elements with only 1-2 nodes there
 // span the arm's thickness near the tips and shorten it without bending.)
 constexpr int kMuscleFaceNodes = 3;
-constexpr double kMarkerBand = 0.004;         // m: |z - target| of a marker candidate
+constexpr double kMarkerBand = 0.004;  // m: |z - target| of a marker candidate
 constexpr std::array<double, 4> kMarkerTargetZ = {-0.070, -0.040, 0.0362, 0.0632};
-constexpr double kLossScale = 0.002;          // m: residuals in units of 2 mm
+constexpr double kLossScale = 0.002;  // m: residuals in units of 2 mm
 // Fit bounds and defaults.
 constexpr double kMinE = 1e4, kMaxE = 5e6, kMinNu = 0.2, kMaxNu = 0.45;
-constexpr double kMaxSlack = 0.015;                // m: slack in [0, 15 mm]
-constexpr double kMinLag = 1e-3, kMaxLag = 0.5;    // s: log lag in [log 1 ms, log 0.5 s]
+constexpr double kMaxSlack = 0.015;                     // m: slack in [0, 15 mm]
+constexpr double kMinLag = 1e-3, kMaxLag = 0.5;         // s: log lag in [log 1 ms, log 0.5 s]
 constexpr double kMinLength = 0.03, kMaxLength = 0.13;  // m: log tendon length in [log 30 mm, log 130 mm]
-constexpr double kSlackSmoothing = 0.001;          // m: width of the slack's quadratic onset
-constexpr double kFitStart = 1.0;    // s: the tendon first moves at 1.18 s in cyclic1
-constexpr double kFitSeconds = 2.0;  // s
+constexpr double kSlackSmoothing = 0.001;               // m: width of the slack's quadratic onset
+constexpr double kFitStart = 1.0;                       // s: the tendon first moves at 1.18 s in cyclic1
+constexpr double kFitSeconds = 2.0;                     // s
 constexpr double kDefaultSeconds = 10;
 constexpr int kDefaultIterations = 10;
 
@@ -57,7 +57,6 @@ std::string Num(double v) {
   s << v;
   return s.str();
 }
-
 
 double Sigmoid(double u) { return 1 / (1 + std::exp(-u)); }
 double Logit(double s) { return std::log(s / (1 - s)); }
@@ -138,15 +137,15 @@ class FitTable : public ceres::IterationCallback {
   FitTable(FILE* log, const double* u, double density, bool arms) : log_(log), u_(u), density_(density), arms_(arms) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     if (s.iteration == 0) {
-      std::fprintf(log_, "%4s %13s %11s %11s %9s %14s %14s %9s %9s %9s", "iter", "loss", "loss_change",
-                   "|gradient|", "total_t", "youngs_modulus", "poissons_ratio", "slack_mm", "lag_s", "length_mm");
+      std::fprintf(log_, "%4s %13s %11s %11s %9s %14s %14s %9s %9s %9s", "iter", "loss", "loss_change", "|gradient|",
+                   "total_t", "youngs_modulus", "poissons_ratio", "slack_mm", "lag_s", "length_mm");
       std::fprintf(log_, arms_ ? " %14s\n" : "\n", "arms_youngs_modulus");
     }
     const MaterialParameters m = StarfishCalibration::FromCoordinates(u_, density_);
     const StarfishActuation a = StarfishCalibration::ActuationFromCoordinates(u_ + 2);
     std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %9.2f %14.6g %14.6g %9.4f %9.4f %9.3f", s.iteration, s.cost,
-                 s.cost_change, s.gradient_max_norm, s.cumulative_time_in_seconds, m.youngs_modulus,
-                 m.poissons_ratio, a.slack / kMm, a.lag, a.length / kMm);
+                 s.cost_change, s.gradient_max_norm, s.cumulative_time_in_seconds, m.youngs_modulus, m.poissons_ratio,
+                 a.slack / kMm, a.lag, a.length / kMm);
     if (arms_) std::fprintf(log_, " %14.6g", StarfishCalibration::FromCoordinates(u_ + 5, density_).youngs_modulus);
     std::fprintf(log_, "\n");
     std::fflush(log_);
@@ -172,8 +171,7 @@ void WriteTrace(const std::string& dir, const Mesh& mesh, const Rollout& rollout
   if (!out) throw InvalidInputError("cannot write '" + path + "'");
   const std::array<int, 4> vertices = StarfishCalibration::MarkerVertices(mesh);
   out << "time_s,tendon_mm,activation";
-  for (int m = 1; m <= 4; ++m)
-    out << ",M" << m << "_sim_x,M" << m << "_cap_x,M" << m << "_sim_z,M" << m << "_cap_z";
+  for (int m = 1; m <= 4; ++m) out << ",M" << m << "_sim_x,M" << m << "_cap_x,M" << m << "_sim_z,M" << m << "_cap_z";
   out << "\n";
   const State& s0 = rollout.states[0];
   for (int j = w.first; j <= w.last; ++j) {
@@ -183,8 +181,9 @@ void WriteTrace(const std::string& dir, const Mesh& mesh, const Rollout& rollout
     out << rec.time[j] << "," << rec.tendon[j] / kMm << "," << rollout.inputs[input].activation(0);
     for (int m = 0; m < 4; ++m) {
       const int v = vertices[m];
-      out << "," << (s.x(3 * v) - s0.x(3 * v)) / kMm << "," << (rec.markers[j][2 * m] - rec.markers[w.first][2 * m]) / kMm
-          << "," << (s.x(3 * v + 2) - s0.x(3 * v + 2)) / kMm << ","
+      out << "," << (s.x(3 * v) - s0.x(3 * v)) / kMm << ","
+          << (rec.markers[j][2 * m] - rec.markers[w.first][2 * m]) / kMm << ","
+          << (s.x(3 * v + 2) - s0.x(3 * v + 2)) / kMm << ","
           << -(rec.markers[j][2 * m + 1] - rec.markers[w.first][2 * m + 1]) / kMm;
     }
     out << "\n";
@@ -257,7 +256,8 @@ StarfishRecording ReadStarfishRecording(const std::string& path) {
     for (int c = 0; c < 10; ++c)
       if (!ParseCsvNumber(fields[c], &v[c]))
         throw InvalidInputError(where + kColumns[c] + " is not a number: '" + fields[c] + "'");
-    if (!std::isfinite(v[0])) throw InvalidInputError(where + "time = " + Num(v[0]) + " is invalid: must be finite (ms)");
+    if (!std::isfinite(v[0]))
+      throw InvalidInputError(where + "time = " + Num(v[0]) + " is invalid: must be finite (ms)");
     if (std::isinf(v[1]))
       throw InvalidInputError(where + "tendon = " + Num(v[1]) + " is invalid: must be finite or NaN (mm)");
     for (int c = 2; c < 10; ++c)
@@ -292,17 +292,17 @@ StarfishWindow MakeStarfishWindow(const StarfishRecording& rec, double start, do
                             Num(rec.time.back() - rec.time.front()) + " s)");
   if (std::isnan(rec.tendon[w.first]))
     throw InvalidInputError(rec.path + ":" + std::to_string(rec.lines[w.first]) +
-                            ": tendon contraction is NaN at the window's first row (t = " +
-                            Num(rec.time[w.first]) + " s): nothing to simulate");
+                            ": tendon contraction is NaN at the window's first row (t = " + Num(rec.time[w.first]) +
+                            " s): nothing to simulate");
   const double end = rec.time[w.first] + seconds;
   w.last = w.first;
   while (w.last + 1 < rec.num_rows() && rec.time[w.last + 1] <= end + 1e-9 && !std::isnan(rec.tendon[w.last + 1]))
     ++w.last;
   if (w.last + 1 < rec.num_rows() && rec.time[w.last + 1] <= end + 1e-9) {
     std::ostringstream note;
-    note << rec.path << ":" << rec.lines[w.last + 1] << ": tendon contraction is NaN from t = "
-         << rec.time[w.last + 1] << " s; the window stops before it (" << rec.time[w.last] - rec.time[w.first]
-         << " s instead of " << seconds << " s)";
+    note << rec.path << ":" << rec.lines[w.last + 1] << ": tendon contraction is NaN from t = " << rec.time[w.last + 1]
+         << " s; the window stops before it (" << rec.time[w.last] - rec.time[w.first] << " s instead of " << seconds
+         << " s)";
     w.note = note.str();
   } else if (w.last + 1 == rec.num_rows() && rec.time[w.last] < end - 0.5 / StarfishCalibration::kFrameRate) {
     std::ostringstream note;
@@ -318,8 +318,10 @@ StarfishWindow MakeStarfishWindow(const StarfishRecording& rec, double start, do
 
 const char* ToString(StarfishRegions regions) {
   switch (regions) {
-    case StarfishRegions::kNone: return "none";
-    case StarfishRegions::kBodyArms: return "body-arms";
+    case StarfishRegions::kNone:
+      return "none";
+    case StarfishRegions::kBodyArms:
+      return "body-arms";
   }
   return "unknown";
 }
@@ -331,7 +333,8 @@ StarfishRegions ParseStarfishRegions(const std::string& name) {
 }
 
 std::string StarfishCalibration::description() const {
-  return "fit E, nu, tendon slack, servo lag and tendon length of a soft starfish swimming underwater to real captured motion, predict other recordings";
+  return "fit E, nu, tendon slack, servo lag and tendon length of a soft starfish swimming underwater to real captured "
+         "motion, predict other recordings";
 }
 
 void StarfishCalibration::set_substeps(int substeps) {
@@ -355,8 +358,8 @@ std::array<int, 4> StarfishCalibration::MarkerVertices(const Mesh& mesh) {
       if (best < 0 || p(1) < mesh.vertices(1, best)) best = i;
     }
     if (best < 0)
-      throw InvalidInputError("starfish mesh: no vertex on the flat face within 4 mm of z = " +
-                              Num(kMarkerTargetZ[m]) + " m for marker M" + std::to_string(m + 1));
+      throw InvalidInputError("starfish mesh: no vertex on the flat face within 4 mm of z = " + Num(kMarkerTargetZ[m]) +
+                              " m for marker M" + std::to_string(m + 1));
     vertices[m] = best;
   }
   return vertices;
@@ -534,8 +537,8 @@ std::unique_ptr<solvers::CalibrationModel> StarfishCalibration::MakeModel(const 
                             {0, solvers::MaterialParameter::kPoissonsRatio}};
   setup.inputs = WindowInputs(rec, w, actuation);
   setup.num_steps = static_cast<int>(setup.inputs.size());
-  setup.input_parameters = std::make_shared<TendonActuationInputs>(WindowContractions(rec, w),
-                                                                   setup.solver.time_step, 4);
+  setup.input_parameters =
+      std::make_shared<TendonActuationInputs>(WindowContractions(rec, w), setup.solver.time_step, 4);
   setup.jacobian = solvers::JacobianMode::kReverse;
   {
     Simulator sim(setup.scene, setup.solver);
@@ -601,7 +604,8 @@ MaterialParameters StarfishCalibration::FromCoordinates(const double* u, double 
 
 void StarfishCalibration::ToCoordinates(const MaterialParameters& m, double* u) {
   if (!(m.youngs_modulus > kMinE && m.youngs_modulus < kMaxE))
-    throw InvalidInputError("youngs_modulus = " + Num(m.youngs_modulus) + " is outside the fit's interval (1e4, 5e6) Pa");
+    throw InvalidInputError("youngs_modulus = " + Num(m.youngs_modulus) +
+                            " is outside the fit's interval (1e4, 5e6) Pa");
   if (!(m.poissons_ratio > kMinNu && m.poissons_ratio < kMaxNu))
     throw InvalidInputError("poissons_ratio = " + Num(m.poissons_ratio) + " is outside the fit's interval (0.2, 0.45)");
   u[0] = Logit(std::log(m.youngs_modulus / kMinE) / std::log(kMaxE / kMinE));
@@ -638,9 +642,10 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
     return with_regions.Run(rest);
   }
   if (args.steps > 0 || args.dt > 0)
-    throw InvalidInputError("--steps and --dt are fixed by the recordings of " + name() +
-                            " (60 Hz camera frames, " + std::to_string(substeps_) + " steps per frame)");
-  if (!args.data_file.empty()) throw InvalidInputError(name() + " reads its recordings from --calibrate and --predict, not --data");
+    throw InvalidInputError("--steps and --dt are fixed by the recordings of " + name() + " (60 Hz camera frames, " +
+                            std::to_string(substeps_) + " steps per frame)");
+  if (!args.data_file.empty())
+    throw InvalidInputError(name() + " reads its recordings from --calibrate and --predict, not --data");
   const auto start_clock = std::chrono::steady_clock::now();
   FILE* log = args.json ? stderr : stdout;
   const double seconds = args.seconds > 0 ? args.seconds : kDefaultSeconds;
@@ -650,14 +655,13 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
   std::vector<std::string> predict_paths = args.predict_files;
   if (calibrate_path.empty()) {
     calibrate_path = SharedDataPath("starfish/data_horizontal_cyclic1.csv");
-    if (predict_paths.empty())
-      predict_paths = {calibrate_path, SharedDataPath("starfish/data_horizontal_cyclic2.csv")};
+    if (predict_paths.empty()) predict_paths = {calibrate_path, SharedDataPath("starfish/data_horizontal_cyclic2.csv")};
   } else if (predict_paths.empty()) {
     predict_paths = {calibrate_path};
   }
   // pd-lbfgs unless chosen: --methods (first entry) or a --method other than
   // the command line's default (pd).
-  const Method method = !args.methods.empty()       ? ParseMethod(args.methods.front())
+  const Method method = !args.methods.empty()        ? ParseMethod(args.methods.front())
                         : args.method != Method::kPd ? args.method
                                                      : Method::kPdLbfgs;
   const SolverOptions options = Options(method, args.threads);
@@ -672,10 +676,12 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
 
   const Scene scene = MakeScene();
   std::fprintf(log, "# %s: %s\n", name().c_str(), description().c_str());
-  std::fprintf(log, "# mesh: TetGen -%s of starfish_half_simplified.obj: %d nodes, %d tets, %d DoFs (%zu with y, z fixed)\n",
+  std::fprintf(log,
+               "# mesh: TetGen -%s of starfish_half_simplified.obj: %d nodes, %d tets, %d DoFs (%zu with y, z fixed)\n",
                kTetgenSwitches, scene.mesh.num_vertices(), scene.mesh.num_elements(), scene.mesh.num_dofs(),
                scene.dirichlet.dofs.size() / 2);
-  std::fprintf(log, "# muscles (elements): -z %zu, +z %zu, -y %zu, +y %zu; %d wetted triangles; %s, %d steps per frame\n",
+  std::fprintf(log,
+               "# muscles (elements): -z %zu, +z %zu, -y %zu, +y %zu; %d wetted triangles; %s, %d steps per frame\n",
                scene.muscles[0].elements.size(), scene.muscles[1].elements.size(), scene.muscles[2].elements.size(),
                scene.muscles[3].elements.size(), static_cast<int>(scene.hydrodynamics->triangles.cols()),
                ToString(method), substeps_);
@@ -687,33 +693,40 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
   // The fit.
   const MaterialParameters guess = scene.material;
   const StarfishActuation actuation_guess = ActuationGuess();
-  std::fprintf(log, "# fit: Ceres L-BFGS on (log E, log nu, slack, log lag, log length%s) mapped into E in [1e4, 5e6] "
-               "Pa, nu in [0.2, 0.45], tendon slack in [0, 15] mm, servo lag in [1, 500] ms, tendon length in [30, 130] mm; "
-               "loss = 1/2 weighted mean squared marker error / (2 mm)^2\n",
-               regions_ == StarfishRegions::kBodyArms ? ", log E_arms" : "");
+  std::fprintf(
+      log,
+      "# fit: Ceres L-BFGS on (log E, log nu, slack, log lag, log length%s) mapped into E in [1e4, 5e6] "
+      "Pa, nu in [0.2, 0.45], tendon slack in [0, 15] mm, servo lag in [1, 500] ms, tendon length in [30, 130] mm; "
+      "loss = 1/2 weighted mean squared marker error / (2 mm)^2\n",
+      regions_ == StarfishRegions::kBodyArms ? ", log E_arms" : "");
   if (regions_ == StarfishRegions::kBodyArms)
-    std::fprintf(log, "# regions: body-arms: E of the %zu arm elements (centroid beyond |y|, |z| < 18 mm) fitted apart "
-                 "from the body's %zu; nu and density shared\n", scene.material_regions[0].elements.size(),
+    std::fprintf(log,
+                 "# regions: body-arms: E of the %zu arm elements (centroid beyond |y|, |z| < 18 mm) fitted apart "
+                 "from the body's %zu; nu and density shared\n",
+                 scene.material_regions[0].elements.size(),
                  scene.mesh.num_elements() - scene.material_regions[0].elements.size());
   const StarfishFit fit = Fit(calibration, fit_window, options, guess, actuation_guess,
                               args.max_iterations >= 0 ? args.max_iterations : kDefaultIterations, log);
   const MaterialParameters& fitted = fit.material;
   const StarfishActuation& actuation = fit.actuation;
   const solvers::CalibrationStatistics& stats = fit.statistics;
-  std::fprintf(log, "# fit: %s after %d iterations; E = %.6g Pa, nu = %.6g, slack = %.3f mm, lag = %.4f s, "
-               "length = %.2f mm; loss %.6e -> %.6e\n", fit.termination.c_str(), fit.iterations, fitted.youngs_modulus,
-               fitted.poissons_ratio, actuation.slack / kMm, actuation.lag, actuation.length / kMm, fit.initial_cost,
-               fit.final_cost);
+  std::fprintf(log,
+               "# fit: %s after %d iterations; E = %.6g Pa, nu = %.6g, slack = %.3f mm, lag = %.4f s, "
+               "length = %.2f mm; loss %.6e -> %.6e\n",
+               fit.termination.c_str(), fit.iterations, fitted.youngs_modulus, fitted.poissons_ratio,
+               actuation.slack / kMm, actuation.lag, actuation.length / kMm, fit.initial_cost, fit.final_cost);
   std::fprintf(log, "# fit: %d rollouts (%.2f s forward), %d gradients (%.2f s backward), %d failed\n", stats.rollouts,
                stats.forward_seconds, stats.gradients, stats.backward_seconds, stats.failures);
   if (!fit.region_materials.empty())
-    std::fprintf(log, "# fit: arms E = %.6g Pa (body E = %.6g Pa, ratio %.3g)\n", fit.region_materials[0].youngs_modulus,
-                 fitted.youngs_modulus, fit.region_materials[0].youngs_modulus / fitted.youngs_modulus);
+    std::fprintf(log, "# fit: arms E = %.6g Pa (body E = %.6g Pa, ratio %.3g)\n",
+                 fit.region_materials[0].youngs_modulus, fitted.youngs_modulus,
+                 fit.region_materials[0].youngs_modulus / fitted.youngs_modulus);
   if (stats.failures > 0) std::fprintf(log, "# last failure: %s\n", stats.last_error.c_str());
 
   // Predictions.
   nlohmann::json files = nlohmann::json::array();
-  std::fprintf(log, "\n# predictions with the fitted material (first %g s of each file)\n%-40s %8s %8s %10s %12s %10s\n",
+  std::fprintf(log,
+               "\n# predictions with the fitted material (first %g s of each file)\n%-40s %8s %8s %10s %12s %10s\n",
                seconds, "file", "seconds", "frames", "rmse_mm", "arm_rel_mm", "sim_s");
   for (size_t f = 0; f < predictions.size(); ++f) {
     const StarfishRecording& rec = predictions[f];
@@ -758,10 +771,12 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                           {"tendon_lag_s", actuation.lag},
                           {"tendon_length_mm", actuation.length / kMm},
                           {"truth", nlohmann::json::object()},
-                          {"initial_guess", {{"youngs_modulus", guess.youngs_modulus}, {"poissons_ratio", guess.poissons_ratio},
-                                             {"tendon_slack_mm", actuation_guess.slack / kMm},
-                                             {"tendon_lag_s", actuation_guess.lag},
-                                             {"tendon_length_mm", actuation_guess.length / kMm}}},
+                          {"initial_guess",
+                           {{"youngs_modulus", guess.youngs_modulus},
+                            {"poissons_ratio", guess.poissons_ratio},
+                            {"tendon_slack_mm", actuation_guess.slack / kMm},
+                            {"tendon_lag_s", actuation_guess.lag},
+                            {"tendon_length_mm", actuation_guess.length / kMm}}},
                           {"method", ToString(method)},
                           {"initial_cost", fit.initial_cost},
                           {"final_cost", fit.final_cost},
@@ -773,14 +788,17 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                           {"backward_seconds", stats.backward_seconds},
                           {"termination", fit.termination},
                           {"usable", fit.usable},
-                          {"mesh", {{"nodes", scene.mesh.num_vertices()}, {"tets", scene.mesh.num_elements()},
-                                    {"tetgen_switches", kTetgenSwitches}}},
+                          {"mesh",
+                           {{"nodes", scene.mesh.num_vertices()},
+                            {"tets", scene.mesh.num_elements()},
+                            {"tetgen_switches", kTetgenSwitches}}},
                           {"steps_per_frame", substeps_},
-                          {"calibration", {{"file", calibrate_path},
-                                           {"start_s", calibration.time[fit_window.first]},
-                                           {"seconds", calibration.time[fit_window.last] - calibration.time[fit_window.first]},
-                                           {"frames", fit_window.num_frames()},
-                                           {"marker_weights", kMarkerWeights}}},
+                          {"calibration",
+                           {{"file", calibrate_path},
+                            {"start_s", calibration.time[fit_window.first]},
+                            {"seconds", calibration.time[fit_window.last] - calibration.time[fit_window.first]},
+                            {"frames", fit_window.num_frames()},
+                            {"marker_weights", kMarkerWeights}}},
                           {"files", files},
                           {"total_seconds", total}};
     out["regions"] = ToString(regions_);

@@ -47,11 +47,11 @@ namespace diffpd::problems {
 // ..., M4 x, M4 y (mm, image plane). Stored here in SI units.
 struct StarfishRecording {
   std::string path;
-  std::vector<double> time;     // s, strictly increasing
-  std::vector<double> tendon;   // m; NaN where the file has NaN
+  std::vector<double> time;    // s, strictly increasing
+  std::vector<double> tendon;  // m; NaN where the file has NaN
   // Per row: image x and image y (m) of M1..M4: {x1, y1, x2, y2, ..., x4, y4}.
   std::vector<std::array<double, 8>> markers;
-  std::vector<int> lines;       // file line of each row (the header is line 1)
+  std::vector<int> lines;  // file line of each row (the header is line 1)
 
   int num_rows() const { return static_cast<int>(time.size()); }
 };
@@ -75,8 +75,8 @@ StarfishRecording ReadStarfishRecording(const std::string& path);
 // after it, stopping before the first row with a NaN tendon value.
 struct StarfishWindow {
   int first = 0;
-  int last = 0;           // inclusive; last > first
-  std::string note;       // why the window is shorter than asked ("" if it is not)
+  int last = 0;      // inclusive; last > first
+  std::string note;  // why the window is shorter than asked ("" if it is not)
   int num_frames() const { return last - first + 1; }
 };
 // Throws InvalidInputError if `seconds` is not finite and > 0, if `start` is
@@ -138,16 +138,16 @@ StarfishRegions ParseStarfishRegions(const std::string& name);
 
 // The outcome of a fit (StarfishCalibration::Fit).
 struct StarfishFit {
-  MaterialParameters material;   // fitted (the body's with kBodyArms)
+  MaterialParameters material;  // fitted (the body's with kBodyArms)
   // kBodyArms: the arms' fitted material (E fitted; nu = material's,
   // density = material's); empty otherwise.
   std::vector<MaterialParameters> region_materials;
-  StarfishActuation actuation;   // fitted
-  double initial_cost = 0;       // loss 1/2 |r|^2 (see WindowMotion) at the start
+  StarfishActuation actuation;  // fitted
+  double initial_cost = 0;      // loss 1/2 |r|^2 (see WindowMotion) at the start
   double final_cost = 0;
-  int iterations = 0;            // Ceres L-BFGS iterations
-  bool usable = false;           // Ceres' solution is usable
-  std::string termination;       // Ceres' message
+  int iterations = 0;                         // Ceres L-BFGS iterations
+  bool usable = false;                        // Ceres' solution is usable
+  std::string termination;                    // Ceres' message
   solvers::CalibrationStatistics statistics;  // rollouts, gradients, timings
 };
 
@@ -155,8 +155,8 @@ class StarfishCalibration : public Problem {
  public:
   // Marker weights of the fit, M1..M4 (weights of the squared errors).
   static constexpr std::array<double, 4> kMarkerWeights = {10, 1, 1, 10};
-  static constexpr double kFrameRate = 60;     // Hz, the camera
-  static constexpr double kTendonRest = 0.065; // m: the fact sheet's a = 1 - contraction / 65 mm
+  static constexpr double kFrameRate = 60;      // Hz, the camera
+  static constexpr double kTendonRest = 0.065;  // m: the fact sheet's a = 1 - contraction / 65 mm
 
   std::string name() const override { return "calibrate-starfish"; }
   std::string description() const override;
@@ -214,9 +214,8 @@ class StarfishCalibration : public Problem {
   // an input block). The initial state is WindowInitialState at `actuation` and is
   // held fixed, so the gradient is exact when the window starts with the
   // tendon slack (a = 1, as in the default fit window from rest).
-  std::unique_ptr<solvers::CalibrationModel> MakeModel(const StarfishRecording& recording,
-                                                       const StarfishWindow& window, const SolverOptions& options,
-                                                       const MaterialParameters& material,
+  std::unique_ptr<solvers::CalibrationModel> MakeModel(const StarfishRecording& recording, const StarfishWindow& window,
+                                                       const SolverOptions& options, const MaterialParameters& material,
                                                        const StarfishActuation& actuation) const;
 
   // Fits E, nu, slack, lag and length on a window with Ceres' L-BFGS

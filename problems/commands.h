@@ -20,13 +20,13 @@ struct CommandArgs {
   std::string problem;
   Method method = Method::kPd;
   int threads = 0;
-  int steps = -1;        // -1: the problem's default
-  double dt = -1;        // -1: the problem's default (s)
-  double rel_tolerance = -1;  // -1: the command's default
-  double lbfgs_weight_scale = SolverOptions().lbfgs_weight_scale;  // pd-lbfgs preconditioner
+  int steps = -1;                                                      // -1: the problem's default
+  double dt = -1;                                                      // -1: the problem's default (s)
+  double rel_tolerance = -1;                                           // -1: the command's default
+  double lbfgs_weight_scale = SolverOptions().lbfgs_weight_scale;      // pd-lbfgs preconditioner
   bool rigid_mode_correction = SolverOptions().rigid_mode_correction;  // pd-lbfgs, PD backward
-  int verbosity = 0;     // SolverOptions::verbosity: 0 silent, 1 per step, 2 per iteration
-  std::string out_dir;   // "" : no files
+  int verbosity = 0;    // SolverOptions::verbosity: 0 silent, 1 per step, 2 per iteration
+  std::string out_dir;  // "" : no files
   bool json = false;
   // Optimisation problems (Problem::Run): the reduced instance, whether to
   // repeat the solve with newton-cholesky for the time ratio, and Ipopt

@@ -24,8 +24,8 @@ double RelativeError(double a, double b) {
 
 }  // namespace
 
-GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& options, const State& initial,
-                                     int steps, const GradCheckOptions& check) {
+GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& options, const State& initial, int steps,
+                                     const GradCheckOptions& check) {
   std::mt19937_64 rng(check.seed);
   Simulator sim(scene, options);
   const int n = sim.num_dofs();
@@ -36,7 +36,8 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   for (auto& in : inputs) in.external_force = 0.1 * node_force * RandomVector(&rng, n);
   const int num_muscles = static_cast<int>(scene.muscles.size());
   if (num_muscles > 0)
-    for (auto& in : inputs) in.activation = VectorXd::Constant(num_muscles, 0.9) + 0.02 * RandomVector(&rng, num_muscles);
+    for (auto& in : inputs)
+      in.activation = VectorXd::Constant(num_muscles, 0.9) + 0.02 * RandomVector(&rng, num_muscles);
 
   auto loss = [&](Simulator& s, const State& init, const std::vector<StepInput>& in) {
     const Rollout r = s.Simulate(init, in);
@@ -65,24 +66,37 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   const double eps_pos = check.relative_step * 0.1;  // m (0.1 m body scale)
   for (int k = 0; k < check.directions; ++k) {
     const VectorXd dx = RandomVector(&rng, n).normalized();
-    record("x0", n, [&](double e) { State s = initial; s.x += e * dx; return loss(sim, s, inputs); },
-           grad.x0.dot(dx), eps_pos);
+    record(
+        "x0", n,
+        [&](double e) {
+          State s = initial;
+          s.x += e * dx;
+          return loss(sim, s, inputs);
+        },
+        grad.x0.dot(dx), eps_pos);
     const VectorXd dv = RandomVector(&rng, n).normalized();
-    record("v0", n, [&](double e) { State s = initial; s.v += e * dv; return loss(sim, s, inputs); },
-           grad.v0.dot(dv), eps_pos / options.time_step);
+    record(
+        "v0", n,
+        [&](double e) {
+          State s = initial;
+          s.v += e * dv;
+          return loss(sim, s, inputs);
+        },
+        grad.v0.dot(dv), eps_pos / options.time_step);
     std::vector<VectorXd> df(steps);
     double analytic = 0;
     for (int i = 0; i < steps; ++i) {
       df[i] = RandomVector(&rng, n) * (node_force / std::sqrt(double(n * steps)));
       analytic += grad.external_force[i].dot(df[i]);
     }
-    record("external_force", long(n) * steps,
-           [&](double e) {
-             std::vector<StepInput> in = inputs;
-             for (int i = 0; i < steps; ++i) in[i].external_force += e * df[i];
-             return loss(sim, initial, in);
-           },
-           analytic, 100 * check.relative_step);  // forces act almost linearly: a larger step beats rounding
+    record(
+        "external_force", long(n) * steps,
+        [&](double e) {
+          std::vector<StepInput> in = inputs;
+          for (int i = 0; i < steps; ++i) in[i].external_force += e * df[i];
+          return loss(sim, initial, in);
+        },
+        analytic, 100 * check.relative_step);  // forces act almost linearly: a larger step beats rounding
     if (num_muscles > 0) {
       std::vector<VectorXd> da(steps);
       double analytic_a = 0;
@@ -90,13 +104,14 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
         da[i] = RandomVector(&rng, num_muscles) / std::sqrt(double(num_muscles * steps));
         analytic_a += grad.activation[i].dot(da[i]);
       }
-      record("activation", long(num_muscles) * steps,
-             [&](double e) {
-               std::vector<StepInput> in = inputs;
-               for (int i = 0; i < steps; ++i) in[i].activation += e * da[i];
-               return loss(sim, initial, in);
-             },
-             analytic_a, check.relative_step);
+      record(
+          "activation", long(num_muscles) * steps,
+          [&](double e) {
+            std::vector<StepInput> in = inputs;
+            for (int i = 0; i < steps; ++i) in[i].activation += e * da[i];
+            return loss(sim, initial, in);
+          },
+          analytic_a, check.relative_step);
     }
   }
   // State-force parameters: a fresh simulator per perturbed scene. Forces are
@@ -106,29 +121,34 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     Simulator s(perturbed, options);
     return loss(s, initial, inputs);
   };
-  auto record_scene = [&](const std::string& name, const std::function<void(Scene*, double)>& perturb,
-                          double analytic, double eps) {
-    record(name, 1,
-           [&](double e) {
-             Scene p = scene;
-             perturb(&p, e);
-             return scene_loss(p);
-           },
-           analytic, eps);
+  auto record_scene = [&](const std::string& name, const std::function<void(Scene*, double)>& perturb, double analytic,
+                          double eps) {
+    record(
+        name, 1,
+        [&](double e) {
+          Scene p = scene;
+          perturb(&p, e);
+          return scene_loss(p);
+        },
+        analytic, eps);
   };
   if (scene.linear_damping)
-    record_scene("linear_damping", [](Scene* p, double e) { *p->linear_damping += e; },
-                 grad.state_forces.linear_damping, force_step * std::max(1.0, *scene.linear_damping));
+    record_scene(
+        "linear_damping", [](Scene* p, double e) { *p->linear_damping += e; }, grad.state_forces.linear_damping,
+        force_step * std::max(1.0, *scene.linear_damping));
   if (scene.hydrodynamics) {
     const Hydrodynamics& hy = *scene.hydrodynamics;
-    record_scene("fluid_density", [](Scene* p, double e) { p->hydrodynamics->fluid_density += e; },
-                 grad.state_forces.fluid_density, force_step * std::max(1.0, hy.fluid_density));
-    record_scene("drag_tangential", [](Scene* p, double e) { p->hydrodynamics->drag_tangential += e; },
-                 grad.state_forces.drag_tangential, force_step);
-    record_scene("drag_normal", [](Scene* p, double e) { p->hydrodynamics->drag_normal += e; },
-                 grad.state_forces.drag_normal, force_step);
-    record_scene("thrust", [](Scene* p, double e) { p->hydrodynamics->thrust += e; }, grad.state_forces.thrust,
-                 force_step);
+    record_scene(
+        "fluid_density", [](Scene* p, double e) { p->hydrodynamics->fluid_density += e; },
+        grad.state_forces.fluid_density, force_step * std::max(1.0, hy.fluid_density));
+    record_scene(
+        "drag_tangential", [](Scene* p, double e) { p->hydrodynamics->drag_tangential += e; },
+        grad.state_forces.drag_tangential, force_step);
+    record_scene(
+        "drag_normal", [](Scene* p, double e) { p->hydrodynamics->drag_normal += e; }, grad.state_forces.drag_normal,
+        force_step);
+    record_scene(
+        "thrust", [](Scene* p, double e) { p->hydrodynamics->thrust += e; }, grad.state_forces.thrust, force_step);
   }
   bool any_friction = false;
   for (const auto& c : scene.penalty_contacts) any_friction = any_friction || c.friction > 0;
@@ -136,12 +156,13 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     double analytic = 0;
     for (size_t c = 0; c < scene.penalty_contacts.size(); ++c)
       if (scene.penalty_contacts[c].friction > 0) analytic += grad.state_forces.penalty_friction[c];
-    record_scene("penalty_friction",
-                 [](Scene* p, double e) {
-                   for (auto& c : p->penalty_contacts)
-                     if (c.friction > 0) c.friction += e;
-                 },
-                 analytic, force_step);
+    record_scene(
+        "penalty_friction",
+        [](Scene* p, double e) {
+          for (auto& c : p->penalty_contacts)
+            if (c.friction > 0) c.friction += e;
+        },
+        analytic, force_step);
   }
   const MaterialParameters base = scene.material;
   auto material_loss = [&](MaterialParameters m) {
@@ -150,14 +171,30 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     sim.SetMaterial(base);
     return l;
   };
-  record("youngs_modulus", 1,
-         [&](double e) { MaterialParameters m = base; m.youngs_modulus += e; return material_loss(m); },
-         grad.youngs_modulus, check.relative_step * base.youngs_modulus);
-  record("poissons_ratio", 1,
-         [&](double e) { MaterialParameters m = base; m.poissons_ratio += e; return material_loss(m); },
-         grad.poissons_ratio, check.relative_step * 0.1);
-  record("density", 1, [&](double e) { MaterialParameters m = base; m.density += e; return material_loss(m); },
-         grad.density, check.relative_step * base.density);
+  record(
+      "youngs_modulus", 1,
+      [&](double e) {
+        MaterialParameters m = base;
+        m.youngs_modulus += e;
+        return material_loss(m);
+      },
+      grad.youngs_modulus, check.relative_step * base.youngs_modulus);
+  record(
+      "poissons_ratio", 1,
+      [&](double e) {
+        MaterialParameters m = base;
+        m.poissons_ratio += e;
+        return material_loss(m);
+      },
+      grad.poissons_ratio, check.relative_step * 0.1);
+  record(
+      "density", 1,
+      [&](double e) {
+        MaterialParameters m = base;
+        m.density += e;
+        return material_loss(m);
+      },
+      grad.density, check.relative_step * base.density);
   for (const auto& e : result.inputs) result.max_rel_error = std::max(result.max_rel_error, e.max_rel_error);
   return result;
 }

@@ -31,9 +31,9 @@ struct GradCheckOptions {
 };
 
 struct GradCheckEntry {
-  std::string input;       // "x0", "v0", "external_force", "youngs_modulus", ...
+  std::string input;  // "x0", "v0", "external_force", "youngs_modulus", ...
   double max_rel_error = 0;
-  long entries = 0;        // number of scalar inputs of this kind
+  long entries = 0;  // number of scalar inputs of this kind
   int directions = 0;
 };
 
@@ -44,7 +44,7 @@ struct GradCheckResult {
 
 // Runs the check; the solver options are used as given (make tolerances
 // tight: the finite differences are only as good as the forward solves).
-GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& options, const State& initial,
-                                     int steps, const GradCheckOptions& check = GradCheckOptions());
+GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& options, const State& initial, int steps,
+                                     const GradCheckOptions& check = GradCheckOptions());
 
 }  // namespace diffpd::problems

@@ -26,8 +26,10 @@ int GradcheckCommand(const CommandArgs& args) {
     nlohmann::json inputs = nlohmann::json::object();
     for (const auto& e : result.inputs)
       inputs[e.input] = {{"max_rel_error", e.max_rel_error}, {"entries", e.entries}, {"directions", e.directions}};
-    nlohmann::json out = {{"problem", problem->name()}, {"method", ToString(options.method)},
-                          {"max_rel_error", result.max_rel_error}, {"inputs", inputs}};
+    nlohmann::json out = {{"problem", problem->name()},
+                          {"method", ToString(options.method)},
+                          {"max_rel_error", result.max_rel_error},
+                          {"inputs", inputs}};
     std::printf("%s\n", out.dump(2).c_str());
   } else {
     std::printf("%-16s %14s %10s %10s\n", "input", "max_rel_error", "entries", "directions");

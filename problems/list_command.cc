@@ -11,8 +11,10 @@ namespace diffpd::problems {
 int ListCommand(bool json) {
   nlohmann::json out = nlohmann::json::array();
   for (const auto& p : AllProblems()) {
-    if (json) out.push_back({{"name", p->name()}, {"description", p->description()}});
-    else std::printf("%-24s %s\n", p->name().c_str(), p->description().c_str());
+    if (json)
+      out.push_back({{"name", p->name()}, {"description", p->description()}});
+    else
+      std::printf("%-24s %s\n", p->name().c_str(), p->description().c_str());
   }
   if (json) std::printf("%s\n", out.dump(2).c_str());
   return 0;

@@ -110,9 +110,12 @@ std::vector<int> NodesWhere(const Mesh& mesh, const std::function<bool(const Vec
 
 std::string Locomotion::name() const {
   switch (body_) {
-    case Body::kTorus: return "torus";
-    case Body::kQuadruped: return "quadruped";
-    case Body::kCow: return "cow";
+    case Body::kTorus:
+      return "torus";
+    case Body::kQuadruped:
+      return "quadruped";
+    case Body::kCow:
+      return "cow";
   }
   return "";
 }
@@ -226,8 +229,8 @@ Ipopt::SmartPtr<solvers::RolloutNlp> Locomotion::MakeNlp(Simulator* sim, Instanc
 
 solvers::IpoptOptions Locomotion::DefaultIpoptOptions(InstanceSize size) const {
   solvers::IpoptOptions o;
-  o.int_options = {{"max_iter", size == InstanceSize::kSmall ? 8 : 40}, {"acceptable_iter", 5},
-                   {"accept_after_max_steps", 3}};
+  o.int_options = {
+      {"max_iter", size == InstanceSize::kSmall ? 8 : 40}, {"acceptable_iter", 5}, {"accept_after_max_steps", 3}};
   o.num_options = {{"tol", 1e-4}, {"acceptable_tol", 1e-3}};
   return o;
 }

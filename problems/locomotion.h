@@ -22,13 +22,11 @@
 //    35 % of its height); muscles = the four legs, fibres vertical; "up"
 //    as for the quadruped.
 // Small: coarse voxels, 20 steps (two periods; quadruped 30), 8 Ipopt
-// iterations, steps solved to rel_tolerance 1e-4 (full: 1e-6); full: finer voxels (torus and cow 12.5 mm, quadruped 15 mm),
-// 40 steps, 40 iterations (a full rollout takes about 10 s with
-// newton-cholesky on one core: finer meshes are out of reach for now). Ipopt accepts a trial point after 3
-// backtracking steps (accept_after_max_steps): the contact makes the
-// objective piecewise smooth, and long line searches cost a rollout each.
-// Start: a travelling wave of amplitude 0.1.
-// The objective's improvement rule: at least 0.2 cm more travel than the start.
+// iterations, steps solved to rel_tolerance 1e-4 (full: 1e-6); full: finer voxels (torus and cow 12.5 mm, quadruped 15
+// mm), 40 steps, 40 iterations (a full rollout takes about 10 s with newton-cholesky on one core: finer meshes are out
+// of reach for now). Ipopt accepts a trial point after 3 backtracking steps (accept_after_max_steps): the contact makes
+// the objective piecewise smooth, and long line searches cost a rollout each. Start: a travelling wave of amplitude
+// 0.1. The objective's improvement rule: at least 0.2 cm more travel than the start.
 #pragma once
 
 #include "trajectory_optimization.h"
@@ -42,7 +40,10 @@ class Locomotion : public TrajectoryOptimizationProblem {
   // whose coarse legs need three periods to get going, 20 otherwise; tests
   // shorten it).
   explicit Locomotion(Body body, int small_steps = -1)
-      : body_(body), small_steps_(small_steps > 0 ? small_steps : body == Body::kQuadruped ? 30 : 20) {}
+      : body_(body),
+        small_steps_(small_steps > 0            ? small_steps
+                     : body == Body::kQuadruped ? 30
+                                                : 20) {}
   std::string name() const override;
   std::string description() const override;
   Scene MakeScene(InstanceSize size) const override;
@@ -54,7 +55,7 @@ class Locomotion : public TrajectoryOptimizationProblem {
   double RequiredObjective(double initial_objective) const override { return initial_objective - 0.2; }
   std::string improvement_rule() const override { return "at least 0.2 cm more forward travel than the start"; }
 
-  static constexpr double kPeriod = 0.1;           // s
+  static constexpr double kPeriod = 0.1;  // s
   static constexpr double kMinActivation = 0.7;
   static constexpr double kMaxActivation = 1.3;
   static constexpr double kMaxTiltDegrees = 30.0;

@@ -16,8 +16,8 @@ using diffpd::problems::CommandArgs;
 // Adds the options shared by the simulating subcommands.
 void AddCommonOptions(CLI::App* cmd, CommandArgs* args, std::string* method) {
   cmd->add_option("problem", args->problem, "problem name (see `diffpd list`)")->required();
-  cmd->add_option("--method", *method,
-                  "semi-implicit, newton-cholesky, newton-pcg, pd or pd-lbfgs")->capture_default_str();
+  cmd->add_option("--method", *method, "semi-implicit, newton-cholesky, newton-pcg, pd or pd-lbfgs")
+      ->capture_default_str();
   cmd->add_option("--threads", args->threads, "threads for element loops (0: OpenMP default)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--steps", args->steps, "number of time steps (default: the problem's)");
@@ -48,13 +48,17 @@ int main(int argc, char** argv) {
   std::string run_method = "pd-lbfgs", grad_method = "pd";  // pd-lbfgs: the fastest PD variant measured on every scene
   CLI::App* run = app.add_subcommand("run", "simulate a problem, print a per-step table and write results");
   AddCommonOptions(run, &run_args, &run_method);
-  run->add_option("--out", run_args.out_dir, "directory for VTK frames (.vtu + .pvd), plots and summary.json (optimisation problems: default out/<problem>)");
+  run->add_option(
+      "--out", run_args.out_dir,
+      "directory for VTK frames (.vtu + .pvd), plots and summary.json (optimisation problems: default out/<problem>)");
   run->add_flag("--small", run_args.small, "optimisation problems: the reduced instance (under a minute)");
   run->add_flag("!--no-compare", run_args.compare_newton,
                 "optimisation problems: skip the repeat with newton-cholesky");
   run->add_option("--ipopt", run_args.ipopt_options, "optimisation problems: Ipopt option name=value (repeatable)");
-  run->add_option("--data", run_args.data_file, "calibration problems: captured-motion CSV (default: the problem's in data/)");
-  run->add_option("--methods", run_args.methods, "calibration problems: methods to fit with, compared (comma-separated)")
+  run->add_option("--data", run_args.data_file,
+                  "calibration problems: captured-motion CSV (default: the problem's in data/)");
+  run->add_option("--methods", run_args.methods,
+                  "calibration problems: methods to fit with, compared (comma-separated)")
       ->delimiter(',');
   run->add_option("--max-iterations", run_args.max_iterations, "calibration problems: Ceres iterations per fit");
   run->add_option("--calibrate", run_args.calibrate_file, "calibrate-starfish: the recording to fit");

@@ -25,9 +25,7 @@ class Problem {
   virtual int default_steps() const = 0;
   virtual double default_time_step() const = 0;
   // Per-step inputs of a default rollout (defaults to no input).
-  virtual std::vector<StepInput> Inputs(const Simulator& sim, int steps) const {
-    return std::vector<StepInput>(steps);
-  }
+  virtual std::vector<StepInput> Inputs(const Simulator& sim, int steps) const { return std::vector<StepInput>(steps); }
   // `diffpd run <problem>`: a problem that is more than a forward simulation
   // (an optimisation) runs itself and returns the exit code; -1 (the
   // default) means "simulate forward as usual".

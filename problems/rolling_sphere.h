@@ -29,8 +29,8 @@ class RollingSphere : public Problem {
   int default_steps() const override { return 100; }
   double default_time_step() const override { return 0.005; }
 
-  static constexpr double kRadius = 0.05;       // m
-  static constexpr double kSpin = 10.0;         // rad/s about +y
+  static constexpr double kRadius = 0.05;  // m
+  static constexpr double kSpin = 10.0;    // rad/s about +y
   static constexpr double kScreeningRelTolerance = 0.1;
   // The sphere's centre (m): the midpoint of the mesh's bounding box.
   static Vec3 Center(const Scene& scene);

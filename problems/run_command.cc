@@ -31,9 +31,9 @@ int RunCommand(const CommandArgs& args) {
     pvd->AddFrame(0.0, mesh, Eigen::Map<const Eigen::Matrix3Xd>(state.x.data(), 3, mesh.num_vertices()));
   }
   FILE* table = args.json ? stderr : stdout;
-  std::fprintf(table, "# %s: %d nodes, %d elements, %d DoFs, method %s, h = %g s, %d steps\n",
-               problem->name().c_str(), mesh.num_vertices(), mesh.num_elements(), sim.num_dofs(),
-               ToString(options.method), options.time_step, steps);
+  std::fprintf(table, "# %s: %d nodes, %d elements, %d DoFs, method %s, h = %g s, %d steps\n", problem->name().c_str(),
+               mesh.num_vertices(), mesh.num_elements(), sim.num_dofs(), ToString(options.method), options.time_step,
+               steps);
   std::fprintf(table, "%6s %8s %12s %12s %12s %14s %14s\n", "step", "iters", "|grad g|0", "|grad g|", "time_ms",
                "max_disp_m", "kinetic_J");
   nlohmann::json step_rows = nlohmann::json::array();
@@ -48,13 +48,19 @@ int RunCommand(const CommandArgs& args) {
     for (int v = 0; v < mesh.num_vertices(); ++v)
       max_disp = std::max(max_disp, (state.x.segment<3>(3 * v) - rest.segment<3>(3 * v)).norm());
     const double kinetic = 0.5 * state.v.cwiseProduct(mass).dot(state.v);
-    std::fprintf(table, "%6d %8d %12.4e %12.4e %12.3f %14.6e %14.6e\n", i + 1, rep.iterations,
-                 rep.initial_residual, rep.final_residual, 1e3 * rep.seconds, max_disp, kinetic);
+    std::fprintf(table, "%6d %8d %12.4e %12.4e %12.3f %14.6e %14.6e\n", i + 1, rep.iterations, rep.initial_residual,
+                 rep.final_residual, 1e3 * rep.seconds, max_disp, kinetic);
     std::fflush(table);
-    step_rows.push_back({{"step", i + 1}, {"iterations", rep.iterations}, {"line_search_steps", rep.line_search_steps}, {"residual", rep.final_residual},
-                         {"seconds", rep.seconds}, {"max_displacement", max_disp}, {"kinetic_energy", kinetic}});
-    if (pvd) pvd->AddFrame((i + 1) * options.time_step, mesh,
-                           Eigen::Map<const Eigen::Matrix3Xd>(state.x.data(), 3, mesh.num_vertices()));
+    step_rows.push_back({{"step", i + 1},
+                         {"iterations", rep.iterations},
+                         {"line_search_steps", rep.line_search_steps},
+                         {"residual", rep.final_residual},
+                         {"seconds", rep.seconds},
+                         {"max_displacement", max_disp},
+                         {"kinetic_energy", kinetic}});
+    if (pvd)
+      pvd->AddFrame((i + 1) * options.time_step, mesh,
+                    Eigen::Map<const Eigen::Matrix3Xd>(state.x.data(), 3, mesh.num_vertices()));
   }
   nlohmann::json summary = {{"problem", problem->name()},
                             {"method", ToString(options.method)},

@@ -74,8 +74,7 @@ void StressOptions::Validate() const {
   if (!(gradcheck_tolerance > 0)) fail("gradcheck_tolerance", gradcheck_tolerance, "> 0");
 }
 
-DerivativeVerdict JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences,
-                                  double tolerance) {
+DerivativeVerdict JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences, double tolerance) {
   DerivativeVerdict verdict;
   verdict.error = std::numeric_limits<double>::infinity();
   bool resolved = false;
@@ -114,8 +113,8 @@ StressGradientCheck CheckStressGradient(const Scene& scene, const SolverOptions&
   const State& last = rollout.states.back();
   // Rounding scale of the loss: sum of |c_i s_i|, v = (x_K - x_{K-1}) / h
   // carrying the rounding of x over h.
-  const double loss_magnitude = loss.cx.cwiseAbs().dot(last.x.cwiseAbs()) +
-                                loss.cv.cwiseAbs().dot(last.v.cwiseAbs() + last.x.cwiseAbs() / h);
+  const double loss_magnitude =
+      loss.cx.cwiseAbs().dot(last.x.cwiseAbs()) + loss.cv.cwiseAbs().dot(last.v.cwiseAbs() + last.x.cwiseAbs() / h);
   // Estimate of the loss error the solves leave: a residual r moves x by at
   // most r h^2 / m_min (hess g >= M / h^2 at a minimum) and v by that over h;
   // r_k = 10 x step k's final residual (the perturbed rollouts stop at
@@ -290,8 +289,8 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
         method == Method::kSemiImplicit ? options.explicit_energy_tolerance : options.energy_tolerance;
     if (c.max_energy_excess > energy_tolerance) {
       std::ostringstream msg;
-      msg << "the total energy rose by " << c.max_energy_excess << " (relative) > energy tolerance "
-          << energy_tolerance << " without an error";
+      msg << "the total energy rose by " << c.max_energy_excess << " (relative) > energy tolerance " << energy_tolerance
+          << " without an error";
       if (method == Method::kSemiImplicit) msg << " (semi-implicit: h above its stability limit)";
       return finish("violation", msg.str());
     }
@@ -325,8 +324,7 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
         if (!check.resolved[k]) c.gradcheck_unresolved.push_back(check.inputs[k]);
       if (!(check.max_error <= options.gradcheck_tolerance)) {
         std::ostringstream msg;
-        msg << "gradient check: relative error " << check.max_error << " > " << options.gradcheck_tolerance
-            << " (";
+        msg << "gradient check: relative error " << check.max_error << " > " << options.gradcheck_tolerance << " (";
         for (size_t k = 0; k < check.inputs.size(); ++k)
           msg << (k ? ", " : "") << check.inputs[k] << " " << check.errors[k];
         msg << ")";
@@ -357,8 +355,7 @@ std::vector<StressCase> RunStress(const StressOptions& options, std::ostream* pr
               const StressCase& c = cases.back();
               *progress << "[stress " << cases.size() << "/" << total << "] " << c.problem << " " << c.method
                         << " E=" << e << " nu=" << nu << " h=" << h << ": " << c.outcome
-                        << (c.message.empty() ? "" : " (" + c.message + ")") << " " << c.seconds << " s"
-                        << std::endl;
+                        << (c.message.empty() ? "" : " (" + c.message + ")") << " " << c.seconds << " s" << std::endl;
             }
           }
   return cases;

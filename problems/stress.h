@@ -41,12 +41,12 @@ struct StressOptions {
   std::vector<Method> methods = {Method::kPd, Method::kPdLbfgs, Method::kNewtonPcg, Method::kNewtonCholesky};
   std::vector<double> youngs_moduli = {1e2, 1e4, 1e6, 1e8, 1e10};  // Pa
   std::vector<double> poissons_ratios = {0, 0.3, 0.45, 0.499};
-  std::vector<double> time_steps = {1e-5, 1e-3, 1e-2, 1e-1};      // s
-  int steps = 10000;             // per case
-  double rel_tolerance = 1e-6;   // of each step (SolverOptions::rel_tolerance)
+  std::vector<double> time_steps = {1e-5, 1e-3, 1e-2, 1e-1};  // s
+  int steps = 10000;                                          // per case
+  double rel_tolerance = 1e-6;                                // of each step (SolverOptions::rel_tolerance)
   // Of each step (N); <= 0: AutoAbsTolerance(scene, h), above the rounding floor.
   double abs_tolerance = -1;
-  int max_iterations = 1000;     // of each step (SolverOptions::max_iterations)
+  int max_iterations = 1000;  // of each step (SolverOptions::max_iterations)
   int threads = 0;
   // Allowed rise of the total energy, relative to its magnitude, for the
   // implicit methods (implicit Euler dissipates: measured rises are 0).
@@ -55,7 +55,7 @@ struct StressOptions {
   // energy oscillates by O(h omega) when stable; a rise above half the
   // energy scale (the measure tends to 1 as energy explodes) is instability.
   double explicit_energy_tolerance = 0.5;
-  int gradcheck_steps = 3;       // prefix checked by finite differences (0: skip)
+  int gradcheck_steps = 3;  // prefix checked by finite differences (0: skip)
   // Allowed relative error of the check (CheckStressGradient's tolerance).
   double gradcheck_tolerance = 1e-4;
   std::uint64_t seed = 20211;
@@ -71,8 +71,8 @@ struct StressCase {
   std::string problem;
   std::string method;
   double youngs_modulus = 0, poissons_ratio = 0, time_step = 0;
-  std::string outcome;   // "ok", "failed" or "violation"
-  std::string message;   // empty for ok; the error or the violated property
+  std::string outcome;  // "ok", "failed" or "violation"
+  std::string message;  // empty for ok; the error or the violated property
   int steps_completed = 0;
   // Steps of the rollout that ended at g's rounding floor above the
   // tolerance (StepReport::rounding_floor_stop), and PD-LBFGS steps that
@@ -132,8 +132,7 @@ struct DerivativeVerdict {
   bool tested = false;  // false: the derivative disagrees but is within the noise at every step
 };
 // The rule of CheckStressGradient below for one derivative.
-DerivativeVerdict JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences,
-                                  double tolerance);
+DerivativeVerdict JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences, double tolerance);
 
 struct StressGradientCheck {
   std::vector<std::string> inputs;  // "x0", "v0", "external_force", ...

@@ -29,7 +29,8 @@ Subcommand AddSynthCommand(CLI::App* parent) {
     const std::unique_ptr<Problem> problem = MakeProblem(args->problem);
     const auto* calibration = dynamic_cast<const CalibrationProblem*>(problem.get());
     if (!calibration)
-      throw InvalidInputError("problem '" + args->problem + "' has no synthetic captured motion (not a calibration problem)");
+      throw InvalidInputError("problem '" + args->problem +
+                              "' has no synthetic captured motion (not a calibration problem)");
     for (const std::string& path : calibration->WriteSyntheticData(args->dir)) std::printf("wrote %s\n", path.c_str());
     return 0;
   };

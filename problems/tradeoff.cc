@@ -41,8 +41,8 @@ void Progress(std::ostream* out, const std::string& line) {
 
 RolloutMeasurement MustSucceed(RolloutMeasurement m, const std::string& what) {
   if (!m.ok())
-    throw SolverError(m.status, "the reference (" + what + ", newton-cholesky, rel_tolerance 1e-10) failed: " +
-                                    m.failure);
+    throw SolverError(m.status,
+                      "the reference (" + what + ", newton-cholesky, rel_tolerance 1e-10) failed: " + m.failure);
   return m;
 }
 
@@ -68,8 +68,10 @@ TradeoffRow MakeRow(const std::string& sweep, Method method, const std::string& 
 std::string Describe(const TradeoffRow& r) {
   std::ostringstream s;
   s << "[tradeoff] " << r.sweep << " " << r.method << " " << r.parameter << " = " << r.value << ": ";
-  if (!r.failure.empty()) s << "failed: " << r.failure;
-  else s << r.seconds << " s, state error " << r.state_rel_error << ", gradient error " << r.grad_rel_error;
+  if (!r.failure.empty())
+    s << "failed: " << r.failure;
+  else
+    s << r.seconds << " s, state error " << r.state_rel_error << ", gradient error " << r.grad_rel_error;
   return s.str();
 }
 
@@ -89,7 +91,7 @@ std::vector<int> CornerDofs(const Mesh& mesh) {
 // A resolution level's corner displacements and scaled material gradient.
 struct CornerMeasurement {
   RolloutMeasurement m;
-  VectorXd displacement;  // 24
+  VectorXd displacement;       // 24
   VectorXd material_gradient;  // (E dL/dE, nu dL/dnu, rho dL/drho)
   int dofs = 0, steps = 0, elements = 0;
 };
@@ -118,9 +120,9 @@ CornerMeasurement MeasureCorners(const std::string& problem_name, int doublings,
       out.displacement(k) = out.m.final_state.x(corners[k]) - rest(corners[k]);
     const int n = sim.num_dofs();
     const MaterialParameters& mat = scene.material;
-    out.material_gradient = Eigen::Vector3d(mat.youngs_modulus * out.m.gradient(2 * n),
-                                            mat.poissons_ratio * out.m.gradient(2 * n + 1),
-                                            mat.density * out.m.gradient(2 * n + 2));
+    out.material_gradient =
+        Eigen::Vector3d(mat.youngs_modulus * out.m.gradient(2 * n), mat.poissons_ratio * out.m.gradient(2 * n + 1),
+                        mat.density * out.m.gradient(2 * n + 2));
   }
   return out;
 }
@@ -143,8 +145,9 @@ void TradeoffOptions::Validate() const {
   if (methods.empty()) throw InvalidInputError("methods is empty: name at least one method");
   for (Method m : methods)
     if (m == Method::kSemiImplicit)
-      throw InvalidInputError("method semi-implicit has no tolerance to trade: use newton-cholesky, newton-pcg, "
-                              "pd or pd-lbfgs");
+      throw InvalidInputError(
+          "method semi-implicit has no tolerance to trade: use newton-cholesky, newton-pcg, "
+          "pd or pd-lbfgs");
   if (sweep_tolerance && tolerances.empty()) throw InvalidInputError("tolerances is empty: give at least one");
   for (double t : tolerances)
     if (!(t > 0 && t < 1)) fail("tolerance", t, "in (0, 1)");
@@ -283,8 +286,9 @@ bool GnuplotAvailable() {
 
 void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& png_path, const std::string& title) {
   if (!GnuplotAvailable())
-    throw std::runtime_error("--plot needs the gnuplot program, which is not on PATH (Debian: apt-get install "
-                             "gnuplot-nox), or leave out --plot");
+    throw std::runtime_error(
+        "--plot needs the gnuplot program, which is not on PATH (Debian: apt-get install "
+        "gnuplot-nox), or leave out --plot");
   const std::vector<std::string> sweeps = {"tolerance", "time_step", "resolution"};
   std::vector<std::string> present;
   for (const auto& s : sweeps)
@@ -315,16 +319,17 @@ void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& 
       script << block(s, m) << " << EOD\n";
       for (const auto& r : rows)
         if (r.sweep == s && r.method == m && r.failure.empty())
-          script << r.seconds << " " << std::max(r.state_rel_error, 1e-17) << " "
-                 << std::max(r.grad_rel_error, 1e-17) << "\n";
+          script << r.seconds << " " << std::max(r.state_rel_error, 1e-17) << " " << std::max(r.grad_rel_error, 1e-17)
+                 << "\n";
       script << "EOD\n";
     }
   script << "set multiplot layout 2," << present.size() << " title " << GnuplotQuote(title) << "\n";
   const char* what[2] = {"state", "gradient"};
   for (int row = 0; row < 2; ++row)
     for (const auto& s : present) {
-      const std::string label = s == "tolerance" ? "tolerance sweep" : s == "time_step" ? "time-step sweep"
-                                                                                          : "mesh-resolution sweep";
+      const std::string label = s == "tolerance"   ? "tolerance sweep"
+                                : s == "time_step" ? "time-step sweep"
+                                                   : "mesh-resolution sweep";
       script << "set title '" << label << "'\nset xlabel 'forward + backward time (s)'\nset ylabel '" << what[row]
              << " relative error'\nplot ";
       bool first = true;

@@ -36,11 +36,11 @@ struct TradeoffOptions {
   std::vector<double> tolerances = {1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8};
   // Tolerance of the time-step and resolution sweeps.
   double rel_tolerance = 1e-4;
-  int steps = -1;          // <= 0: the problem's default
-  double time_step = -1;   // h0; <= 0: the problem's default (s)
+  int steps = -1;         // <= 0: the problem's default
+  double time_step = -1;  // h0; <= 0: the problem's default (s)
   int threads = 0;
   int max_iterations = 1000;  // of each step's solve (the references use it too)
-  int refine = 0;          // mesh of the tolerance and time-step sweeps, finest of the resolution sweep
+  int refine = 0;             // mesh of the tolerance and time-step sweeps, finest of the resolution sweep
   int time_step_levels = 4;   // >= 1
   int resolution_levels = 4;  // >= 1
   bool sweep_tolerance = true;
@@ -53,12 +53,12 @@ struct TradeoffOptions {
 };
 
 struct TradeoffRow {
-  std::string sweep;      // "tolerance", "time_step" or "resolution"
+  std::string sweep;  // "tolerance", "time_step" or "resolution"
   std::string method;
   std::string parameter;  // "rel_tolerance", "time_step" (s) or "elements"
   double value = 0;
-  std::string failure;    // "" when the run succeeded
-  double seconds = 0;     // forward_s + backward_s
+  std::string failure;  // "" when the run succeeded
+  double seconds = 0;   // forward_s + backward_s
   double forward_s = 0, backward_s = 0, iters_per_step = 0;
   double state_rel_error = 0, grad_rel_error = 0;
   int dofs = 0, steps = 0;
@@ -82,7 +82,6 @@ bool GnuplotAvailable();
 // error and bottom row gradient error against seconds, log-log, one curve per
 // method (zero errors drawn at 1e-17). Throws std::runtime_error when gnuplot
 // is missing or fails, InvalidInputError for a path gnuplot cannot quote.
-void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& png_path,
-                       const std::string& title);
+void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& png_path, const std::string& title);
 
 }  // namespace diffpd::problems

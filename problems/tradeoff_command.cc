@@ -47,17 +47,21 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
   options.methods = ParseMethods(args.methods);
   options.sweep_tolerance = options.sweep_time_step = options.sweep_resolution = false;
   for (const auto& s : args.sweeps) {
-    if (s == "tolerance") options.sweep_tolerance = true;
-    else if (s == "time_step") options.sweep_time_step = true;
-    else if (s == "resolution") options.sweep_resolution = true;
+    if (s == "tolerance")
+      options.sweep_tolerance = true;
+    else if (s == "time_step")
+      options.sweep_time_step = true;
+    else if (s == "resolution")
+      options.sweep_resolution = true;
     else
       throw InvalidInputError("sweep '" + s + "' is invalid: valid sweeps are tolerance, time_step, resolution");
   }
   if (!args.plot.empty()) {
     // Fail before the (long) sweeps, not after.
     if (!GnuplotAvailable())
-      throw std::runtime_error("--plot needs the gnuplot program, which is not on PATH (Debian: apt-get install "
-                               "gnuplot-nox), or leave out --plot");
+      throw std::runtime_error(
+          "--plot needs the gnuplot program, which is not on PATH (Debian: apt-get install "
+          "gnuplot-nox), or leave out --plot");
     const auto dir = std::filesystem::absolute(args.plot).parent_path();
     if (!std::filesystem::is_directory(dir))
       throw InvalidInputError("--plot " + args.plot + " is invalid: directory " + dir.string() + " does not exist");

@@ -152,12 +152,12 @@ OptimizationReport RunOptimization(const TrajectoryOptimizationProblem& problem,
                    "# %s (%s instance): %d DoFs, %d steps of %g s, method %s; %d variables, %d constraints, "
                    "constraint Jacobian by %s mode\n",
                    problem.name().c_str(), SizeName(settings.size), run.num_dofs, run.num_steps, options.time_step,
-                   ToString(run.method), run.num_variables, run.num_constraints,
-                   solvers::ToString(run.jacobian_mode));
+                   ToString(run.method), run.num_variables, run.num_constraints, solvers::ToString(run.jacobian_mode));
     run.summary = SolveWithIpopt(nlp, ipopt);
     const IpoptSummary& s = run.summary;
     run.required_objective = problem.RequiredObjective(s.initial_objective);
-    run.improved = s.constraint_violation <= 1e-6 && std::isfinite(s.objective) && s.objective <= run.required_objective;
+    run.improved =
+        s.constraint_violation <= 1e-6 && std::isfinite(s.objective) && s.objective <= run.required_objective;
     if (settings.log) std::fprintf(settings.log, "# %s: %s\n", ToString(run.method), s.BriefReport().c_str());
 
     if (!settings.out_dir.empty()) {
@@ -175,7 +175,8 @@ OptimizationReport RunOptimization(const TrajectoryOptimizationProblem& problem,
             pvd.AddFrame(k * options.time_step, mesh,
                          Eigen::Map<const Eigen::Matrix3Xd>(rollout->states[k].x.data(), 3, mesh.num_vertices()));
           pvd.Write();
-          report.files.push_back((std::filesystem::path(settings.out_dir) / "frames" / (problem.name() + ".pvd")).string());
+          report.files.push_back(
+              (std::filesystem::path(settings.out_dir) / "frames" / (problem.name() + ".pvd")).string());
         }
       }
     }
@@ -188,8 +189,8 @@ OptimizationReport RunOptimization(const TrajectoryOptimizationProblem& problem,
     report.newton_time_ratio = sim_seconds(report.runs[1]) / std::max(sim_seconds(report.runs[0]), 1e-300);
   }
   if (!settings.out_dir.empty()) {
-    const std::string png = PlotHistories(settings.out_dir, problem.name() + ": objective per Ipopt iteration", histories,
-                                          all_positive);
+    const std::string png =
+        PlotHistories(settings.out_dir, problem.name() + ": objective per Ipopt iteration", histories, all_positive);
     if (!png.empty()) report.files.push_back(png);
     const std::string json_path = (std::filesystem::path(settings.out_dir) / "summary.json").string();
     std::ofstream(json_path) << ReportJson(report).dump(2) << "\n";

@@ -83,7 +83,7 @@ struct OptimizationRun {
   solvers::ConstraintJacobianMode jacobian_mode = solvers::ConstraintJacobianMode::kReverse;
   int num_variables = 0, num_constraints = 0, num_dofs = 0, num_steps = 0;
   double required_objective = 0;  // RequiredObjective(initial objective)
-  bool improved = false;  // feasible (violation <= 1e-6) and objective <= required_objective
+  bool improved = false;          // feasible (violation <= 1e-6) and objective <= required_objective
 };
 
 struct OptimizationReport {

@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(g++ make cmake pkg-config libeigen3-dev libsuitesparse-dev libmetis-dev libceres-dev
           coinor-libipopt-dev libgtest-dev libgmock-dev libomp-dev libcli11-dev nlohmann-json3-dev
-          gnuplot-nox tetgen)
+          gnuplot-nox tetgen clang-format git)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

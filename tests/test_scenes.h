@@ -53,7 +53,7 @@ inline std::vector<int> NodesAtXMin(const Mesh& mesh, double tol = 1e-9) {
 
 // A small clamped beam with gravity: the default test scene.
 inline Scene SmallBeamScene(bool tets = false, std::vector<ElasticEnergy> energies = {ElasticEnergy::kPdCorotated,
-                                                                                     ElasticEnergy::kPdVolume}) {
+                                                                                      ElasticEnergy::kPdVolume}) {
   Scene scene;
   scene.mesh = tets ? BoxTetMesh(3, 2, 2, 0.12, 0.04, 0.04) : BoxHexMesh(4, 2, 2, 0.16, 0.04, 0.04);
   scene.material.youngs_modulus = 2e5;

@@ -18,7 +18,8 @@ double Seconds(Clock::time_point start) { return std::chrono::duration<double>(C
 
 int StepsFor(const CalibrationSetup& setup) {
   if (setup.num_steps < 0)
-    throw InvalidInputError("num_steps = " + std::to_string(setup.num_steps) + " is invalid: must be >= 0 (0: enough to reach the last sample)");
+    throw InvalidInputError("num_steps = " + std::to_string(setup.num_steps) +
+                            " is invalid: must be >= 0 (0: enough to reach the last sample)");
   setup.solver.Validate();
   setup.motion.Validate();
   return setup.num_steps > 0 ? setup.num_steps
@@ -43,18 +44,24 @@ void CheckBasis(const MatrixXd& basis, const char* name, int* columns) {
 
 double& Field(MaterialParameters* m, MaterialParameter p) {
   switch (p) {
-    case MaterialParameter::kYoungsModulus: return m->youngs_modulus;
-    case MaterialParameter::kPoissonsRatio: return m->poissons_ratio;
-    case MaterialParameter::kDensity: return m->density;
+    case MaterialParameter::kYoungsModulus:
+      return m->youngs_modulus;
+    case MaterialParameter::kPoissonsRatio:
+      return m->poissons_ratio;
+    case MaterialParameter::kDensity:
+      return m->density;
   }
   DIFFPD_CHECK(false, "unknown MaterialParameter " << static_cast<int>(p));
 }
 
 double Field(const MaterialComponents& c, MaterialParameter p) {
   switch (p) {
-    case MaterialParameter::kYoungsModulus: return c.youngs_modulus;
-    case MaterialParameter::kPoissonsRatio: return c.poissons_ratio;
-    case MaterialParameter::kDensity: return c.density;
+    case MaterialParameter::kYoungsModulus:
+      return c.youngs_modulus;
+    case MaterialParameter::kPoissonsRatio:
+      return c.poissons_ratio;
+    case MaterialParameter::kDensity:
+      return c.density;
   }
   DIFFPD_CHECK(false, "unknown MaterialParameter " << static_cast<int>(p));
 }
@@ -63,15 +70,18 @@ double Field(const MaterialComponents& c, MaterialParameter p) {
 
 const char* ToString(MaterialParameter parameter) {
   switch (parameter) {
-    case MaterialParameter::kYoungsModulus: return "youngs_modulus";
-    case MaterialParameter::kPoissonsRatio: return "poissons_ratio";
-    case MaterialParameter::kDensity: return "density";
+    case MaterialParameter::kYoungsModulus:
+      return "youngs_modulus";
+    case MaterialParameter::kPoissonsRatio:
+      return "poissons_ratio";
+    case MaterialParameter::kDensity:
+      return "density";
   }
   return "unknown";
 }
 
-LinearInputParameters::LinearInputParameters(MatrixXd position_basis, MatrixXd velocity_basis,
-                                             MatrixXd force_basis, int force_begin, int force_end)
+LinearInputParameters::LinearInputParameters(MatrixXd position_basis, MatrixXd velocity_basis, MatrixXd force_basis,
+                                             int force_begin, int force_end)
     : position_(std::move(position_basis)),
       velocity_(std::move(velocity_basis)),
       force_(std::move(force_basis)),
@@ -84,8 +94,7 @@ LinearInputParameters::LinearInputParameters(MatrixXd position_basis, MatrixXd v
   if (columns <= 0) throw InvalidInputError("LinearInputParameters: no basis with at least one column given");
   if (force_begin_ < 0 || force_end_ < force_begin_) {
     std::ostringstream msg;
-    msg << "force_begin = " << force_begin_ << ", force_end = " << force_end_
-        << " is invalid: need 0 <= begin <= end";
+    msg << "force_begin = " << force_begin_ << ", force_end = " << force_end_ << " is invalid: need 0 <= begin <= end";
     throw InvalidInputError(msg.str());
   }
   size_ = columns;
@@ -140,8 +149,7 @@ CalibrationModel::CalibrationModel(CalibrationSetup setup)
   const int n = sim_->num_dofs();
   std::set<MaterialParameter> seen;
   for (MaterialParameter p : setup_.fitted)
-    if (!seen.insert(p).second)
-      throw InvalidInputError(std::string("fitted lists ") + ToString(p) + " twice");
+    if (!seen.insert(p).second) throw InvalidInputError(std::string("fitted lists ") + ToString(p) + " twice");
   const int regions = static_cast<int>(setup_.scene.material_regions.size());
   std::set<std::pair<int, MaterialParameter>> seen_regions;
   for (size_t i = 0; i < setup_.fitted_regions.size(); ++i) {
@@ -307,9 +315,15 @@ void CalibrationModel::ForwardJacobian() {
   std::vector<InputDirection> dirs;
   for (MaterialParameter p : setup_.fitted) {
     switch (p) {
-      case MaterialParameter::kYoungsModulus: dirs.push_back(InputDirection::YoungsModulus()); break;
-      case MaterialParameter::kPoissonsRatio: dirs.push_back(InputDirection::PoissonsRatio()); break;
-      case MaterialParameter::kDensity: dirs.push_back(InputDirection::Density()); break;
+      case MaterialParameter::kYoungsModulus:
+        dirs.push_back(InputDirection::YoungsModulus());
+        break;
+      case MaterialParameter::kPoissonsRatio:
+        dirs.push_back(InputDirection::PoissonsRatio());
+        break;
+      case MaterialParameter::kDensity:
+        dirs.push_back(InputDirection::Density());
+        break;
     }
   }
   const int regions = static_cast<int>(setup_.scene.material_regions.size());
@@ -321,7 +335,9 @@ void CalibrationModel::ForwardJacobian() {
       case MaterialParameter::kPoissonsRatio:
         dirs.push_back(InputDirection::RegionPoissonsRatio(rp.region, regions));
         break;
-      case MaterialParameter::kDensity: dirs.push_back(InputDirection::RegionDensity(rp.region, regions)); break;
+      case MaterialParameter::kDensity:
+        dirs.push_back(InputDirection::RegionDensity(rp.region, regions));
+        break;
     }
   }
   dirs.insert(dirs.end(), input_directions_.begin(), input_directions_.end());
@@ -347,7 +363,8 @@ VectorXd CalibrationModel::ParameterGradient(const RolloutGradient& g, int last_
   base.poissons_ratio = g.poissons_ratio;
   base.density = g.density;
   for (MaterialParameter p : setup_.fitted) out(column++) = Field(base, p);
-  for (const RegionParameter& rp : setup_.fitted_regions) out(column++) = Field(g.region_materials[rp.region], rp.parameter);
+  for (const RegionParameter& rp : setup_.fitted_regions)
+    out(column++) = Field(g.region_materials[rp.region], rp.parameter);
   for (const InputDirection& d : input_directions_) {
     double v = 0;
     if (d.x0.size()) v += g.x0.dot(d.x0);

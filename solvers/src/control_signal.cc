@@ -49,9 +49,7 @@ void PerStepSignal::Evaluate(const Eigen::Ref<const VectorXd>& c, VectorXd* valu
   if (jacobian) *jacobian = MatrixXd::Identity(num_steps(), num_steps());
 }
 
-VectorXd PerStepSignal::ConstantCoefficients(double value) const {
-  return VectorXd::Constant(num_steps(), value);
-}
+VectorXd PerStepSignal::ConstantCoefficients(double value) const { return VectorXd::Constant(num_steps(), value); }
 
 PiecewiseLinearSignal::PiecewiseLinearSignal(int num_steps, int knots) : ControlSignal(num_steps), knots_(knots) {
   RequireSteps(num_steps, 2);
@@ -71,8 +69,7 @@ PiecewiseLinearSignal::PiecewiseLinearSignal(int num_steps, int knots) : Control
   }
 }
 
-void PiecewiseLinearSignal::Evaluate(const Eigen::Ref<const VectorXd>& c, VectorXd* values,
-                                     MatrixXd* jacobian) const {
+void PiecewiseLinearSignal::Evaluate(const Eigen::Ref<const VectorXd>& c, VectorXd* values, MatrixXd* jacobian) const {
   CheckSize(c);
   Linear(basis_, c, values, jacobian);
 }
@@ -83,12 +80,9 @@ int PiecewiseLinearSignal::FirstStep(int j) const {
   return num_steps();
 }
 
-VectorXd PiecewiseLinearSignal::ConstantCoefficients(double value) const {
-  return VectorXd::Constant(knots_, value);
-}
+VectorXd PiecewiseLinearSignal::ConstantCoefficients(double value) const { return VectorXd::Constant(knots_, value); }
 
-FourierSignal::FourierSignal(int num_steps, double time_step, double period, int harmonics)
-    : ControlSignal(num_steps) {
+FourierSignal::FourierSignal(int num_steps, double time_step, double period, int harmonics) : ControlSignal(num_steps) {
   RequirePositiveFinite(time_step, "time_step");
   RequirePositiveFinite(period, "period");
   if (harmonics < 0) {

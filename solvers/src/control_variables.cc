@@ -72,8 +72,7 @@ void ControlVariables::SetBounds(int offset, int count, double lower, double upp
 void ControlVariables::SetInitial(const VectorXd& values) {
   if (values.size() != size() || !values.allFinite()) {
     std::ostringstream msg;
-    msg << name() << ": starting values have " << values.size() << " entries (expected " << size()
-        << ", all finite)";
+    msg << name() << ": starting values have " << values.size() << " entries (expected " << size() << ", all finite)";
     throw InvalidInputError(msg.str());
   }
   initial_ = values;
@@ -152,8 +151,7 @@ void ExternalForceControl::CheckFits(const Scene& scene, int num_steps) const {
     CheckNodesFit(channels_[c].nodes, scene.mesh.num_vertices(), what);
     if (channels_[c].signal->num_steps() != num_steps) {
       std::ostringstream msg;
-      msg << what << ": its signal has " << channels_[c].signal->num_steps() << " steps, the rollout has "
-          << num_steps;
+      msg << what << ": its signal has " << channels_[c].signal->num_steps() << " steps, the rollout has " << num_steps;
       throw InvalidInputError(msg.str());
     }
   }
@@ -239,9 +237,15 @@ void MaterialVariables::Apply(const Eigen::Ref<const VectorXd>& values, RolloutS
   for (size_t i = 0; i < entries_.size(); ++i) {
     const double value = values(i) * entries_[i].scale;
     switch (entries_[i].field) {
-      case kYoungsModulus: setup->material.youngs_modulus = value; break;
-      case kPoissonsRatio: setup->material.poissons_ratio = value; break;
-      case kDensity: setup->material.density = value; break;
+      case kYoungsModulus:
+        setup->material.youngs_modulus = value;
+        break;
+      case kPoissonsRatio:
+        setup->material.poissons_ratio = value;
+        break;
+      case kDensity:
+        setup->material.density = value;
+        break;
     }
   }
 }
@@ -260,9 +264,15 @@ bool MaterialVariables::AddDirection(const Eigen::Ref<const VectorXd>& values, i
                                      InputDirection* direction) const {
   const double scale = entries_[j].scale;
   switch (entries_[j].field) {
-    case kYoungsModulus: direction->youngs_modulus += scale; break;
-    case kPoissonsRatio: direction->poissons_ratio += scale; break;
-    case kDensity: direction->density += scale; break;
+    case kYoungsModulus:
+      direction->youngs_modulus += scale;
+      break;
+    case kPoissonsRatio:
+      direction->poissons_ratio += scale;
+      break;
+    case kDensity:
+      direction->density += scale;
+      break;
   }
   return true;
 }
@@ -314,8 +324,7 @@ void ActivationControl::CheckFits(const Scene& scene, int num_steps) const {
     }
     if (channels_[c].signal->num_steps() != num_steps) {
       std::ostringstream msg;
-      msg << what << ": its signal has " << channels_[c].signal->num_steps() << " steps, the rollout has "
-          << num_steps;
+      msg << what << ": its signal has " << channels_[c].signal->num_steps() << " steps, the rollout has " << num_steps;
       throw InvalidInputError(msg.str());
     }
   }

@@ -14,8 +14,7 @@ CoordinateManifold::CoordinateManifold(std::vector<CoordinateMap> coordinates) :
     if (m.kind == CoordinateMap::Kind::kLogit &&
         !(std::isfinite(m.lower) && std::isfinite(m.upper) && m.lower < m.upper)) {
       std::ostringstream msg;
-      msg << "CoordinateManifold: coordinate " << i << " has the empty interval (" << m.lower << ", " << m.upper
-          << ")";
+      msg << "CoordinateManifold: coordinate " << i << " has the empty interval (" << m.lower << ", " << m.upper << ")";
       throw InvalidInputError(msg.str());
     }
   }
@@ -23,9 +22,12 @@ CoordinateManifold::CoordinateManifold(std::vector<CoordinateMap> coordinates) :
 
 bool CoordinateManifold::InDomain(int i, double x) const {
   switch (maps_[i].kind) {
-    case CoordinateMap::Kind::kLinear: return std::isfinite(x);
-    case CoordinateMap::Kind::kLog: return x > 0 && std::isfinite(x);
-    case CoordinateMap::Kind::kLogit: return x > maps_[i].lower && x < maps_[i].upper;
+    case CoordinateMap::Kind::kLinear:
+      return std::isfinite(x);
+    case CoordinateMap::Kind::kLog:
+      return x > 0 && std::isfinite(x);
+    case CoordinateMap::Kind::kLogit:
+      return x > maps_[i].lower && x < maps_[i].upper;
   }
   return false;
 }
@@ -33,9 +35,12 @@ bool CoordinateManifold::InDomain(int i, double x) const {
 double CoordinateManifold::ToTangent(int i, double x) const {
   const CoordinateMap& m = maps_[i];
   switch (m.kind) {
-    case CoordinateMap::Kind::kLinear: return x;
-    case CoordinateMap::Kind::kLog: return std::log(x);
-    case CoordinateMap::Kind::kLogit: return std::log((x - m.lower) / (m.upper - x));
+    case CoordinateMap::Kind::kLinear:
+      return x;
+    case CoordinateMap::Kind::kLog:
+      return std::log(x);
+    case CoordinateMap::Kind::kLogit:
+      return std::log((x - m.lower) / (m.upper - x));
   }
   return x;
 }
@@ -43,8 +48,10 @@ double CoordinateManifold::ToTangent(int i, double x) const {
 double CoordinateManifold::FromTangent(int i, double u) const {
   const CoordinateMap& m = maps_[i];
   switch (m.kind) {
-    case CoordinateMap::Kind::kLinear: return u;
-    case CoordinateMap::Kind::kLog: return std::exp(u);
+    case CoordinateMap::Kind::kLinear:
+      return u;
+    case CoordinateMap::Kind::kLog:
+      return std::exp(u);
     case CoordinateMap::Kind::kLogit: {
       // Stable logistic: never exp of a large positive number.
       const double s = u >= 0 ? 1 / (1 + std::exp(-u)) : std::exp(u) / (1 + std::exp(u));
@@ -57,9 +64,12 @@ double CoordinateManifold::FromTangent(int i, double u) const {
 double CoordinateManifold::Derivative(int i, double x) const {
   const CoordinateMap& m = maps_[i];
   switch (m.kind) {
-    case CoordinateMap::Kind::kLinear: return 1;
-    case CoordinateMap::Kind::kLog: return x;
-    case CoordinateMap::Kind::kLogit: return (x - m.lower) * (m.upper - x) / (m.upper - m.lower);
+    case CoordinateMap::Kind::kLinear:
+      return 1;
+    case CoordinateMap::Kind::kLog:
+      return x;
+    case CoordinateMap::Kind::kLogit:
+      return (x - m.lower) * (m.upper - x) / (m.upper - m.lower);
   }
   return 1;
 }
@@ -67,8 +77,8 @@ double CoordinateManifold::Derivative(int i, double x) const {
 bool CoordinateManifold::Plus(const double* x, const double* delta, double* x_plus_delta) const {
   for (int i = 0; i < AmbientSize(); ++i) {
     if (!InDomain(i, x[i])) return false;
-    x_plus_delta[i] = maps_[i].kind == CoordinateMap::Kind::kLinear ? x[i] + delta[i]
-                                                                     : FromTangent(i, ToTangent(i, x[i]) + delta[i]);
+    x_plus_delta[i] =
+        maps_[i].kind == CoordinateMap::Kind::kLinear ? x[i] + delta[i] : FromTangent(i, ToTangent(i, x[i]) + delta[i]);
   }
   return true;
 }
@@ -86,7 +96,8 @@ bool CoordinateManifold::PlusJacobian(const double* x, double* jacobian) const {
 bool CoordinateManifold::Minus(const double* y, const double* x, double* y_minus_x) const {
   for (int i = 0; i < AmbientSize(); ++i) {
     if (!InDomain(i, x[i]) || !InDomain(i, y[i])) return false;
-    y_minus_x[i] = maps_[i].kind == CoordinateMap::Kind::kLinear ? y[i] - x[i] : ToTangent(i, y[i]) - ToTangent(i, x[i]);
+    y_minus_x[i] =
+        maps_[i].kind == CoordinateMap::Kind::kLinear ? y[i] - x[i] : ToTangent(i, y[i]) - ToTangent(i, x[i]);
   }
   return true;
 }

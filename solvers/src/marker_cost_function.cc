@@ -61,8 +61,7 @@ void RolloutEvaluationCallback::PrepareForEvaluation(bool evaluate_jacobians, bo
 }
 
 std::vector<ceres::ResidualBlockId> AddMarkerResidualBlocks(ceres::Problem* problem, CalibrationModel* model,
-                                                            const std::vector<double*>& blocks,
-                                                            ResidualBlocks layout) {
+                                                            const std::vector<double*>& blocks, ResidualBlocks layout) {
   if (blocks.size() != model->parameter_block_sizes().size()) {
     std::ostringstream msg;
     msg << "AddMarkerResidualBlocks: got " << blocks.size() << " parameter blocks, the model has "

@@ -5,8 +5,6 @@
 
 namespace diffpd::solvers {
 
-std::string OptimizerVersions() {
-  return std::string("ceres ") + CERES_VERSION_STRING + ", ipopt " + IPOPT_VERSION;
-}
+std::string OptimizerVersions() { return std::string("ceres ") + CERES_VERSION_STRING + ", ipopt " + IPOPT_VERSION; }
 
 }  // namespace diffpd::solvers

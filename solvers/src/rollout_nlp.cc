@@ -34,9 +34,7 @@ Rollout Truncated(const Rollout& full, int last) {
   return r;
 }
 
-double Violation(double value, double lower, double upper) {
-  return std::max({0.0, lower - value, value - upper});
-}
+double Violation(double value, double lower, double upper) { return std::max({0.0, lower - value, value - upper}); }
 
 }  // namespace
 
@@ -109,9 +107,8 @@ void RolloutNlp::AddRegularization(int offset, int count, double weight, double 
   if (offset < 0 || count < 0 || offset + count > num_variables() || !std::isfinite(weight) || !(weight >= 0) ||
       !std::isfinite(reference)) {
     std::ostringstream msg;
-    msg << "RolloutNlp: regularization of variables [" << offset << ", " << offset + count << ") with weight "
-        << weight << " is invalid: need a range inside [0, " << num_variables()
-        << ") and a finite weight >= 0 and reference";
+    msg << "RolloutNlp: regularization of variables [" << offset << ", " << offset + count << ") with weight " << weight
+        << " is invalid: need a range inside [0, " << num_variables() << ") and a finite weight >= 0 and reference";
     throw InvalidInputError(msg.str());
   }
   regularization_.push_back(Regularization{offset, count, weight, reference});
@@ -267,7 +264,8 @@ bool RolloutNlp::ComputeGradient() {
       PullBackLoss(loss, last, grad);
     }
     for (const Regularization& r : regularization_)
-      grad.segment(r.offset, r.count).array() += r.weight * (cache_->x.segment(r.offset, r.count).array() - r.reference);
+      grad.segment(r.offset, r.count).array() +=
+          r.weight * (cache_->x.segment(r.offset, r.count).array() - r.reference);
     cache_->grad = std::move(grad);
     cache_->has_grad = true;
     return true;
@@ -301,8 +299,9 @@ bool RolloutNlp::ComputeJacobian() {
     if (!constraints_.empty()) {
       if (ResolvedJacobianMode() == ConstraintJacobianMode::kForward) {
         if (!ForwardModeAvailable()) {
-          last_error_ = "constraint Jacobian: forward mode does not cover this problem (muscle activations, contact, "
-                        "muscles or state forces); use ConstraintJacobianMode::kReverse or kAuto";
+          last_error_ =
+              "constraint Jacobian: forward mode does not cover this problem (muscle activations, contact, "
+              "muscles or state forces); use ConstraintJacobianMode::kReverse or kAuto";
           return false;
         }
         JacobianForward(&values);
@@ -390,15 +389,19 @@ bool RolloutNlp::ForwardModeAvailable() const {
 
 ConstraintJacobianMode RolloutNlp::ResolvedJacobianMode() const {
   if (jacobian_mode_ != ConstraintJacobianMode::kAuto) return jacobian_mode_;
-  return ForwardModeAvailable() && num_variables() < static_cast<int>(constraints_.size()) ? ConstraintJacobianMode::kForward
-                                                                                           : ConstraintJacobianMode::kReverse;
+  return ForwardModeAvailable() && num_variables() < static_cast<int>(constraints_.size())
+             ? ConstraintJacobianMode::kForward
+             : ConstraintJacobianMode::kReverse;
 }
 
 const char* ToString(ConstraintJacobianMode mode) {
   switch (mode) {
-    case ConstraintJacobianMode::kAuto: return "auto";
-    case ConstraintJacobianMode::kReverse: return "reverse";
-    case ConstraintJacobianMode::kForward: return "forward";
+    case ConstraintJacobianMode::kAuto:
+      return "auto";
+    case ConstraintJacobianMode::kReverse:
+      return "reverse";
+    case ConstraintJacobianMode::kForward:
+      return "forward";
   }
   return "unknown";
 }
@@ -562,8 +565,8 @@ bool RolloutNlp::eval_g(Ipopt::Index n, const Ipopt::Number* x, bool new_x, Ipop
   return true;
 }
 
-bool RolloutNlp::eval_jac_g(Ipopt::Index n, const Ipopt::Number* x, bool new_x, Ipopt::Index m,
-                            Ipopt::Index nele_jac, Ipopt::Index* iRow, Ipopt::Index* jCol, Ipopt::Number* values) {
+bool RolloutNlp::eval_jac_g(Ipopt::Index n, const Ipopt::Number* x, bool new_x, Ipopt::Index m, Ipopt::Index nele_jac,
+                            Ipopt::Index* iRow, Ipopt::Index* jCol, Ipopt::Number* values) {
   BuildStructure();
   if (n != num_variables() || m != num_constraints() || nele_jac != nnz_jac_) return false;
   if (values == nullptr) {  // structure call: x may be null
@@ -584,9 +587,9 @@ bool RolloutNlp::eval_jac_g(Ipopt::Index n, const Ipopt::Number* x, bool new_x, 
 
 bool RolloutNlp::intermediate_callback(Ipopt::AlgorithmMode mode, Ipopt::Index iter, Ipopt::Number obj_value,
                                        Ipopt::Number inf_pr, Ipopt::Number inf_du, Ipopt::Number mu,
-                                       Ipopt::Number d_norm, Ipopt::Number regularization_size,
-                                       Ipopt::Number alpha_du, Ipopt::Number alpha_pr, Ipopt::Index ls_trials,
-                                       const Ipopt::IpoptData* ip_data, Ipopt::IpoptCalculatedQuantities* ip_cq) {
+                                       Ipopt::Number d_norm, Ipopt::Number regularization_size, Ipopt::Number alpha_du,
+                                       Ipopt::Number alpha_pr, Ipopt::Index ls_trials, const Ipopt::IpoptData* ip_data,
+                                       Ipopt::IpoptCalculatedQuantities* ip_cq) {
   iterations_.push_back(IterationRecord{iter, obj_value, inf_pr, mode == Ipopt::RestorationPhaseMode});
   return true;
 }

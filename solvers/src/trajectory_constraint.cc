@@ -121,9 +121,7 @@ PointTravel::PointTravel(TrackedPoint point, int from_step, int to_step, Vec3 di
   CheckStep(to_step, name_);
 }
 
-int PointTravel::LastState(int num_steps) const {
-  return std::max(Resolve(from_, num_steps), Resolve(to_, num_steps));
-}
+int PointTravel::LastState(int num_steps) const { return std::max(Resolve(from_, num_steps), Resolve(to_, num_steps)); }
 
 double PointTravel::Value(const Rollout& rollout) const {
   return direction_.dot(point_.At(PositionsAt(rollout, to_, name_)) - point_.At(PositionsAt(rollout, from_, name_)));

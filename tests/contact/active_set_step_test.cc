@@ -21,8 +21,8 @@ namespace {
 // above the plane z = 0; every boundary node is a contact candidate.
 Scene BallScene(double height, const ContactSurface& surface = ContactSurface::Plane(Vec3(0, 0, 1), 0.0)) {
   Scene scene;
-  scene.mesh = VoxelizeSdf([](const Vec3& p) { return p.norm() - 0.03; }, Vec3::Constant(-0.03),
-                           Eigen::Vector3i(6, 6, 6), 0.01);
+  scene.mesh =
+      VoxelizeSdf([](const Vec3& p) { return p.norm() - 0.03; }, Vec3::Constant(-0.03), Eigen::Vector3i(6, 6, 6), 0.01);
   const double zmin = scene.mesh.vertices.row(2).minCoeff();
   scene.mesh.vertices.row(2).array() += height - zmin;
   scene.material.youngs_modulus = 1e5;
@@ -316,10 +316,10 @@ class FrictionalContactGradientTest : public ::testing::TestWithParam<GradCase> 
 TEST_P(FrictionalContactGradientTest, RolloutGradientThroughContactMatchesFiniteDifferences) {
   const GradCase c = GetParam();
   const ContactSurface surface =
-      c.height_field ? ContactSurface::HeightField(
-                           [](double x, double y) { return -0.004 + 0.05 * x + 0.02 * x * x - 0.01 * y; },
-                           [](double x, double y) { return Eigen::Vector2d(0.05 + 0.04 * x, -0.01); })
-                     : ContactSurface::Plane(Vec3(0.05, -0.01, 1.0), -0.004);
+      c.height_field
+          ? ContactSurface::HeightField([](double x, double y) { return -0.004 + 0.05 * x + 0.02 * x * x - 0.01 * y; },
+                                        [](double x, double y) { return Eigen::Vector2d(0.05 + 0.04 * x, -0.01); })
+          : ContactSurface::Plane(Vec3(0.05, -0.01, 1.0), -0.004);
   const Scene scene = SlidingBoxScene(surface);
   SolverOptions options;
   options.method = c.method;

@@ -54,16 +54,17 @@ void LinearAlgebra(bool quick) {
   const VectorXd r = VectorXd::Random(mesh.num_dofs());
   const int repeat = quick ? 3 : 7;
   const double solve_base = 1e3 * Median(repeat, [&] {
-    const auto t0 = Clock::now();
-    base.Solve(r);
-    return Seconds(t0);
-  });
+                              const auto t0 = Clock::now();
+                              base.Solve(r);
+                              return Seconds(t0);
+                            });
   for (const int s : {4, 16, 64, 256, 400}) {
     if (quick && s > 256) break;
     // s nodes spread over the bottom face; `shift` gives a different set of the same size.
     auto set = [&](int shift) {
       std::vector<int> nodes;
-      for (int k = 0; k < s; ++k) nodes.push_back(bottom[(static_cast<size_t>(k) * bottom.size() / s + shift) % bottom.size()]);
+      for (int k = 0; k < s; ++k)
+        nodes.push_back(bottom[(static_cast<size_t>(k) * bottom.size() / s + shift) % bottom.size()]);
       std::sort(nodes.begin(), nodes.end());
       nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
       return nodes;
@@ -72,44 +73,46 @@ void LinearAlgebra(bool quick) {
     internal::PdSystem refac(fem, fixed);
     refac.Update(h, rho, w);
     const double t_refac = 1e3 * Median(repeat, [&] {
-      const std::vector<int> nodes = set(++shift);
-      const auto t0 = Clock::now();
-      refac.SetActiveNodes(nodes, ContactLinearSolve::kRefactorize);
-      return Seconds(t0);
-    });
+                             const std::vector<int> nodes = set(++shift);
+                             const auto t0 = Clock::now();
+                             refac.SetActiveNodes(nodes, ContactLinearSolve::kRefactorize);
+                             return Seconds(t0);
+                           });
     const double solve_refac = 1e3 * Median(repeat, [&] {
-      const auto t0 = Clock::now();
-      refac.Solve(r);
-      return Seconds(t0);
-    });
+                                 const auto t0 = Clock::now();
+                                 refac.Solve(r);
+                                 return Seconds(t0);
+                               });
     const double t_cold = 1e3 * Median(repeat, [&] {
-      internal::PdSystem wood(fem, fixed);
-      wood.Update(h, rho, w);
-      const std::vector<int> nodes = set(++shift);
-      const auto t0 = Clock::now();
-      wood.SetActiveNodes(nodes, ContactLinearSolve::kWoodbury);
-      return Seconds(t0);
-    });
+                            internal::PdSystem wood(fem, fixed);
+                            wood.Update(h, rho, w);
+                            const std::vector<int> nodes = set(++shift);
+                            const auto t0 = Clock::now();
+                            wood.SetActiveNodes(nodes, ContactLinearSolve::kWoodbury);
+                            return Seconds(t0);
+                          });
     internal::PdSystem wood(fem, fixed);
     wood.Update(h, rho, w);
     std::vector<int> nodes = set(0);
     wood.SetActiveNodes(nodes, ContactLinearSolve::kWoodbury);
-    const double t_warm = 1e3 * Median(repeat, [&] {
-      // One node replaced by a neighbour not seen before: one new column.
-      std::vector<int> next = nodes;
-      next[next.size() / 2] = bottom[(std::find(bottom.begin(), bottom.end(), next[next.size() / 2]) - bottom.begin() +
-                                      1 + shift++) % bottom.size()];
-      std::sort(next.begin(), next.end());
-      next.erase(std::unique(next.begin(), next.end()), next.end());
-      const auto t0 = Clock::now();
-      wood.SetActiveNodes(next, ContactLinearSolve::kWoodbury);
-      return Seconds(t0);
-    });
+    const double t_warm =
+        1e3 * Median(repeat, [&] {
+          // One node replaced by a neighbour not seen before: one new column.
+          std::vector<int> next = nodes;
+          next[next.size() / 2] =
+              bottom[(std::find(bottom.begin(), bottom.end(), next[next.size() / 2]) - bottom.begin() + 1 + shift++) %
+                     bottom.size()];
+          std::sort(next.begin(), next.end());
+          next.erase(std::unique(next.begin(), next.end()), next.end());
+          const auto t0 = Clock::now();
+          wood.SetActiveNodes(next, ContactLinearSolve::kWoodbury);
+          return Seconds(t0);
+        });
     const double solve_wood = 1e3 * Median(repeat, [&] {
-      const auto t0 = Clock::now();
-      wood.Solve(r);
-      return Seconds(t0);
-    });
+                                const auto t0 = Clock::now();
+                                wood.Solve(r);
+                                return Seconds(t0);
+                              });
     // A step of 20 PD iterations whose active set changed once (warm Woodbury).
     std::printf("%6d %12.3f %12.3f %12.3f | %12.3f %12.3f %12.3f | %14.3f %14.3f\n", s, t_refac, t_cold, t_warm,
                 solve_base, solve_refac, solve_wood, t_refac + 20 * solve_refac, t_warm + 20 * solve_wood);

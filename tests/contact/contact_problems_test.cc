@@ -93,8 +93,8 @@ TEST(BouncingBallTest, FallsLandsWithoutPenetratingAndRebounds) {
     EXPECT_GE(s.x.reshaped(3, s.x.size() / 3).row(2).minCoeff(), -1e-6);
   }
   EXPECT_TRUE(touched);
-  EXPECT_LT(lowest_vz, -1.5);          // about 1.7 m/s at impact
-  EXPECT_GT(highest_vz_after, 0.1);    // it bounces back up
+  EXPECT_LT(lowest_vz, -1.5);        // about 1.7 m/s at impact
+  EXPECT_GT(highest_vz_after, 0.1);  // it bounces back up
 }
 
 TEST(RoutingTendonTest, ContractingTheXMuscleBendsTheColumnTowardX) {

@@ -46,9 +46,16 @@ TEST(ContactSurfaceTest, ProjectionLiesOnTheSurfaceAndItsJacobianMatchesFiniteDi
 TEST(ContactPinTest, NodeIsPinnedAtTheProjectionOfItsPreviousPosition) {
   const ContactSurface plane = ContactSurface::Plane(Vec3(0, 0, 1), 0.0);
   // Arriving from above, resting, or pulled inside: straight onto the plane.
-  EXPECT_LT((internal::ComputeContactPin(plane, Vec3(0.1, 0, 0.002), Vec3(1, 0, -0.4), 0.01).position - Vec3(0.1, 0, 0)).norm(), 1e-15);
-  EXPECT_LT((internal::ComputeContactPin(plane, Vec3(0.3, 0.1, 0), Vec3(0.5, 0, 0), 0.01).position - Vec3(0.3, 0.1, 0)).norm(), 1e-15);
-  EXPECT_LT((internal::ComputeContactPin(plane, Vec3(0.3, 0.1, -0.001), Vec3(0, 0, -1), 0.01).position - Vec3(0.3, 0.1, 0)).norm(), 1e-15);
+  EXPECT_LT((internal::ComputeContactPin(plane, Vec3(0.1, 0, 0.002), Vec3(1, 0, -0.4), 0.01).position - Vec3(0.1, 0, 0))
+                .norm(),
+            1e-15);
+  EXPECT_LT((internal::ComputeContactPin(plane, Vec3(0.3, 0.1, 0), Vec3(0.5, 0, 0), 0.01).position - Vec3(0.3, 0.1, 0))
+                .norm(),
+            1e-15);
+  EXPECT_LT(
+      (internal::ComputeContactPin(plane, Vec3(0.3, 0.1, -0.001), Vec3(0, 0, -1), 0.01).position - Vec3(0.3, 0.1, 0))
+          .norm(),
+      1e-15);
 }
 
 TEST(ContactPinTest, PinDerivativesMatchFiniteDifferencesOnEverySurface) {
@@ -67,7 +74,8 @@ TEST(ContactPinTest, PinDerivativesMatchFiniteDifferencesOnEverySurface) {
         const double eps = 1e-7;
         const Vec3 e = Vec3::Unit(d);
         const Vec3 fdx = (internal::ComputeContactPin(s, x + eps * e, v, 0.01).position -
-                          internal::ComputeContactPin(s, x - eps * e, v, 0.01).position) / (2 * eps);
+                          internal::ComputeContactPin(s, x - eps * e, v, 0.01).position) /
+                         (2 * eps);
         EXPECT_LT((fdx - pin.d_dx.col(d)).norm(), 1e-7);
       }
     }

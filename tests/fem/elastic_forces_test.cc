@@ -48,8 +48,8 @@ VectorXd DeformedPositions(const Mesh& mesh, double noise, unsigned seed) {
 }
 
 // sum_s vol_s sum_energies Psi(F_s) with the public reference densities.
-double ReferenceEnergy(const FemModel& fem, const std::vector<ElasticEnergy>& energies, const VectorXd& x,
-                       double mu, double lambda) {
+double ReferenceEnergy(const FemModel& fem, const std::vector<ElasticEnergy>& energies, const VectorXd& x, double mu,
+                       double lambda) {
   const MaterialParameters m = [&] {
     // E and nu with the given Lame parameters.
     MaterialParameters p;
@@ -84,8 +84,7 @@ struct CaseBody {
   Scene scene;
   FemModel fem;
   ElasticForces forces;
-  explicit CaseBody(const Case& c)
-      : scene(testing::SmallBeamScene(c.tets)), fem(scene.mesh), forces(fem, c.energies) {}
+  explicit CaseBody(const Case& c) : scene(testing::SmallBeamScene(c.tets)), fem(scene.mesh), forces(fem, c.energies) {}
 };
 
 // n entries drawn from N(0, 1) with *rng.
@@ -98,8 +97,12 @@ VectorXd NormalVector(int n, std::mt19937* rng) {
 
 std::vector<Case> Cases() {
   const std::vector<ElasticEnergy> pd = {ElasticEnergy::kPdCorotated, ElasticEnergy::kPdVolume};
-  return {{false, pd, 1e-3},  {true, pd, 1e-3},  {false, pd, 1.5e-2}, {true, pd, 1.5e-2},
-          {false, {ElasticEnergy::kCorotated}, 1e-3}, {true, {ElasticEnergy::kNeoHookean}, 1e-3}};
+  return {{false, pd, 1e-3},
+          {true, pd, 1e-3},
+          {false, pd, 1.5e-2},
+          {true, pd, 1.5e-2},
+          {false, {ElasticEnergy::kCorotated}, 1e-3},
+          {true, {ElasticEnergy::kNeoHookean}, 1e-3}};
 }
 
 TEST(ElasticForcesTest, EnergyIsTheQuadratureSumOfTheReferenceDensities) {
@@ -255,7 +258,9 @@ namespace {
 struct PartialGroupBeam {
   static constexpr double kMu = 7e4, kLambda = 2.8e5;
   PartialGroupBeam(bool tets, std::vector<ElasticEnergy> energies)
-      : scene(BeamScene(tets, std::move(energies))), fem(scene.mesh), forces(fem, scene.energies),
+      : scene(BeamScene(tets, std::move(energies))),
+        fem(scene.mesh),
+        forces(fem, scene.energies),
         x(DeformedPositions(scene.mesh, 2e-3, 14)) {
     EXPECT_NE(fem.num_elements() % 8, 0);
     forces.ElementHessians(x, LameField::Uniform(kMu, kLambda), false, &blocks, 1);
@@ -282,9 +287,11 @@ struct PartialGroupBeam {
 // build, bit for bit.
 TEST(ElasticForcesTest, PackedHessiansFromPositionsMatchThePackedDenseBlocks) {
   using E = ElasticEnergy;
-  const std::vector<std::vector<E>> sets = {
-      {E::kPdCorotated, E::kPdVolume}, {E::kCorotated}, {E::kPdCorotated}, {E::kNeoHookean},
-      {E::kCorotated, E::kLinear}};
+  const std::vector<std::vector<E>> sets = {{E::kPdCorotated, E::kPdVolume},
+                                            {E::kCorotated},
+                                            {E::kPdCorotated},
+                                            {E::kNeoHookean},
+                                            {E::kCorotated, E::kLinear}};
   for (const bool tets : {false, true}) {
     for (const auto& energies : sets) {
       PartialGroupBeam beam(tets, energies);
@@ -305,8 +312,10 @@ TEST(ElasticForcesTest, PackedHessiansFromPositionsMatchThePackedDenseBlocks) {
         const std::string what = std::string(tets ? "tets" : "hexes") + ", " + std::to_string(energies.size()) +
                                  " energies, first " + std::to_string(static_cast<int>(energies[0])) + ", " +
                                  std::to_string(threads) + " threads";
-        if (all_svd) EXPECT_LE(worst, 1e-13 * largest) << what;
-        else EXPECT_EQ(direct, packed) << what;
+        if (all_svd)
+          EXPECT_LE(worst, 1e-13 * largest) << what;
+        else
+          EXPECT_EQ(direct, packed) << what;
       }
     }
   }

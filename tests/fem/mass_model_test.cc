@@ -27,8 +27,8 @@ TEST(MassModelTest, PartsSplitTheBodyMassAndUniformDensitiesTakeTheSinglePartAri
     single.SetDensities({1e3});
     EXPECT_EQ((mass.mass() - single.mass()).norm(), 0.0);
     mass.SetDensities({1e3, 2e3, 0.5e3});
-    const VectorXd expected = 1e3 * mass.part_unit_mass(0) + 2e3 * mass.part_unit_mass(1) +
-                              0.5e3 * mass.part_unit_mass(2);
+    const VectorXd expected =
+        1e3 * mass.part_unit_mass(0) + 2e3 * mass.part_unit_mass(1) + 0.5e3 * mass.part_unit_mass(2);
     EXPECT_LT((mass.mass() - expected).norm(), 1e-15 * expected.norm());
     // Direction and gradient are adjoint: g . dM(drho) = dL/drho . drho.
     const VectorXd drho = Eigen::Vector3d(0.3, -1.0, 2.0);

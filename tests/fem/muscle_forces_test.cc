@@ -83,7 +83,8 @@ TEST_P(MuscleForcesTest, GradientHessianAndActivationDerivativeMatchFiniteDiffer
     f.forces->AddEnergyAndGradient(x, a, &grad);
     const double eps = 1e-7;
     const double fd = (f.forces->AddEnergyAndGradient(x + eps * d, a, nullptr) -
-                       f.forces->AddEnergyAndGradient(x - eps * d, a, nullptr)) / (2 * eps);
+                       f.forces->AddEnergyAndGradient(x - eps * d, a, nullptr)) /
+                      (2 * eps);
     EXPECT_NEAR(fd, grad.dot(d), 1e-6 * std::abs(fd) + 1e-12);
     VectorXd gp = VectorXd::Zero(n), gm = VectorXd::Zero(n), hd = VectorXd::Zero(n);
     f.forces->AddEnergyAndGradient(x + eps * d, a, &gp);
@@ -119,7 +120,8 @@ TEST_P(MuscleForcesTest, ElementHessiansAssembleToTheHessianProductAndProjectToP
     for (int e = 0; e < f.mesh.num_elements(); ++e) {
       const Eigen::Map<const MatrixXd> ke(blocks.data() + static_cast<size_t>(e) * nb * nb, nb, nb);
       for (int p = 0; p < nb; ++p)
-        for (int q = 0; q < nb; ++q) h(3 * f.mesh.elements(p / 3, e) + p % 3, 3 * f.mesh.elements(q / 3, e) + q % 3) += ke(p, q);
+        for (int q = 0; q < nb; ++q)
+          h(3 * f.mesh.elements(p / 3, e) + p % 3, 3 * f.mesh.elements(q / 3, e) + q % 3) += ke(p, q);
     }
     const double min_eig = Eigen::SelfAdjointEigenSolver<MatrixXd>(h).eigenvalues().minCoeff();
     if (project) {

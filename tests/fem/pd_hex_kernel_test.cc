@@ -86,8 +86,8 @@ internal::PdHexElement ElementOf(const Hex& hex, const Eigen::Matrix<double, 3, 
 
 // The kernel on one element with weights for `energies`, from a cold
 // (identity) cache.
-bool Kernel(const Hex& hex, const Eigen::Matrix<double, 3, 8>& xe, const std::vector<ElasticEnergy>& energies, double mu,
-            double lambda, Eigen::Matrix<double, 3, 8>* fe, double* energy, std::vector<Mat3>* v_cache) {
+bool Kernel(const Hex& hex, const Eigen::Matrix<double, 3, 8>& xe, const std::vector<ElasticEnergy>& energies,
+            double mu, double lambda, Eigen::Matrix<double, 3, 8>* fe, double* energy, std::vector<Mat3>* v_cache) {
   v_cache->assign(8, Mat3::Identity());
   const internal::PdHexElement element = ElementOf(hex, xe, WeightsOf(energies, mu, lambda), fe, energy, v_cache);
   return PdHexEnergyAndForces(&element, 1);
@@ -107,8 +107,10 @@ TEST(PdHexKernelTest, MatchesTheGeneralPathForEveryPdEnergyCombination) {
   const Hex hex;
   const double mu = 7e4, lambda = 2.8e5;
   using E = ElasticEnergy;
-  const std::vector<std::vector<E>> combos = {
-      {E::kPdCorotated}, {E::kPdVolume}, {E::kPdCorotated, E::kPdVolume}, {E::kPdVolume, E::kPdCorotated, E::kPdVolume}};
+  const std::vector<std::vector<E>> combos = {{E::kPdCorotated},
+                                              {E::kPdVolume},
+                                              {E::kPdCorotated, E::kPdVolume},
+                                              {E::kPdVolume, E::kPdCorotated, E::kPdVolume}};
   // Near rest; a rotation with shear; an inversion (det < 0: the volume
   // projection's scalar path); a 1.4x expansion (prod sigma > 2: scalar path).
   const Mat3 rotation = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
@@ -139,8 +141,8 @@ TEST(PdHexKernelTest, RefusesSamplesTheBatchedSvdCannotTakeAndChangesNothing) {
   std::vector<Eigen::Matrix<double, 3, 8>> bad(4, good);
   bad[0](1, 4) = std::numeric_limits<double>::quiet_NaN();
   bad[1](2, 7) = std::numeric_limits<double>::infinity();
-  bad[2].setZero();                              // all nodes at the origin: F = 0
-  bad[3] = 1e-120 * hex.rest;                    // entries below 1e-100
+  bad[2].setZero();            // all nodes at the origin: F = 0
+  bad[3] = 1e-120 * hex.rest;  // entries below 1e-100
   for (size_t i = 0; i < bad.size(); ++i) {
     Eigen::Matrix<double, 3, 8> fe = Eigen::Matrix<double, 3, 8>::Constant(7.0);
     double energy = 7.0;
@@ -158,7 +160,8 @@ TEST(PdHexKernelTest, TwoElementsInOneCallMatchSeparateCalls) {
   const Hex hex;
   using E = ElasticEnergy;
   const Mat3 rotation = Eigen::AngleAxisd(0.4, Vec3(0, 1, 1).normalized()).toRotationMatrix();
-  const Eigen::Matrix<double, 3, 8> xa = Deformed(hex, rotation, 2e-3, 11), xb = Deformed(hex, 0.9 * Mat3::Identity(), 3e-3, 12);
+  const Eigen::Matrix<double, 3, 8> xa = Deformed(hex, rotation, 2e-3, 11),
+                                    xb = Deformed(hex, 0.9 * Mat3::Identity(), 3e-3, 12);
   const PdHexWeights wa = WeightsOf({E::kPdCorotated, E::kPdVolume}, 7e4, 2.8e5);
   const PdHexWeights wb = WeightsOf({E::kPdCorotated, E::kPdVolume}, 3e5, 0.0);  // nu = 0: no volume weight
   Eigen::Matrix<double, 3, 8> fa, fb, fa1, fb1;
@@ -166,7 +169,8 @@ TEST(PdHexKernelTest, TwoElementsInOneCallMatchSeparateCalls) {
   std::vector<Mat3> va(8, Mat3::Identity()), vb(8, Mat3::Identity()), va1 = va, vb1 = vb;
   const internal::PdHexElement both[2] = {ElementOf(hex, xa, wa, &fa, &ea, &va), ElementOf(hex, xb, wb, &fb, &eb, &vb)};
   ASSERT_TRUE(PdHexEnergyAndForces(both, 2));
-  const internal::PdHexElement a = ElementOf(hex, xa, wa, &fa1, &ea1, &va1), b = ElementOf(hex, xb, wb, &fb1, &eb1, &vb1);
+  const internal::PdHexElement a = ElementOf(hex, xa, wa, &fa1, &ea1, &va1),
+                               b = ElementOf(hex, xb, wb, &fb1, &eb1, &vb1);
   ASSERT_TRUE(PdHexEnergyAndForces(&a, 1));
   ASSERT_TRUE(PdHexEnergyAndForces(&b, 1));
   EXPECT_NEAR(ea, ea1, 1e-14 * ea1);
@@ -196,7 +200,8 @@ TEST(PdHexKernelTest, ElasticForcesUsesEachElementsLameParameters) {
   std::normal_distribution<double> normal;
   for (int i = 0; i < x.size(); ++i) x(i) = scene.mesh.vertices(i % 3, i / 3) + 2e-3 * normal(rng);
   VectorXd grad;
-  const double energy = forces.EnergyAndGradient(x, internal::LameField::PerElement(mu.data(), lambda.data()), &grad, 1);
+  const double energy =
+      forces.EnergyAndGradient(x, internal::LameField::PerElement(mu.data(), lambda.data()), &grad, 1);
   double expected = 0;
   VectorXd expected_grad = VectorXd::Zero(x.size());
   for (int e = 0; e < m; ++e) {
@@ -206,8 +211,8 @@ TEST(PdHexKernelTest, ElasticForcesUsesEachElementsLameParameters) {
       const int s = 8 * e + q;
       const Eigen::Map<const Eigen::Matrix<double, 8, 3>> g(fem.grad(s));
       Mat3 P;
-      expected += fem.sample_volume(s) *
-                  internal::EvaluateDensity(scene.energies, Mat3(xe * g), mu[e], lambda[e], &P, nullptr);
+      expected +=
+          fem.sample_volume(s) * internal::EvaluateDensity(scene.energies, Mat3(xe * g), mu[e], lambda[e], &P, nullptr);
       const Eigen::Matrix<double, 3, 8> f = fem.sample_volume(s) * P * g.transpose();
       for (int a = 0; a < 8; ++a) expected_grad.segment<3>(3 * scene.mesh.elements(a, e)) += f.col(a);
     }

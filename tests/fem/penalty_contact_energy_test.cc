@@ -50,8 +50,9 @@ TEST(PenaltyContactEnergyTest, ConformsToItsEnergyGradientHessianAndPdTerm) {
   VectorXd dir(n);
   for (int d = 0; d < n; ++d) dir(d) = normal(rng) / 0.002;
   const double eps = 1e-8;
-  const double fd = (energy.AddEnergyAndGradient(x + eps * dir, nullptr) -
-                     energy.AddEnergyAndGradient(x - eps * dir, nullptr)) / (2 * eps);
+  const double fd =
+      (energy.AddEnergyAndGradient(x + eps * dir, nullptr) - energy.AddEnergyAndGradient(x - eps * dir, nullptr)) /
+      (2 * eps);
   EXPECT_NEAR(fd, grad.dot(dir), 1e-6 * std::abs(fd));
   VectorXd gp = VectorXd::Zero(n), gm = VectorXd::Zero(n), hd = VectorXd::Zero(n);
   energy.AddEnergyAndGradient(x + eps * dir, &gp);

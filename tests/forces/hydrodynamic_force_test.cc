@@ -78,12 +78,14 @@ TEST(HydrodynamicForceTest, VectorJacobianProductsMatchFiniteDifferences) {
     const double eps = 1e-7;
     for (int d = 0; d < 3; ++d) {
       const Vec3 e = Vec3::Unit(d);
-      const double fd_u = w.dot(internal::HydrodynamicForce(p, n, u + eps * e) -
-                                internal::HydrodynamicForce(p, n, u - eps * e)) / (2 * eps);
+      const double fd_u =
+          w.dot(internal::HydrodynamicForce(p, n, u + eps * e) - internal::HydrodynamicForce(p, n, u - eps * e)) /
+          (2 * eps);
       EXPECT_NEAR(fd_u, gu(d), 1e-6 * gu.norm());
       const double en = 1e-9;
-      const double fd_n = w.dot(internal::HydrodynamicForce(p, n + en * e, u) -
-                                internal::HydrodynamicForce(p, n - en * e, u)) / (2 * en);
+      const double fd_n =
+          w.dot(internal::HydrodynamicForce(p, n + en * e, u) - internal::HydrodynamicForce(p, n - en * e, u)) /
+          (2 * en);
       EXPECT_NEAR(fd_n, ga(d), 1e-6 * ga.norm());
     }
     auto check_param = [&](double* field, double analytic) {

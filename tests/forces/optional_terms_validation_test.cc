@@ -46,8 +46,11 @@ TEST(OptionalTermsValidationTest, MuscleErrorsNameTheMuscleAndTheValue) {
   ExpectMessage([](Scene* s) { s->muscles[0].elements[1] = 16; },
                 "scene: muscles[0].elements[1] = 16 is out of range [0, 16) (no such element)");
   ExpectMessage([](Scene* s) { s->muscles[0].elements.clear(); }, "scene: muscles[0] has no elements");
-  ExpectMessage([](Scene* s) { s->muscles[0].fibers = {Vec3(1, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}; },
-                "scene: muscles[0] has 3 fibre directions for 2 elements (need one per element or a single shared one)");
+  ExpectMessage(
+      [](Scene* s) {
+        s->muscles[0].fibers = {Vec3(1, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+      },
+      "scene: muscles[0] has 3 fibre directions for 2 elements (need one per element or a single shared one)");
   ExpectMessage([](Scene* s) { s->muscles[0].stiffness = -1; },
                 "scene: muscles[0].stiffness = -1 is invalid: must be finite and > 0 (Pa)");
 }
@@ -70,8 +73,9 @@ TEST(OptionalTermsValidationTest, StateForceParametersMustBeFinite) {
 }
 
 TEST(OptionalTermsValidationTest, ContactErrorsNameTheContactAndTheValue) {
-  ExpectMessage([](Scene* s) { s->frictional_contacts[0].surface.normal = Vec3::Zero(); },
-                "scene: frictional_contacts[0].surface.normal = (0, 0, 0) is invalid: must be finite with non-zero length");
+  ExpectMessage(
+      [](Scene* s) { s->frictional_contacts[0].surface.normal = Vec3::Zero(); },
+      "scene: frictional_contacts[0].surface.normal = (0, 0, 0) is invalid: must be finite with non-zero length");
   ExpectMessage([](Scene* s) { s->frictional_contacts[0].surface = ContactSurface::Sphere(Vec3::Zero(), 0.0); },
                 "scene: frictional_contacts[0].surface.radius = 0 is invalid: must be finite and > 0 (m)");
   ExpectMessage([](Scene* s) { s->frictional_contacts[0].surface = ContactSurface::HeightField(nullptr, nullptr); },
@@ -86,8 +90,9 @@ TEST(OptionalTermsValidationTest, ContactErrorsNameTheContactAndTheValue) {
                 "free");
   ExpectMessage([](Scene* s) { s->frictional_contact_options.max_passes = 0; },
                 "scene: frictional_contact_options.max_passes = 0 is invalid: must be >= 1");
-  ExpectMessage([](Scene* s) { s->frictional_contact_options.screening_rel_tolerance = 1; },
-                "scene: frictional_contact_options.screening_rel_tolerance = 1 is invalid: must be finite and in [0, 1)");
+  ExpectMessage(
+      [](Scene* s) { s->frictional_contact_options.screening_rel_tolerance = 1; },
+      "scene: frictional_contact_options.screening_rel_tolerance = 1 is invalid: must be finite and in [0, 1)");
   ExpectMessage([](Scene* s) { s->frictional_contact_options.screening_rel_tolerance = std::nan(""); },
                 "scene: frictional_contact_options.screening_rel_tolerance = nan is invalid: must be finite and in [0, "
                 "1)");

@@ -173,8 +173,8 @@ TEST_P(StateForceGradientTest, RolloutGradientsWithRespectToStateAndForceParamet
   int parameters = 0;
   for (const auto& entry : result.inputs) {
     EXPECT_LT(entry.max_rel_error, 1e-5) << ToString(GetParam()) << " input " << entry.input;
-    for (const char* name : {"linear_damping", "fluid_density", "drag_tangential", "drag_normal", "thrust",
-                             "penalty_friction"})
+    for (const char* name :
+         {"linear_damping", "fluid_density", "drag_tangential", "drag_normal", "thrust", "penalty_friction"})
       if (entry.input == name) ++parameters;
   }
   EXPECT_EQ(parameters, 6);

@@ -31,8 +31,7 @@ int Count(const std::string& text, const std::string& pattern) {
 class VtkWriterTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    directory_ = std::filesystem::path(::testing::TempDir()) /
-                 ("diffpd_vtk_writer_test_" + std::to_string(getpid()));
+    directory_ = std::filesystem::path(::testing::TempDir()) / ("diffpd_vtk_writer_test_" + std::to_string(getpid()));
     std::filesystem::create_directories(directory_);
   }
   void TearDown() override { std::filesystem::remove_all(directory_); }
@@ -69,7 +68,7 @@ TEST_F(VtkWriterTest, HexMeshWithPointData) {
   // Cell 0 is [0,1]^3: our nodes 0..7 at (i, j, k) = grid points (i*2 + j)*2 + k;
   // VTK's order is (0,0,0) (1,0,0) (1,1,0) (0,1,0) then the same at z = 1.
   EXPECT_NE(text.find("  0 4 6 2 1 5 7 3\n"), std::string::npos) << text;
-  EXPECT_EQ(Count(text, "          12\n"), 2);  // two VTK_HEXAHEDRON cell types
+  EXPECT_EQ(Count(text, "          12\n"), 2);                // two VTK_HEXAHEDRON cell types
   EXPECT_NE(text.find("          16\n"), std::string::npos);  // the second offset
 }
 
@@ -79,7 +78,7 @@ TEST_F(VtkWriterTest, TetMesh) {
   const std::string text = ReadText(Path("tets.vtu"));
   EXPECT_NE(text.find("NumberOfPoints=\"5\" NumberOfCells=\"2\""), std::string::npos);
   EXPECT_NE(text.find("  1 4 2 3\n"), std::string::npos);
-  EXPECT_EQ(Count(text, "          10\n"), 2);  // VTK_TETRA; the offsets are 4 and 8
+  EXPECT_EQ(Count(text, "          10\n"), 2);           // VTK_TETRA; the offsets are 4 and 8
   EXPECT_NE(text.find("  2 2 2\n"), std::string::npos);  // scaled position of vertex 4
 }
 

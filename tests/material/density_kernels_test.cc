@@ -16,15 +16,13 @@ namespace diffpd::internal {
 namespace {
 
 const std::vector<ElasticEnergy> kEnergies = {ElasticEnergy::kLinear, ElasticEnergy::kCorotated,
-                                              ElasticEnergy::kNeoHookean,
-                                              ElasticEnergy::kPdCorotated, ElasticEnergy::kPdVolume};
+                                              ElasticEnergy::kNeoHookean, ElasticEnergy::kPdCorotated,
+                                              ElasticEnergy::kPdVolume};
 constexpr double kMu = 1.3, kLambda = 2.1;
 
 Mat3 RandomRotation(std::mt19937& rng) {
   std::normal_distribution<double> normal;
-  return Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
-      .normalized()
-      .toRotationMatrix();
+  return Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized().toRotationMatrix();
 }
 
 // Deformations with singular values in [0.2, 5], inverted (det < 0) when asked.
@@ -42,7 +40,9 @@ std::vector<Mat3> RandomDeformations(std::mt19937& rng, int count, bool inverted
 
 double Relative(double a, double b) { return std::abs(a - b) / std::max(1.0, std::abs(b)); }
 template <class M>
-double Relative(const M& a, const M& b) { return (a - b).norm() / std::max(1.0, b.norm()); }
+double Relative(const M& a, const M& b) {
+  return (a - b).norm() / std::max(1.0, b.norm());
+}
 
 TEST(DensityKernelsTest, MatchReferenceImplementations) {
   std::mt19937 rng(51);
@@ -56,7 +56,8 @@ TEST(DensityKernelsTest, MatchReferenceImplementations) {
         EXPECT_LE(Relative(Energy(energy, F, kMu, kLambda), e), 1e-12) << ToString(energy);
         EXPECT_LE(Relative(Stress(energy, F, kMu, kLambda), P), 1e-12) << ToString(energy);
         EXPECT_LE(Relative(internal::StressDifferential(energy, F, kMu, kLambda), D), 1e-10)
-            << ToString(energy) << " at F =\n" << F;
+            << ToString(energy) << " at F =\n"
+            << F;
         const Svd3 svd = ComputeSvd3(F);
         Mat3 stress;
         EXPECT_LE(Relative(EnergyAndStress(energy, F, svd, kMu, kLambda, &stress), e), 1e-12);
@@ -72,8 +73,7 @@ TEST(DensityKernelsTest, ProjectiveForm) {
   std::mt19937 rng(52);
   const Mat9 I = Mat9::Identity();
   for (ElasticEnergy energy : kEnergies) {
-    EXPECT_EQ(NeedsSvd(energy), energy != ElasticEnergy::kLinear &&
-                                    energy != ElasticEnergy::kNeoHookean);
+    EXPECT_EQ(NeedsSvd(energy), energy != ElasticEnergy::kLinear && energy != ElasticEnergy::kNeoHookean);
     if (!IsProjective(energy)) continue;
     const double w = ProjectiveWeight(energy, kMu, kLambda);
     EXPECT_EQ(w, energy == ElasticEnergy::kPdCorotated ? 2.0 * kMu : kLambda);
@@ -83,7 +83,8 @@ TEST(DensityKernelsTest, ProjectiveForm) {
       EXPECT_LE(Relative(Energy(energy, F, kMu, kLambda), 0.5 * w * (F - proj).squaredNorm()), 1e-12);
       EXPECT_LE(Relative(Stress(energy, F, kMu, kLambda), Mat3(w * (F - proj))), 1e-12);
       EXPECT_LE(Relative(internal::StressDifferential(energy, F, kMu, kLambda),
-                         Mat9(w * (I - ProjectionDifferential(energy, svd)))), 1e-10);
+                         Mat9(w * (I - ProjectionDifferential(energy, svd)))),
+                1e-10);
     }
   }
 }

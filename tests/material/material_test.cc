@@ -19,15 +19,13 @@ namespace diffpd {
 namespace {
 
 const std::vector<ElasticEnergy> kEnergies = {ElasticEnergy::kLinear, ElasticEnergy::kCorotated,
-                                              ElasticEnergy::kNeoHookean,
-                                              ElasticEnergy::kPdCorotated, ElasticEnergy::kPdVolume};
+                                              ElasticEnergy::kNeoHookean, ElasticEnergy::kPdCorotated,
+                                              ElasticEnergy::kPdVolume};
 constexpr double kMu = 1.3, kLambda = 2.1;
 
 Mat3 RandomRotation(std::mt19937& rng) {
   std::normal_distribution<double> normal;
-  return Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
-      .normalized()
-      .toRotationMatrix();
+  return Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized().toRotationMatrix();
 }
 
 // Deformations with det F > 0: small ones around I and large ones with
@@ -40,8 +38,7 @@ std::vector<Mat3> RandomDeformations(std::mt19937& rng, int count) {
     if (n % 2 == 0) {
       for (int i = 0; i < 9; ++i) F(i) += small(rng);
     } else {
-      F = RandomRotation(rng) * Vec3(large(rng), large(rng), large(rng)).asDiagonal() *
-          RandomRotation(rng);
+      F = RandomRotation(rng) * Vec3(large(rng), large(rng), large(rng)).asDiagonal() * RandomRotation(rng);
     }
     result.push_back(F);
   }
@@ -57,9 +54,7 @@ std::string ValidationMessage(const MaterialParameters& parameters) {
   return "no error";
 }
 
-TEST(MaterialParametersTest, DefaultsAreValid) {
-  EXPECT_EQ(ValidationMessage(MaterialParameters()), "no error");
-}
+TEST(MaterialParametersTest, DefaultsAreValid) { EXPECT_EQ(ValidationMessage(MaterialParameters()), "no error"); }
 
 TEST(MaterialParametersTest, ValidationMessagesAreExact) {
   MaterialParameters p;
@@ -73,13 +68,11 @@ TEST(MaterialParametersTest, ValidationMessagesAreExact) {
   EXPECT_EQ(ValidationMessage(p), "youngs_modulus = inf is invalid: must be finite and > 0 (Pa)");
   p = MaterialParameters();
   p.poissons_ratio = 0.5;
-  EXPECT_EQ(ValidationMessage(p),
-            "poissons_ratio = 0.5 is invalid: must be finite and in (-1, 0.5)");
+  EXPECT_EQ(ValidationMessage(p), "poissons_ratio = 0.5 is invalid: must be finite and in (-1, 0.5)");
   p.poissons_ratio = -1.0;
   EXPECT_EQ(ValidationMessage(p), "poissons_ratio = -1 is invalid: must be finite and in (-1, 0.5)");
   p.poissons_ratio = std::numeric_limits<double>::infinity();
-  EXPECT_EQ(ValidationMessage(p),
-            "poissons_ratio = inf is invalid: must be finite and in (-1, 0.5)");
+  EXPECT_EQ(ValidationMessage(p), "poissons_ratio = inf is invalid: must be finite and in (-1, 0.5)");
   p = MaterialParameters();
   p.density = 0.0;
   EXPECT_EQ(ValidationMessage(p), "density = 0 is invalid: must be finite and > 0 (kg/m^3)");
@@ -102,14 +95,12 @@ TEST(MaterialParametersTest, LameParametersAndDerivatives) {
     plus.youngs_modulus += hE;
     minus.youngs_modulus -= hE;
     EXPECT_NEAR(dmu_dE, (plus.mu() - minus.mu()) / (2 * hE), 1e-6 * std::abs(dmu_dE));
-    EXPECT_NEAR(dlambda_dE, (plus.lambda() - minus.lambda()) / (2 * hE),
-                1e-6 * std::abs(dlambda_dE) + 1e-12);
+    EXPECT_NEAR(dlambda_dE, (plus.lambda() - minus.lambda()) / (2 * hE), 1e-6 * std::abs(dlambda_dE) + 1e-12);
     plus = minus = p;
     plus.poissons_ratio += hnu;
     minus.poissons_ratio -= hnu;
     EXPECT_NEAR(dmu_dnu, (plus.mu() - minus.mu()) / (2 * hnu), 1e-6 * std::abs(dmu_dnu));
-    EXPECT_NEAR(dlambda_dnu, (plus.lambda() - minus.lambda()) / (2 * hnu),
-                1e-6 * std::abs(dlambda_dnu));
+    EXPECT_NEAR(dlambda_dnu, (plus.lambda() - minus.lambda()) / (2 * hnu), 1e-6 * std::abs(dlambda_dnu));
   }
   double only_mu = 0.0;
   p.LameDerivatives(&only_mu, nullptr, nullptr, nullptr);  // unwanted outputs may be null
@@ -132,8 +123,7 @@ TEST(ElasticEnergyTest, NamesAndProjectivity) {
 TEST(ElasticEnergyTest, ZeroEnergyAndStressAtRest) {
   for (ElasticEnergy energy : kEnergies) {
     EXPECT_NEAR(EnergyDensity(energy, Mat3::Identity(), kMu, kLambda), 0.0, 1e-15) << ToString(energy);
-    EXPECT_LE(FirstPiolaStress(energy, Mat3::Identity(), kMu, kLambda).norm(), 1e-14)
-        << ToString(energy);
+    EXPECT_LE(FirstPiolaStress(energy, Mat3::Identity(), kMu, kLambda).norm(), 1e-14) << ToString(energy);
   }
 }
 
@@ -147,12 +137,11 @@ TEST(ElasticEnergyTest, StressIsTheEnergyGradient) {
         Mat3 plus = F, minus = F;
         plus(n) += h;
         minus(n) -= h;
-        numeric(n) = (EnergyDensity(energy, plus, kMu, kLambda) -
-                      EnergyDensity(energy, minus, kMu, kLambda)) / (2 * h);
+        numeric(n) = (EnergyDensity(energy, plus, kMu, kLambda) - EnergyDensity(energy, minus, kMu, kLambda)) / (2 * h);
       }
       const Mat3 stress = FirstPiolaStress(energy, F, kMu, kLambda);
-      EXPECT_LE((stress - numeric).norm(), 1e-6 * std::max(1.0, numeric.norm()))
-          << ToString(energy) << " at F =\n" << F;
+      EXPECT_LE((stress - numeric).norm(), 1e-6 * std::max(1.0, numeric.norm())) << ToString(energy) << " at F =\n"
+                                                                                 << F;
     }
   }
 }
@@ -167,13 +156,13 @@ TEST(ElasticEnergyTest, StressDifferentialIsTheStressJacobian) {
         Mat3 plus = F, minus = F;
         plus(n) += h;
         minus(n) -= h;
-        const Mat3 column = (FirstPiolaStress(energy, plus, kMu, kLambda) -
-                             FirstPiolaStress(energy, minus, kMu, kLambda)) / (2 * h);
+        const Mat3 column =
+            (FirstPiolaStress(energy, plus, kMu, kLambda) - FirstPiolaStress(energy, minus, kMu, kLambda)) / (2 * h);
         numeric.col(n) = Eigen::Map<const Vec9>(column.data());
       }
       const Mat9 analytic = StressDifferential(energy, F, kMu, kLambda);
-      EXPECT_LE((analytic - numeric).norm(), 1e-6 * std::max(1.0, numeric.norm()))
-          << ToString(energy) << " at F =\n" << F;
+      EXPECT_LE((analytic - numeric).norm(), 1e-6 * std::max(1.0, numeric.norm())) << ToString(energy) << " at F =\n"
+                                                                                   << F;
     }
   }
 }
@@ -187,12 +176,11 @@ TEST(ElasticEnergyTest, LinearInLameParameters) {
       const double e = EnergyDensity(energy, F, kMu, kLambda);
       EXPECT_NEAR(e, kMu * e_mu + kLambda * e_lambda, 1e-12 * std::max(1.0, std::abs(e)));
       const Mat3 P = FirstPiolaStress(energy, F, kMu, kLambda);
-      const Mat3 P_sum = kMu * FirstPiolaStress(energy, F, 1.0, 0.0) +
-                         kLambda * FirstPiolaStress(energy, F, 0.0, 1.0);
+      const Mat3 P_sum = kMu * FirstPiolaStress(energy, F, 1.0, 0.0) + kLambda * FirstPiolaStress(energy, F, 0.0, 1.0);
       EXPECT_LE((P - P_sum).norm(), 1e-12 * std::max(1.0, P.norm()));
       const Mat9 D = StressDifferential(energy, F, kMu, kLambda);
-      const Mat9 D_sum = kMu * StressDifferential(energy, F, 1.0, 0.0) +
-                         kLambda * StressDifferential(energy, F, 0.0, 1.0);
+      const Mat9 D_sum =
+          kMu * StressDifferential(energy, F, 1.0, 0.0) + kLambda * StressDifferential(energy, F, 0.0, 1.0);
       EXPECT_LE((D - D_sum).norm(), 1e-12 * std::max(1.0, D.norm()));
     }
   }
@@ -206,12 +194,9 @@ TEST(ElasticEnergyTest, RotationInvariance) {
     for (const Mat3& F : RandomDeformations(rng, 20)) {
       const Mat3 Q = RandomRotation(rng);
       const double e = EnergyDensity(energy, F, kMu, kLambda);
-      EXPECT_NEAR(EnergyDensity(energy, Q * F, kMu, kLambda), e, 1e-11 * std::max(1.0, e))
-          << ToString(energy);
-      EXPECT_NEAR(EnergyDensity(energy, F * Q, kMu, kLambda), e, 1e-11 * std::max(1.0, e))
-          << ToString(energy);
-      EXPECT_LE((FirstPiolaStress(energy, Q * F, kMu, kLambda) -
-                 Q * FirstPiolaStress(energy, F, kMu, kLambda)).norm(),
+      EXPECT_NEAR(EnergyDensity(energy, Q * F, kMu, kLambda), e, 1e-11 * std::max(1.0, e)) << ToString(energy);
+      EXPECT_NEAR(EnergyDensity(energy, F * Q, kMu, kLambda), e, 1e-11 * std::max(1.0, e)) << ToString(energy);
+      EXPECT_LE((FirstPiolaStress(energy, Q * F, kMu, kLambda) - Q * FirstPiolaStress(energy, F, kMu, kLambda)).norm(),
                 1e-11 * std::max(1.0, e));
     }
   }
@@ -233,9 +218,8 @@ TEST(ElasticEnergyTest, InvertedElementsForNonNeoHookeanEnergies) {
 TEST(ElasticEnergyTest, NeoHookeanRejectsInvertedElements) {
   for (const Vec3& diagonal : {Vec3(1.0, 1.0, -1.0), Vec3(2.0, 0.5, 0.0)}) {
     const Mat3 F = diagonal.asDiagonal();
-    const std::string expected = diagonal(2) < 0
-        ? "neohookean energy: det F = -1 <= 0 (inverted element)"
-        : "neohookean energy: det F = 0 <= 0 (inverted element)";
+    const std::string expected = diagonal(2) < 0 ? "neohookean energy: det F = -1 <= 0 (inverted element)"
+                                                 : "neohookean energy: det F = 0 <= 0 (inverted element)";
     try {
       EnergyDensity(ElasticEnergy::kNeoHookean, F, kMu, kLambda);
       ADD_FAILURE() << "no exception";

@@ -23,9 +23,7 @@ using Projector = std::function<Mat3(const Mat3&)>;
 
 Mat3 RandomRotation(std::mt19937& rng) {
   std::normal_distribution<double> normal;
-  return Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
-      .normalized()
-      .toRotationMatrix();
+  return Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized().toRotationMatrix();
 }
 
 // Q1 diag(sigma) Q2 with sigma_i uniform in [lo, hi] (random signs if signed).
@@ -53,7 +51,8 @@ Mat9 FiniteDifference(const Projector& proj, const Mat3& F, double h = 1e-6) {
 
 void ExpectDifferentialMatches(const Mat9& analytic, const Mat9& numeric, const Mat3& F) {
   EXPECT_LE((analytic - numeric).norm(), 1e-6 * std::max(1.0, numeric.norm()))
-      << "F =\n" << F << "\nsigma = " << ComputeSvd3(F).sigma.transpose();
+      << "F =\n"
+      << F << "\nsigma = " << ComputeSvd3(F).sigma.transpose();
 }
 
 // ---- rotation -------------------------------------------------------------
@@ -82,8 +81,7 @@ TEST(RotationProjectionTest, IsTheClosestRotation) {
     for (int m = 0; m < 200; ++m) {
       // Far samples and samples near R (R exp(small skew)).
       const Vec3 w = (m % 2 ? 1e-3 : 1.0) * Vec3(normal(rng), normal(rng), normal(rng));
-      const Mat3 sample = m % 2 ? Mat3(R * Eigen::AngleAxisd(w.norm(), w.normalized()))
-                                : RandomRotation(rng);
+      const Mat3 sample = m % 2 ? Mat3(R * Eigen::AngleAxisd(w.norm(), w.normalized())) : RandomRotation(rng);
       EXPECT_GE((F - sample).norm(), distance - 1e-12);
     }
   }
@@ -94,11 +92,10 @@ TEST(RotationProjectionTest, DifferentialMatchesFiniteDifferences) {
   for (int n = 0; n < 100; ++n) {
     Mat3 F = RandomDeformation(rng, 0.2, 5.0);
     if (n % 4 == 1) F = F * Vec3(1.0, 1.0, -1.0).asDiagonal();  // inverted
-    if (n % 4 == 2) {  // near-repeated singular values
+    if (n % 4 == 2) {                                           // near-repeated singular values
       F = RandomRotation(rng) * Vec3(1.3, 1.3 + 1e-9, 0.7).asDiagonal() * RandomRotation(rng);
     }
-    ExpectDifferentialMatches(RotationProjectionDifferential(ComputeSvd3(F)),
-                              FiniteDifference(Rotation, F), F);
+    ExpectDifferentialMatches(RotationProjectionDifferential(ComputeSvd3(F)), FiniteDifference(Rotation, F), F);
   }
   // Identity and a repeated spectrum.
   ExpectDifferentialMatches(RotationProjectionDifferential(ComputeSvd3(Mat3::Identity())),
@@ -153,17 +150,16 @@ double BruteForceDistance(const Vec3& sigma) {
 }
 
 TEST(VolumeProjectionTest, IsTheGlobalMinimiserOnHardSpectra) {
-  const std::vector<Vec3> spectra = {
-      {1, 1, 1},       {2, 1, 0.5},      {1.9, 1.9, 1.9}, {1.95, 1.9, 1.85}, {2, 2, 2},
-      {10, 10, 10},    {10, 3, 1},       {5, 5, 4},       {1, 1, -1},        {1, 1, 0},
-      {1, 0, 0},       {0, 0, 0},        {3, 2, -2},      {0.5, 0.2, -0.1},  {1e3, 1, 1e-3},
-      {1e6, 1e-6, 1e-6}, {1e6, 1e6, 1e-6}, {1e3, 1e3, 1e3}, {0.1, 0.1, 0.1}, {4, 0.3, -0.3}};
+  const std::vector<Vec3> spectra = {{1, 1, 1},        {2, 1, 0.5},      {1.9, 1.9, 1.9}, {1.95, 1.9, 1.85},
+                                     {2, 2, 2},        {10, 10, 10},     {10, 3, 1},      {5, 5, 4},
+                                     {1, 1, -1},       {1, 1, 0},        {1, 0, 0},       {0, 0, 0},
+                                     {3, 2, -2},       {0.5, 0.2, -0.1}, {1e3, 1, 1e-3},  {1e6, 1e-6, 1e-6},
+                                     {1e6, 1e6, 1e-6}, {1e3, 1e3, 1e3},  {0.1, 0.1, 0.1}, {4, 0.3, -0.3}};
   for (const Vec3& sigma : spectra) {
     const VolumeProjection p = ProjectSingularValuesToUnitDeterminant(sigma);
     EXPECT_NEAR(p.d.prod(), 1.0, 1e-13) << sigma.transpose();
     const double distance = (p.d - sigma).norm();
-    EXPECT_LE(distance, BruteForceDistance(sigma) * (1 + 1e-12)) << sigma.transpose() << " -> "
-                                                                 << p.d.transpose();
+    EXPECT_LE(distance, BruteForceDistance(sigma) * (1 + 1e-12)) << sigma.transpose() << " -> " << p.d.transpose();
   }
 }
 
@@ -172,17 +168,21 @@ TEST(VolumeProjectionTest, IsTheGlobalMinimiserOnHardSpectra) {
 // infinitesimal strains up to the edge of its domain (prod just below 2,
 // where the general path takes over), including strongly anisotropic spectra.
 TEST(VolumeProjectionTest, PositiveSpectraBelowProductTwoAreProjectedToRounding) {
-  const std::vector<Vec3> spectra = {
-      {1 + 1e-12, 1, 1 - 1e-12}, {1 + 1e-6, 1 - 1e-7, 1 - 2e-6}, {1.02, 0.99, 0.97},
-      {1.2599, 1.2599, 1.2599},  {1.9, 1.01, 1.04},              {1.5, 1.15, 1.15},
-      {30, 0.2, 0.1},            {1e4, 1e-2, 1e-3},              {0.3, 0.2, 0.01}};
+  const std::vector<Vec3> spectra = {{1 + 1e-12, 1, 1 - 1e-12},
+                                     {1 + 1e-6, 1 - 1e-7, 1 - 2e-6},
+                                     {1.02, 0.99, 0.97},
+                                     {1.2599, 1.2599, 1.2599},
+                                     {1.9, 1.01, 1.04},
+                                     {1.5, 1.15, 1.15},
+                                     {30, 0.2, 0.1},
+                                     {1e4, 1e-2, 1e-3},
+                                     {0.3, 0.2, 0.01}};
   for (const Vec3& sigma : spectra) {
     ASSERT_LT(sigma.prod(), 2.0);
     const VolumeProjection p = ProjectSingularValuesToUnitDeterminant(sigma);
     EXPECT_NEAR(p.d.prod(), 1.0, 4e-15) << sigma.transpose();
     for (int i = 0; i < 3; ++i) {
-      EXPECT_NEAR(p.d(i) * (p.d(i) - sigma(i)), p.multiplier, 1e-14 * (1 + sigma.squaredNorm()))
-          << sigma.transpose();
+      EXPECT_NEAR(p.d(i) * (p.d(i) - sigma(i)), p.multiplier, 1e-14 * (1 + sigma.squaredNorm())) << sigma.transpose();
     }
     EXPECT_LE((p.d - sigma).norm(), BruteForceDistance(sigma) * (1 + 1e-12)) << sigma.transpose();
   }
@@ -202,7 +202,7 @@ TEST(VolumeProjectionTest, BatchMatchesSingleCallsLaneByLane) {
       std::sort(sigma[l].data(), sigma[l].data() + 3, std::greater<double>());
     }
     const int odd = count / 2;
-    if (trial % 5 == 1) sigma[odd](2) = -sigma[odd](2);  // inverted
+    if (trial % 5 == 1) sigma[odd](2) = -sigma[odd](2);    // inverted
     if (trial % 5 == 2) sigma[odd] = Vec3(2.0, 1.9, 1.8);  // prod >= 2: general path
     if (trial % 5 == 3) sigma[odd](0) = std::numeric_limits<double>::infinity();
     VolumeProjection batch[kVolumeBatch];
@@ -249,20 +249,19 @@ TEST(VolumeProjectionTest, DifferentialMatchesFiniteDifferences) {
   for (int n = 0; n < 200; ++n) {
     Mat3 F = RandomDeformation(rng, 0.2, 5.0);
     if (n % 4 == 1) F = F * Vec3(1.0, 1.0, -1.0).asDiagonal();  // inverted
-    if (n % 4 == 2) {  // near-repeated singular values
+    if (n % 4 == 2) {                                           // near-repeated singular values
       const double s = 0.5 + n / 100.0;
       F = RandomRotation(rng) * Vec3(s + 1e-9, s, 0.8).asDiagonal() * RandomRotation(rng);
     }
     if (n % 4 == 3) F = Mat3::Identity() + 0.1 * RandomDeformation(rng, -1.0, 1.0);
-    ExpectDifferentialMatches(UnitDeterminantProjectionDifferential(ComputeSvd3(F)),
-                              FiniteDifference(Volume, F), F);
+    ExpectDifferentialMatches(UnitDeterminantProjectionDifferential(ComputeSvd3(F)), FiniteDifference(Volume, F), F);
   }
 }
 
 TEST(VolumeProjectionTest, SingularValueJacobianMatchesFiniteDifferences) {
   // (Not at ties between minimisers such as sigma = (10, 10, 10), where the
   // projection jumps.)
-  const std::vector<Vec3> spectra = {{2, 1, 0.5}, {1.9, 1.9, 1.9}, {3, 2, -1}, {10, 9, 8},
+  const std::vector<Vec3> spectra = {{2, 1, 0.5}, {1.9, 1.9, 1.9}, {3, 2, -1},    {10, 9, 8},
                                      {1, 1, 1},   {1e3, 1, 1e-3},  {4, 0.3, -0.2}};
   for (const Vec3& sigma : spectra) {
     const Mat3 J = UnitDeterminantProjectionJacobian(sigma, ProjectSingularValuesToUnitDeterminant(sigma));
@@ -271,8 +270,9 @@ TEST(VolumeProjectionTest, SingularValueJacobianMatchesFiniteDifferences) {
       Vec3 plus = sigma, minus = sigma;
       plus(j) += h;
       minus(j) -= h;
-      const Vec3 column = (ProjectSingularValuesToUnitDeterminant(plus).d -
-                           ProjectSingularValuesToUnitDeterminant(minus).d) / (2.0 * h);
+      const Vec3 column =
+          (ProjectSingularValuesToUnitDeterminant(plus).d - ProjectSingularValuesToUnitDeterminant(minus).d) /
+          (2.0 * h);
       EXPECT_LE((J.col(j) - column).norm(), 1e-6 * std::max(1.0, column.norm()))
           << sigma.transpose() << " column " << j;
     }

@@ -22,17 +22,14 @@ constexpr double kUlps = 16.0;
 
 Mat3 RandomRotation(std::mt19937& rng) {
   std::normal_distribution<double> normal;
-  return Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
-      .normalized()
-      .toRotationMatrix();
+  return Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized().toRotationMatrix();
 }
 
 // Checks every property of ComputeSvd3(F); returns the SVD for more checks.
 Svd3 CheckSvd(const Mat3& F) {
   const Svd3 svd = ComputeSvd3(F);
   const Mat3 I = Mat3::Identity();
-  EXPECT_LE((svd.U * svd.sigma.asDiagonal() * svd.V.transpose() - F).norm(), kUlps * kEps * F.norm())
-      << "F =\n" << F;
+  EXPECT_LE((svd.U * svd.sigma.asDiagonal() * svd.V.transpose() - F).norm(), kUlps * kEps * F.norm()) << "F =\n" << F;
   EXPECT_LE((svd.U.transpose() * svd.U - I).norm(), kUlps * kEps) << "F =\n" << F;
   EXPECT_LE((svd.V.transpose() * svd.V - I).norm(), kUlps * kEps) << "F =\n" << F;
   EXPECT_NEAR(svd.U.determinant(), 1.0, kUlps * kEps);
@@ -81,17 +78,15 @@ TEST(Svd3Test, ReflectionsHaveNegativeLastSingularValue) {
   for (int n = 0; n < 100; ++n) {
     const Mat3 reflection = RandomRotation(rng) * Vec3(1.0, 1.0, -1.0).asDiagonal();
     CheckSingularValues(reflection, Vec3(1.0, 1.0, -1.0));
-    CheckSingularValues(reflection * Vec3(3.0, 2.0, 0.5).asDiagonal() * RandomRotation(rng),
-                        Vec3(3.0, 2.0, -0.5));
+    CheckSingularValues(reflection * Vec3(3.0, 2.0, 0.5).asDiagonal() * RandomRotation(rng), Vec3(3.0, 2.0, -0.5));
   }
 }
 
 TEST(Svd3Test, RepeatedRankDeficientAndScaled) {
   std::mt19937 rng(2);
-  const std::vector<Vec3> spectra = {
-      {1, 1, 1},     {2, 2, 1},    {2, 1, 1},         {1, 1, -1},   {2, 2, -2},
-      {1, 1, 0},     {1, 0, 0},    {1, 1e-9, 1e-9},   {1, 1e-5, 0}, {1, 1 + 1e-12, 1},
-      {3, 3, -1e-7}, {1, 0.5, 0.5}, {1 + 1e-15, 1, 1}, {0, 0, 0}};
+  const std::vector<Vec3> spectra = {{1, 1, 1},     {2, 2, 1},     {2, 1, 1},         {1, 1, -1},   {2, 2, -2},
+                                     {1, 1, 0},     {1, 0, 0},     {1, 1e-9, 1e-9},   {1, 1e-5, 0}, {1, 1 + 1e-12, 1},
+                                     {3, 3, -1e-7}, {1, 0.5, 0.5}, {1 + 1e-15, 1, 1}, {0, 0, 0}};
   for (const Vec3& spectrum : spectra) {
     for (double scale : {1e-8, 1e-4, 1.0, 1e4, 1e8}) {
       for (int n = 0; n < 20; ++n) {
@@ -121,11 +116,9 @@ TEST(Svd3Test, RankOneOuterProducts) {
 TEST(Svd3Test, ExtremeScalesAreRescaledExactly) {
   std::mt19937 rng(4);
   for (double scale : {1e-200, 1e-120, 1e120, 1e200}) {
-    const Mat3 F = scale * RandomRotation(rng) * Vec3(3.0, 2.0, -1.0).asDiagonal() *
-                   RandomRotation(rng);
+    const Mat3 F = scale * RandomRotation(rng) * Vec3(3.0, 2.0, -1.0).asDiagonal() * RandomRotation(rng);
     const Svd3 svd = ComputeSvd3(F);
-    EXPECT_LE((svd.U * svd.sigma.asDiagonal() * svd.V.transpose() - F).norm(),
-              kUlps * kEps * F.norm());
+    EXPECT_LE((svd.U * svd.sigma.asDiagonal() * svd.V.transpose() - F).norm(), kUlps * kEps * F.norm());
     EXPECT_LE((svd.sigma / scale - Vec3(3.0, 2.0, -1.0)).norm(), kUlps * kEps * 4.0);
   }
 }
@@ -169,8 +162,9 @@ TEST(Svd3Test, BatchMatchesScalarLaneByLane) {
       // Warm guess: the V of a nearby matrix; else a random rotation or I.
       Mat3 nearby = F[l];
       nearby(0, 1) += 1e-3;
-      guess[l] = (trial + l) % 4 == 0 ? Mat3(RandomRotation(rng))
-                 : (trial + l) % 4 == 1 ? Mat3::Identity() : ComputeSvd3(nearby).V;
+      guess[l] = (trial + l) % 4 == 0   ? Mat3(RandomRotation(rng))
+                 : (trial + l) % 4 == 1 ? Mat3::Identity()
+                                        : ComputeSvd3(nearby).V;
     }
     if (trial % 7 == 3) F[count / 2].setZero();
     if (trial % 7 == 4) F[count / 2](1, 1) = nan;

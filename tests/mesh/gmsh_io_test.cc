@@ -49,8 +49,7 @@ const char kTets[] =
 class ReadGmshTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    directory_ = std::filesystem::path(::testing::TempDir()) /
-                 ("diffpd_gmsh_io_test_" + std::to_string(getpid()));
+    directory_ = std::filesystem::path(::testing::TempDir()) / ("diffpd_gmsh_io_test_" + std::to_string(getpid()));
     std::filesystem::create_directories(directory_);
   }
   void TearDown() override { std::filesystem::remove_all(directory_); }

@@ -89,9 +89,7 @@ TEST(SignedElementVolumeTest, UsesGivenPositions) {
   EXPECT_DOUBLE_EQ(SignedElementVolume(tet, 2.0 * tet.vertices, 0), 8.0 / 6.0);
 }
 
-TEST(ValidateMeshTest, NoElements) {
-  ExpectMessage(Mesh{}, "mesh", "mesh: the mesh has no elements");
-}
+TEST(ValidateMeshTest, NoElements) { ExpectMessage(Mesh{}, "mesh", "mesh: the mesh has no elements"); }
 
 TEST(ValidateMeshTest, WrongNumberOfRows) {
   Mesh mesh = UnitCube();

@@ -15,8 +15,7 @@ namespace {
 class ReadObjTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    directory_ = std::filesystem::path(::testing::TempDir()) /
-                 ("diffpd_obj_reader_test_" + std::to_string(getpid()));
+    directory_ = std::filesystem::path(::testing::TempDir()) / ("diffpd_obj_reader_test_" + std::to_string(getpid()));
     std::filesystem::create_directories(directory_);
   }
   void TearDown() override { std::filesystem::remove_all(directory_); }

@@ -17,7 +17,7 @@ SurfaceMesh UnitCube() {
   for (int a = 0; a < 8; ++a) surface.vertices.col(a) = Vec3(a >> 2 & 1, a >> 1 & 1, a & 1);
   surface.triangles.resize(3, 12);
   surface.triangles << 0, 0, 4, 4, 0, 0, 2, 2, 0, 0, 1, 1,  //
-      1, 3, 6, 7, 4, 5, 3, 7, 2, 6, 5, 7,                    //
+      1, 3, 6, 7, 4, 5, 3, 7, 2, 6, 5, 7,                   //
       3, 2, 7, 5, 5, 1, 7, 6, 6, 4, 7, 3;
   return surface;
 }

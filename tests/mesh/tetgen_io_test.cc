@@ -36,8 +36,7 @@ const char kEle1[] =
 class TetGenTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    directory_ = std::filesystem::path(::testing::TempDir()) /
-                 ("diffpd_tetgen_io_test_" + std::to_string(getpid()));
+    directory_ = std::filesystem::path(::testing::TempDir()) / ("diffpd_tetgen_io_test_" + std::to_string(getpid()));
     std::filesystem::create_directories(directory_);
   }
   void TearDown() override { std::filesystem::remove_all(directory_); }
@@ -160,7 +159,7 @@ TEST(TetrahedralizeSurfaceTest, Errors) {
   SurfaceMesh triangle;  // not a closed surface: TetGen gives up
   triangle.vertices.resize(3, 3);
   triangle.vertices << 0, 1, 0,  //
-      0, 0, 1,                    //
+      0, 0, 1,                   //
       0, 0, 0;
   triangle.triangles.resize(3, 1);
   triangle.triangles << 0, 1, 2;

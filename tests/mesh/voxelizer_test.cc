@@ -35,7 +35,7 @@ SurfaceMesh BoxSurface(const Vec3& lo, const Vec3& hi) {
   surface.vertices = box.vertices;  // node a = 4i + 2j + k
   surface.triangles.resize(3, 12);
   surface.triangles << 0, 0, 4, 4, 0, 0, 2, 2, 0, 0, 1, 1,  //
-      1, 3, 6, 7, 4, 5, 3, 7, 2, 6, 5, 7,                    //
+      1, 3, 6, 7, 4, 5, 3, 7, 2, 6, 5, 7,                   //
       3, 2, 7, 5, 5, 1, 7, 6, 6, 4, 7, 3;
   return surface;
 }
@@ -45,7 +45,7 @@ SurfaceMesh Octahedron() {
   SurfaceMesh surface;
   surface.vertices.resize(3, 6);
   surface.vertices << 1, -1, 0, 0, 0, 0,  //
-      0, 0, 1, -1, 0, 0,                   //
+      0, 0, 1, -1, 0, 0,                  //
       0, 0, 0, 0, 1, -1;
   surface.triangles.resize(3, 8);
   int t = 0;
@@ -165,15 +165,14 @@ TEST(VoxelizeSurfaceTest, RejectsBadInput) {
   SurfaceMesh triangle;
   triangle.vertices.resize(3, 3);
   triangle.vertices << 0, 1, 0,  //
-      0, 0, 1,                    //
+      0, 0, 1,                   //
       0, 0, 0;
   triangle.triangles.resize(3, 1);
   triangle.triangles << 0, 1, 2;
   EXPECT_EQ(ErrorOf([&] { VoxelizeSurface(triangle, 0.5); }),
             "VoxelizeSurface: no cell centre lies inside the surface (dx = 0.5, grid 2 x 2 x 1 cells); "
             "use a smaller dx or check that the surface is closed");
-  EXPECT_EQ(ErrorOf([&] { VoxelizeSurface(triangle, -0.5); }),
-            "VoxelizeSurface: dx = -0.5, must be finite and > 0");
+  EXPECT_EQ(ErrorOf([&] { VoxelizeSurface(triangle, -0.5); }), "VoxelizeSurface: dx = -0.5, must be finite and > 0");
   EXPECT_EQ(ErrorOf([&] { VoxelizeSurface(triangle, 0.5, 0.0); }),
             "VoxelizeSurface: scale = 0, must be finite and > 0");
   EXPECT_EQ(ErrorOf([&] { VoxelizeSurface(triangle, 1e-5); }),

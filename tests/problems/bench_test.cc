@@ -172,10 +172,10 @@ TEST(BenchTest, JsonIsAListWithTheRequiredFields) {
   ASSERT_TRUE(parsed.is_array());
   ASSERT_EQ(parsed.size(), 2u);
   for (const auto& row : parsed) {
-    for (const char* field : {"forward_s", "backward_s", "iters_per_step", "state_rel_error", "grad_rel_error",
-                              "forward_per_iteration_ms", "factorization_s", "speedup_vs_newton_cholesky",
-                              "backward_iters_per_step", "backward_fallbacks", "rounding_floor_steps",
-                              "newton_fallback_steps"})
+    for (const char* field :
+         {"forward_s", "backward_s", "iters_per_step", "state_rel_error", "grad_rel_error", "forward_per_iteration_ms",
+          "factorization_s", "speedup_vs_newton_cholesky", "backward_iters_per_step", "backward_fallbacks",
+          "rounding_floor_steps", "newton_fallback_steps"})
       EXPECT_TRUE(row.at(field).is_number()) << field;
     EXPECT_TRUE(row.at("method").is_string());
     EXPECT_EQ(row.at("status"), "ok");
@@ -198,8 +198,7 @@ TEST(BenchTest, AMethodThatFailsIsReportedWithItsSolverError) {
   o.methods = {Method::kPd, Method::kNewtonCholesky};
   o.max_iterations = 20;  // far too few for PD at 1e-4
   const BenchResult r = RunBench("cantilever", o);
-  EXPECT_EQ(r.rows[0].failure.rfind("maximum number of iterations reached: pd: the step did not converge in 20", 0),
-            0u)
+  EXPECT_EQ(r.rows[0].failure.rfind("maximum number of iterations reached: pd: the step did not converge in 20", 0), 0u)
       << r.rows[0].failure;
   EXPECT_TRUE(r.rows[1].failure.empty());
   const nlohmann::json rows = BenchToJson(r, o);
@@ -222,8 +221,8 @@ TEST(ScalingTest, ElementCountsDoubleAndTimePerIterationIsReported) {
     EXPECT_GT(row.factorization_s, 0);
     EXPECT_GT(row.iteration_ms, 0);
     EXPECT_LT(row.iteration_ms, row.forward_per_iteration_ms);
-    EXPECT_NEAR(row.iteration_ms * row.iters_per_step * o.steps,
-                1e3 * (row.forward_s - row.factorization_s), 1e-9 * 1e3 * row.forward_s);
+    EXPECT_NEAR(row.iteration_ms * row.iters_per_step * o.steps, 1e3 * (row.forward_s - row.factorization_s),
+                1e-9 * 1e3 * row.forward_s);
     EXPECT_GT(row.peak_rss_mib, 0);
   }
   EXPECT_EQ(r.exponent_per_iteration.count("pd-lbfgs"), 1u);

@@ -20,8 +20,12 @@
 namespace diffpd::problems {
 namespace {
 
-const char* const kStatusNames[] = {"maximum number of iterations reached", "line search failed", "non-finite value",
-                                    "factorization failed", "inverted element", "diverged"};
+const char* const kStatusNames[] = {"maximum number of iterations reached",
+                                    "line search failed",
+                                    "non-finite value",
+                                    "factorization failed",
+                                    "inverted element",
+                                    "diverged"};
 
 StressOptions ReducedGrid() {
   StressOptions o;
@@ -57,7 +61,10 @@ std::string Name(const StressCase& c) {
 // problems' typical material and step.
 TEST(StressTest, EveryExtremeCaseIsOkOrAClearSolverError) {
   const StressOptions o = ReducedGrid();
-  const double corners[][3] = {{1e2, 0, 0.1}, {1e2, 0.499, 1e-5}, {1e10, 0, 1e-5}, {1e10, 0.499, 0.1},
+  const double corners[][3] = {{1e2, 0, 0.1},
+                               {1e2, 0.499, 1e-5},
+                               {1e10, 0, 1e-5},
+                               {1e10, 0.499, 0.1},
                                {1e6, 0.45, 0.01}};  // the last: typical, Newton only (PD's tight solves are slow)
   std::set<std::string> tested_inputs;
   int ok = 0;

@@ -115,13 +115,14 @@ TEST(ParallelTriangularSolveTest, RefusesColumnsThatAreNotALowerFactor) {
   const int perm[] = {0, 1};
   using Column = ParallelTriangularSolve::Column;
   const auto make = [&](Column c0, Column c1) {
-    return ParallelTriangularSolve::Create(2, perm, [&](int j) { return j == 0 ? c0 : c1; }, 1);
+    return ParallelTriangularSolve::Create(
+        2, perm, [&](int j) { return j == 0 ? c0 : c1; }, 1);
   };
   EXPECT_NE(make({rows0, values0, 2}, {rows1, values1, 1}), nullptr);
-  EXPECT_EQ(make({swapped, values0, 2}, {rows1, values1, 1}), nullptr);   // diagonal not first
-  EXPECT_EQ(make({rows0, values0, 2}, {rows1, negative, 1}), nullptr);    // non-positive pivot
-  EXPECT_EQ(make({rows0, values0, 2}, {rows0, values0, 2}), nullptr);     // column 1 starts at row 0
-  EXPECT_EQ(make({rows0, values0, 0}, {rows1, values1, 1}), nullptr);     // empty column
+  EXPECT_EQ(make({swapped, values0, 2}, {rows1, values1, 1}), nullptr);  // diagonal not first
+  EXPECT_EQ(make({rows0, values0, 2}, {rows1, negative, 1}), nullptr);   // non-positive pivot
+  EXPECT_EQ(make({rows0, values0, 2}, {rows0, values0, 2}), nullptr);    // column 1 starts at row 0
+  EXPECT_EQ(make({rows0, values0, 0}, {rows1, values1, 1}), nullptr);    // empty column
 }
 
 }  // namespace

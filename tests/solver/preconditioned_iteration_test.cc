@@ -147,8 +147,8 @@ TEST(PreconditionedIterationTest, AZeroColumnConvergesAtOnceAndCostsNoSolve) {
   MatrixXd z;
   std::vector<char> ok;
   int iterations = 0, calls = 0;
-  SolvePreconditioned(Options(PdBackwardMethod::kConjugateGradient), b, s.apply(), s.precondition(&calls), &z,
-                      &ok, &iterations);
+  SolvePreconditioned(Options(PdBackwardMethod::kConjugateGradient), b, s.apply(), s.precondition(&calls), &z, &ok,
+                      &iterations);
   EXPECT_TRUE(ok[0]);
   EXPECT_TRUE(ok[1]);
   EXPECT_EQ(z.col(0).norm(), 0.0);

@@ -66,8 +66,7 @@ TEST_P(RegionMaterialsTest, RegionsEqualToTheBaseMaterialChangeNothing) {
               1e-10 * std::abs(ga.youngs_modulus));
   EXPECT_NEAR(sum(&RolloutGradient::poissons_ratio, &MaterialComponents::poissons_ratio), ga.poissons_ratio,
               1e-10 * std::abs(ga.poissons_ratio));
-  EXPECT_NEAR(sum(&RolloutGradient::density, &MaterialComponents::density), ga.density,
-              1e-10 * std::abs(ga.density));
+  EXPECT_NEAR(sum(&RolloutGradient::density, &MaterialComponents::density), ga.density, 1e-10 * std::abs(ga.density));
 }
 
 TEST_P(RegionMaterialsTest, ARegionCoveringEveryElementActsAsTheSceneMaterial) {
@@ -171,8 +170,7 @@ struct Case {
 };
 
 std::string CaseName(const ::testing::TestParamInfo<Case>& info) {
-  return MethodName(info.param.method) + (info.param.tets ? "_tet" : "_hex") +
-         (info.param.damping ? "_damped" : "");
+  return MethodName(info.param.method) + (info.param.tets ? "_tet" : "_hex") + (info.param.damping ? "_damped" : "");
 }
 
 class RegionDerivativeTest : public ::testing::TestWithParam<Case> {};
@@ -304,9 +302,9 @@ TEST(RegionMaterialsTest, SetRegionMaterialValidatesAndRolloutsRecordTheRegions)
   EXPECT_EQ(message(-1, MaterialParameters()), "SetRegionMaterial: region -1 is out of range [0, 2)");
   MaterialParameters bad;
   bad.youngs_modulus = -1;
-  EXPECT_EQ(message(0, bad), "SetRegionMaterial: region 0: youngs_modulus = -1 is invalid: must be finite and > 0 (Pa)");
-  EXPECT_EQ(sim.scene().material_regions[0].material.youngs_modulus,
-            scene.material_regions[0].material.youngs_modulus);
+  EXPECT_EQ(message(0, bad),
+            "SetRegionMaterial: region 0: youngs_modulus = -1 is invalid: must be finite and > 0 (Pa)");
+  EXPECT_EQ(sim.scene().material_regions[0].material.youngs_modulus, scene.material_regions[0].material.youngs_modulus);
   const Rollout r = sim.Simulate(sim.RestState(), std::vector<StepInput>(2));
   ASSERT_EQ(r.region_materials.size(), 2u);
   EXPECT_EQ(r.region_materials[1].density, scene.material_regions[1].material.density);

@@ -143,8 +143,7 @@ TEST(RigidModeCorrectionTest, FrameIndifferenceProductsEqualTheExactHessianProdu
     internal::StepLinearization exact(sim, x);
     for (int k = 0; k < RigidModeCorrection::kModes; ++k) {
       const VectorXd reference = exact.Apply(rigid.modes().col(k));
-      EXPECT_LT((h.col(k) - reference).norm(), 1e-9 * reference.norm())
-          << (tets ? "tets" : "hexes") << ", mode " << k;
+      EXPECT_LT((h.col(k) - reference).norm(), 1e-9 * reference.norm()) << (tets ? "tets" : "hexes") << ", mode " << k;
     }
   }
 }

@@ -87,8 +87,10 @@ nlohmann::json Measure(const Grid& grid) {
 int Main(int argc, char** argv) {
   bool large = false, json = false;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--large")) large = true;
-    else if (!std::strcmp(argv[i], "--json")) json = true;
+    if (!std::strcmp(argv[i], "--large"))
+      large = true;
+    else if (!std::strcmp(argv[i], "--json"))
+      json = true;
     else {
       std::fprintf(stderr, "usage: solve_benchmark [--large] [--json]\n");
       return 2;
@@ -104,8 +106,8 @@ int Main(int argc, char** argv) {
     const nlohmann::json row = Measure(g);
     rows.push_back(row);
     if (!json)
-      std::printf("%-4s %8d %11.0f %10.3f %10.3f %10.3f %10.2f %8.3f %7.3f %9.3f %9.1f\n", g.name, row["nodes"].get<int>(),
-                  row["factor_entries"].get<double>(), row["cholmod_ms"].get<double>(),
+      std::printf("%-4s %8d %11.0f %10.3f %10.3f %10.3f %10.2f %8.3f %7.3f %9.3f %9.1f\n", g.name,
+                  row["nodes"].get<int>(), row["factor_entries"].get<double>(), row["cholmod_ms"].get<double>(),
                   row["copy_1_thread_ms"].get<double>(), row["copy_2_threads_ms"].get<double>(),
                   row["speedup_2_threads"].get<double>(), row["serial_fraction"].get<double>(),
                   row["factorization_s"].get<double>(), row["factorization_and_copy_s"].get<double>(),
@@ -113,8 +115,11 @@ int Main(int argc, char** argv) {
   }
   rusage usage;
   getrusage(RUSAGE_SELF, &usage);
-  if (json) std::cout << rows.dump(1) << "\n";
-  else std::printf("peak RSS %.0f MiB (three factors of the largest grid and a copy each of two)\n", usage.ru_maxrss / 1024.0);
+  if (json)
+    std::cout << rows.dump(1) << "\n";
+  else
+    std::printf("peak RSS %.0f MiB (three factors of the largest grid and a copy each of two)\n",
+                usage.ru_maxrss / 1024.0);
   return 0;
 }
 

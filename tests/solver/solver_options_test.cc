@@ -27,8 +27,7 @@ TEST(SolverOptionsTest, InvalidFieldsAreRejectedWithTheFieldAndRange) {
   EXPECT_EQ(MessageOf([&] { o.Validate(); }), "solver options: time_step = 0 is invalid: must be finite and > 0 (s)");
   o = SolverOptions();
   o.time_step = NAN;
-  EXPECT_EQ(MessageOf([&] { o.Validate(); }),
-            "solver options: time_step = nan is invalid: must be finite and > 0 (s)");
+  EXPECT_EQ(MessageOf([&] { o.Validate(); }), "solver options: time_step = nan is invalid: must be finite and > 0 (s)");
   o = SolverOptions();
   o.rel_tolerance = 1.5;
   EXPECT_EQ(MessageOf([&] { o.Validate(); }), "solver options: rel_tolerance = 1.5 is invalid: must be in [0, 1)");
@@ -52,8 +51,8 @@ TEST(SolverOptionsTest, InvalidFieldsAreRejectedWithTheFieldAndRange) {
 }
 
 TEST(SolverOptionsTest, MethodNamesRoundTripAndUnknownNamesAreListed) {
-  for (const Method m : {Method::kSemiImplicit, Method::kNewtonCholesky, Method::kNewtonPcg, Method::kPd,
-                         Method::kPdLbfgs})
+  for (const Method m :
+       {Method::kSemiImplicit, Method::kNewtonCholesky, Method::kNewtonPcg, Method::kPd, Method::kPdLbfgs})
     EXPECT_EQ(ParseMethod(ToString(m)), m);
   EXPECT_EQ(MessageOf([] { ParseMethod("newton"); }),
             "unknown method 'newton': valid methods are semi-implicit, newton-cholesky, newton-pcg, pd, pd-lbfgs");
@@ -68,7 +67,8 @@ TEST(SolverOptionsTest, BadScenesAndInputsAreRejected) {
   scene.dirichlet.dofs.push_back(1000000);
   scene.dirichlet.values.conservativeResize(scene.dirichlet.values.size() + 1);
   scene.dirichlet.values(scene.dirichlet.values.size() - 1) = 0;
-  EXPECT_EQ(MessageOf([&] { Simulator(scene, SolverOptions()); }), "scene: Dirichlet DoF 1000000 is out of range [0, 135)");
+  EXPECT_EQ(MessageOf([&] { Simulator(scene, SolverOptions()); }),
+            "scene: Dirichlet DoF 1000000 is out of range [0, 135)");
   scene = testing::SmallBeamScene();
   scene.material.poissons_ratio = 0.5;
   EXPECT_EQ(MessageOf([&] { Simulator(scene, SolverOptions()); }),
@@ -77,8 +77,7 @@ TEST(SolverOptionsTest, BadScenesAndInputsAreRejected) {
   Simulator sim(testing::SmallBeamScene(), SolverOptions());
   State s = sim.RestState();
   s.v.resize(3);
-  EXPECT_EQ(MessageOf([&] { sim.Step(s, StepInput()); }),
-            "state.v has 3 entries, expected 135 (3 x number of nodes)");
+  EXPECT_EQ(MessageOf([&] { sim.Step(s, StepInput()); }), "state.v has 3 entries, expected 135 (3 x number of nodes)");
   s = sim.RestState();
   s.x(4) = NAN;
   EXPECT_EQ(MessageOf([&] { sim.Step(s, StepInput()); }), "state.x has a non-finite entry");

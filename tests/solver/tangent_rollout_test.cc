@@ -23,7 +23,6 @@ struct Case {
   bool tets;
 };
 
-
 // Directions: E, nu, rho (scaled to the parameter), x0, v0, forces, and a mix.
 std::vector<InputDirection> TestDirections(const Scene& scene, int n, int steps) {
   std::mt19937_64 rng(7);
@@ -137,8 +136,7 @@ TEST_P(TangentReverseModeTest, AgreesWithReverseModeOnRandomLinearLosses) {
     double forward = 0;
     for (int k = 0; k <= steps; ++k) forward += loss.dx[k].dot(t.dx[k].col(p)) + loss.dv[k].dot(t.dv[k].col(p));
     const InputDirection& d = dirs[p];
-    double reverse = g.youngs_modulus * d.youngs_modulus + g.poissons_ratio * d.poissons_ratio +
-                     g.density * d.density;
+    double reverse = g.youngs_modulus * d.youngs_modulus + g.poissons_ratio * d.poissons_ratio + g.density * d.density;
     if (d.x0.size()) reverse += g.x0.dot(d.x0);
     if (d.v0.size()) reverse += g.v0.dot(d.v0);
     for (int k = 0; k < steps && !d.external_force.empty(); ++k)
@@ -230,9 +228,8 @@ TEST(TangentRolloutTest, RejectsBadDirectionsWithMessages) {
   EXPECT_EQ(message({}), "Tangents: no direction given (need at least one)");
   InputDirection bad;
   bad.x0 = VectorXd::Ones(5);
-  EXPECT_EQ(message({InputDirection::Density(), bad}),
-            "Tangents: direction 1 has x0 with 5 entries, expected " + std::to_string(sim.num_dofs()) +
-                " (3 x number of nodes)");
+  EXPECT_EQ(message({InputDirection::Density(), bad}), "Tangents: direction 1 has x0 with 5 entries, expected " +
+                                                           std::to_string(sim.num_dofs()) + " (3 x number of nodes)");
   InputDirection forces;
   forces.external_force.resize(3);
   EXPECT_EQ(message({forces}), "Tangents: direction 0 has external_force for 3 steps, expected 0 or 2");
@@ -324,7 +321,8 @@ TEST(TangentRolloutTest, ActivationTangentsMatchFiniteDifferences) {
     for (int k = 0; k < k_steps; ++k) inputs[k].activation = VectorXd::Constant(1, 0.9 - 0.01 * k);
     const Rollout rollout = sim.Simulate(MovingStart(sim), inputs);
     InputDirection d;
-    for (int k = 0; k < k_steps; ++k) d.activation.push_back(k == 1 ? VectorXd() : VectorXd::Constant(1, 0.5 + 0.1 * k));
+    for (int k = 0; k < k_steps; ++k)
+      d.activation.push_back(k == 1 ? VectorXd() : VectorXd::Constant(1, 0.5 + 0.1 * k));
     const TangentRollout t = sim.Tangents(rollout, {d, InputDirection::PoissonsRatio()});
     const double eps = 1e-6;
     std::vector<StepInput> plus = inputs, minus = inputs;

@@ -70,7 +70,8 @@ TEST(CapturedMotionTest, WriteThenReadRoundTripsExactly) {
 
 TEST(CapturedMotionTest, AcceptsSpacesBlankLinesAndInterleavedMarkers) {
   const CapturedMotion m = ReadCapturedMotion(WriteText(
-      "ok.csv", std::string(kMarkers) + "\n time , marker , x , y , z \n0, 1, 1, 2, 3\n0, 0, 1, 2, 3\n\n0.5,0,1,2,3\n"));
+      "ok.csv",
+      std::string(kMarkers) + "\n time , marker , x , y , z \n0, 1, 1, 2, 3\n0, 0, 1, 2, 3\n\n0.5,0,1,2,3\n"));
   EXPECT_EQ(m.samples.size(), 3u);
   EXPECT_EQ(m.samples[2].weight, Vec3::Ones());
 }

@@ -86,7 +86,9 @@ TEST(CalibrateStarfishTest, RejectsMalformedFilesNamingFileAndLine) {
   const StarfishWindow w = MakeStarfishWindow(r, 0, 10);
   EXPECT_EQ(w.first, 0);
   EXPECT_EQ(w.last, 1);
-  EXPECT_EQ(w.note, p + ":4: tendon contraction is NaN from t = 0.033 s; the window stops before it (0.0165 s instead of 10 s)");
+  EXPECT_EQ(
+      w.note,
+      p + ":4: tendon contraction is NaN from t = 0.033 s; the window stops before it (0.0165 s instead of 10 s)");
   try {
     MakeStarfishWindow(r, 0.03, 1);
     ADD_FAILURE() << "no error";
@@ -133,8 +135,8 @@ TEST_F(StarfishSceneTest, CentralColumnHasYAndZFixedAndXFree) {
 
 TEST_F(StarfishSceneTest, MarkersAreAtTheFactSheetsRestPositions) {
   const std::array<int, 4> v = StarfishCalibration::MarkerVertices(scene_->mesh);
-  const Vec3 expected[4] = {{-0.52, -4.50, -69.64}, {-0.19, -10.63, -39.18}, {-0.19, -13.27, 34.80},
-                            {-0.63, -4.50, 65.26}};
+  const Vec3 expected[4] = {
+      {-0.52, -4.50, -69.64}, {-0.19, -10.63, -39.18}, {-0.19, -13.27, 34.80}, {-0.63, -4.50, 65.26}};
   for (int m = 0; m < 4; ++m)
     EXPECT_LT((scene_->mesh.vertices.col(v[m]) - 1e-3 * expected[m]).norm(), 1e-3) << "M" << m + 1;
 }
@@ -190,8 +192,12 @@ TEST(StarfishActivationsTest, SlackLagAndLengthShapeTheActivation) {
   double largest[3] = {0, 0, 0};
   for (int j = 0; j < 3; ++j) {
     StarfishActuation plus = at, minus = at;
-    double* p[2] = {j == 0 ? &plus.slack : j == 1 ? &plus.lag : &plus.length,
-                    j == 0 ? &minus.slack : j == 1 ? &minus.lag : &minus.length};
+    double* p[2] = {j == 0   ? &plus.slack
+                    : j == 1 ? &plus.lag
+                             : &plus.length,
+                    j == 0   ? &minus.slack
+                    : j == 1 ? &minus.lag
+                             : &minus.length};
     *p[0] += e;
     *p[1] -= e;
     const std::vector<double> ap = StarfishActivations(c, h, plus, nullptr);

@@ -92,8 +92,8 @@ inline solvers::CalibrationSetup SyntheticSetupFromScene(const Scene& truth_scen
   markers.push_back(Marker{0, far, -1, Vec3::Zero(), 0});
   markers.push_back(Marker{1, far - 1, -1, Vec3::Zero(), 0});
   markers.push_back(Marker{5, scene.mesh.num_vertices() / 2, -1, Vec3::Zero(), 0});
-  markers.push_back(Marker{7, -1, scene.mesh.num_elements() - 1,
-                           tets ? Vec3(0.2, 0.3, 0.1) : Vec3(0.5, -0.25, 0.75), 0});
+  markers.push_back(
+      Marker{7, -1, scene.mesh.num_elements() - 1, tets ? Vec3(0.2, 0.3, 0.1) : Vec3(0.5, -0.25, 0.75), 0});
   std::vector<double> times;
   for (double t = 0.015; t <= steps * 0.01 + 1e-12; t += 0.015) times.push_back(t);
   solvers::CalibrationSetup setup;

@@ -75,16 +75,16 @@ TEST_P(MarkerCostFunctionCheckTest, GradientCheckerAcceptsRandomParameterValues)
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    MethodsAndModes, MarkerCostFunctionCheckTest,
-    ::testing::Values(CheckCase{Method::kNewtonCholesky, false, JacobianMode::kForward, true},
-                      CheckCase{Method::kNewtonCholesky, true, JacobianMode::kReverse, true},
-                      CheckCase{Method::kNewtonCholesky, true, JacobianMode::kForward, false},
-                      CheckCase{Method::kPd, true, JacobianMode::kForward, false}),
-    CheckCaseName);
+INSTANTIATE_TEST_SUITE_P(MethodsAndModes, MarkerCostFunctionCheckTest,
+                         ::testing::Values(CheckCase{Method::kNewtonCholesky, false, JacobianMode::kForward, true},
+                                           CheckCase{Method::kNewtonCholesky, true, JacobianMode::kReverse, true},
+                                           CheckCase{Method::kNewtonCholesky, true, JacobianMode::kForward, false},
+                                           CheckCase{Method::kPd, true, JacobianMode::kForward, false}),
+                         CheckCaseName);
 
 TEST(MarkerCostFunctionTest, HonoursUnwantedJacobiansAndRowMajorBlocks) {
-  CalibrationSetup setup = testing::SyntheticSetup(Method::kNewtonCholesky, true, MaterialParameters{1.5e5, 0.35, 1e3}, 4);
+  CalibrationSetup setup =
+      testing::SyntheticSetup(Method::kNewtonCholesky, true, MaterialParameters{1.5e5, 0.35, 1e3}, 4);
   setup.input_parameters = std::make_shared<LinearInputParameters>(
       LinearInputParameters::UniformInitialVelocity(setup.scene.mesh.num_vertices()));
   CalibrationModel model(setup);

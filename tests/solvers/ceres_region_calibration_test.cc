@@ -24,9 +24,8 @@ namespace {
 CalibrationSetup ThreePartSetup(Method method, bool tets, JacobianMode mode) {
   CalibrationSetup setup = testing::SyntheticSetupFromScene(testing::TwoRegionBeamScene(tets), method, 6);
   setup.fitted = {MaterialParameter::kYoungsModulus, MaterialParameter::kPoissonsRatio};
-  setup.fitted_regions = {{0, MaterialParameter::kYoungsModulus},
-                          {0, MaterialParameter::kPoissonsRatio},
-                          {1, MaterialParameter::kDensity}};
+  setup.fitted_regions = {
+      {0, MaterialParameter::kYoungsModulus}, {0, MaterialParameter::kPoissonsRatio}, {1, MaterialParameter::kDensity}};
   setup.jacobian = mode;
   return setup;
 }
@@ -66,8 +65,8 @@ TEST_P(RegionCostFunctionCheckTest, GradientCheckerAcceptsRandomRegionParameters
   // here) as a relative error of ~1e-6 for PD-LBFGS (measured 1.8e-6 on
   // d r_3 / d nu, the others below 3e-7); a wrong derivative errs by O(1).
   const double precision = c.method == Method::kPd ? 5e-5 : c.method == Method::kPdLbfgs ? 1e-5 : 1e-6;
-  std::vector<double> material = {1e5 + 3e5 * u(rng), 0.25 + 0.2 * u(rng), 2e4 + 8e4 * u(rng),
-                                  0.25 + 0.2 * u(rng), 600 + 800 * u(rng)};
+  std::vector<double> material = {1e5 + 3e5 * u(rng), 0.25 + 0.2 * u(rng), 2e4 + 8e4 * u(rng), 0.25 + 0.2 * u(rng),
+                                  600 + 800 * u(rng)};
   double* blocks[1] = {material.data()};
   ceres::GradientChecker::ProbeResults results;
   EXPECT_TRUE(checker.Probe(blocks, precision, &results))
@@ -150,7 +149,8 @@ TEST(RegionCalibrationTest, RejectsInvalidRegionParametersWithMessages) {
   EXPECT_EQ(message(s), "fitted_regions[1]: region 2 is out of range [0, 2)");
   s.fitted_regions = {{-1, MaterialParameter::kDensity}};
   EXPECT_EQ(message(s), "fitted_regions[0]: region -1 is out of range [0, 2)");
-  s.fitted_regions = {{1, MaterialParameter::kYoungsModulus}, {0, MaterialParameter::kYoungsModulus},
+  s.fitted_regions = {{1, MaterialParameter::kYoungsModulus},
+                      {0, MaterialParameter::kYoungsModulus},
                       {1, MaterialParameter::kYoungsModulus}};
   EXPECT_EQ(message(s), "fitted_regions lists youngs_modulus of region 1 twice");
   s.fitted.clear();

@@ -78,7 +78,8 @@ TEST(RolloutLossFunctionTest, CustomLossOfTheFinalStateMatchesFiniteDifferences)
 TEST(RolloutLossFunctionTest, GradientProblemRecoversTheTrueMaterial) {
   // Residuals in metres (unit weights): line searches start with a step of
   // the gradient's size, so the loss should be O(1) or smaller.
-  CalibrationSetup setup = testing::SyntheticSetup(Method::kNewtonCholesky, false, MaterialParameters{1.4e5, 0.33, 1e3});
+  CalibrationSetup setup =
+      testing::SyntheticSetup(Method::kNewtonCholesky, false, MaterialParameters{1.4e5, 0.33, 1e3});
   for (MarkerSample& s : setup.motion.samples) s.weight = Vec3::Ones();
   CalibrationModel model(setup);
   double x[2];
@@ -105,9 +106,8 @@ TEST(RolloutLossFunctionTest, ReturnsFalseOnAFailingRollout) {
   EXPECT_EQ(model.statistics().last_error,
             "rollout rejected: poissons_ratio = 0.7 is invalid: must be finite and in (-1, 0.5)");
   // A loss that throws is reported, not propagated.
-  RolloutLossFunction throwing(&model, [](const Rollout&, LossGradient*) -> double {
-    throw SolverError(SolverStatus::kNonFinite, "bad loss");
-  });
+  RolloutLossFunction throwing(
+      &model, [](const Rollout&, LossGradient*) -> double { throw SolverError(SolverStatus::kNonFinite, "bad loss"); });
   x[1] = 0.4;
   EXPECT_FALSE(throwing.Evaluate(x, &cost, grad));
   EXPECT_EQ(model.statistics().last_error, "loss gradient failed (non-finite value): bad loss");

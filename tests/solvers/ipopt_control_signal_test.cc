@@ -51,7 +51,8 @@ TEST(ControlSignalTest, FourierSeriesHasTheStatedBasis) {
   s.Evaluate(c, &v, &jac);
   for (int k = 0; k < 10; ++k) {
     const double w = 2 * M_PI * k * h / period;
-    const double expected = 0.5 + 0.1 * std::sin(w) - 0.2 * std::cos(w) + 0.3 * std::sin(2 * w) + 0.05 * std::cos(2 * w);
+    const double expected =
+        0.5 + 0.1 * std::sin(w) - 0.2 * std::cos(w) + 0.3 * std::sin(2 * w) + 0.05 * std::cos(2 * w);
     EXPECT_NEAR(v(k), expected, 1e-15);
   }
   EXPECT_EQ(jac, s.basis());

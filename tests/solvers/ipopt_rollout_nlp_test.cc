@@ -63,7 +63,7 @@ TEST(RolloutNlpTest, BoundsAndStartingPointComeFromTheBlocksAndConstraints) {
   EXPECT_EQ(xl[p.force_offset], -0.5);
   EXPECT_EQ(xu[p.force_offset + 9], 0.5);
   EXPECT_EQ(xu[p.force_offset + 10], M_PI);  // the sinusoid's phase
-  EXPECT_LE(xl[p.velocity_offset], -1e19);  // unbounded: beyond Ipopt's infinity
+  EXPECT_LE(xl[p.velocity_offset], -1e19);   // unbounded: beyond Ipopt's infinity
   EXPECT_GE(xu[p.velocity_offset], 1e19);
   EXPECT_EQ(xl[p.material_offset], 0.5);
   EXPECT_EQ(xu[p.material_offset + 1], 5.0);
@@ -244,7 +244,8 @@ TEST(RolloutNlpTest, FailedRolloutMakesEveryEvaluationReturnFalseAndRecovers) {
   channels[0] = {tip, Vec3::UnitZ(), std::make_unique<solvers::PerStepSignal>(3)};
   nlp.AddVariables(std::make_unique<solvers::ExternalForceControl>(std::move(channels)));
   const int n3 = sim.num_dofs() / 3;
-  nlp.AddObjective(std::make_unique<solvers::PointCoordinate>(solvers::Marker(n3, tip[0]), solvers::kFinalState, Vec3::UnitZ()));
+  nlp.AddObjective(
+      std::make_unique<solvers::PointCoordinate>(solvers::Marker(n3, tip[0]), solvers::kFinalState, Vec3::UnitZ()));
   nlp.AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(n3, tip[0]), 1, Vec3::UnitZ()), -1, 1);
   const int n = nlp.num_variables(), m = nlp.num_constraints();
   Ipopt::Index nn, mm, nnz, nnz_h;
@@ -259,7 +260,8 @@ TEST(RolloutNlpTest, FailedRolloutMakesEveryEvaluationReturnFalseAndRecovers) {
   EXPECT_FALSE(nlp.eval_jac_g(n, bad.data(), false, m, nnz, nullptr, nullptr, jac.data()));
   EXPECT_EQ(nlp.statistics().rollouts, 1);
   EXPECT_EQ(nlp.statistics().failed_rollouts, 1);
-  EXPECT_NE(nlp.last_error().find("rollout: solver failed (maximum number of iterations reached)"), std::string::npos) << nlp.last_error();
+  EXPECT_NE(nlp.last_error().find("rollout: solver failed (maximum number of iterations reached)"), std::string::npos)
+      << nlp.last_error();
   EXPECT_TRUE(std::isinf(nlp.ConstraintViolation(bad)));
   const VectorXd good = VectorXd::Zero(n);
   EXPECT_TRUE(nlp.eval_f(n, good.data(), true, f));
@@ -305,7 +307,8 @@ TEST(RolloutNlpTest, AutoModeChoosesForwardForFewVariablesAndManyConstraints) {
     nlp->AddVariables(std::make_unique<solvers::InitialStateVariables>(solvers::InitialStateVariables::kVelocity, tip));
     const int n = sim->scene().mesh.num_vertices();
     for (int k = 1; k <= 4; ++k)
-      nlp->AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(n, tip[0]), k, Vec3::UnitZ()), -1, 1);
+      nlp->AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(n, tip[0]), k, Vec3::UnitZ()), -1,
+                         1);
     return nlp;
   };
   Simulator sim_a(SmallBeamScene(), TightNewton()), sim_b(SmallBeamScene(), TightNewton());
@@ -354,7 +357,8 @@ struct MuscleBeam {
     const std::vector<int> tip = NodesAtXMax(scene.mesh);
     const int n = scene.mesh.num_vertices();
     nlp->AddObjective(std::make_unique<solvers::PointDistanceSquared>(
-        solvers::MeanOf(n, tip), solvers::kFinalState, solvers::MeanOf(n, tip).At(sim->RestState().x) - Vec3(0.01, 0, 0.01)));
+        solvers::MeanOf(n, tip), solvers::kFinalState,
+        solvers::MeanOf(n, tip).At(sim->RestState().x) - Vec3(0.01, 0, 0.01)));
     nlp->AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(n, tip[0]), 2, Vec3::UnitX()), -1, 1);
   }
 };
@@ -464,8 +468,8 @@ TEST(RolloutNlpTest, BadInputIsRefusedWithAMessage) {
     EXPECT_STREQ(e.what(), "initial_velocity: node 1000 is out of range: the mesh has 45 nodes");
   }
   try {
-    nlp.AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(45, 0), 7, Vec3::UnitZ(), "late"),
-                      0, 1);
+    nlp.AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(45, 0), 7, Vec3::UnitZ(), "late"), 0,
+                      1);
     FAIL() << "no throw";
   } catch (const InvalidInputError& e) {
     EXPECT_STREQ(e.what(), "RolloutNlp: constraint 'late' reads state 7, outside the rollout's states [0, 4]");

@@ -175,9 +175,9 @@ TEST(IpoptSolveTest, FailedRolloutsMakeIpoptCutItsStep) {
   channels[0] = {tip, Vec3::UnitZ(), std::make_unique<PiecewiseLinearSignal>(4, 2)};
   nlp->AddVariables(std::make_unique<ExternalForceControl>(std::move(channels)));
   const TrackedPoint marker = Marker(scene.mesh.num_vertices(), tip[0]);
-  nlp->AddObjective(std::make_unique<PointDistanceSquared>(marker, kFinalState,
-                                                           marker.At(sim.RestState().x) + Vec3(0, 0, 0.002)),
-                    1e7);
+  nlp->AddObjective(
+      std::make_unique<PointDistanceSquared>(marker, kFinalState, marker.At(sim.RestState().x) + Vec3(0, 0, 0.002)),
+      1e7);
   IpoptOptions o;
   o.int_options = {{"max_iter", 100}};
   const IpoptSummary s = SolveWithIpopt(nlp, o);

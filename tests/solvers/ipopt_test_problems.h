@@ -92,9 +92,8 @@ struct BeamNlp {
     velocity->SetInitial(Vec3(0.01, -0.02, 0.05));
     velocity_offset = nlp->AddVariables(std::move(velocity));
 
-    auto position = std::make_unique<InitialStateVariables>(InitialStateVariables::kPosition,
-                                                            std::vector<int>{tip[0], tip[1]},
-                                                            InitialStateVariables::kPerNode);
+    auto position = std::make_unique<InitialStateVariables>(
+        InitialStateVariables::kPosition, std::vector<int>{tip[0], tip[1]}, InitialStateVariables::kPerNode);
     VectorXd p0(6);
     p0 << 1e-3, 0, -2e-3, 0, 1e-3, 5e-4;
     position->SetInitial(p0);
@@ -108,14 +107,14 @@ struct BeamNlp {
     material_offset = nlp->AddVariables(std::move(material));
 
     const TrackedPoint marker = Marker(n, tip.back());
-    nlp->AddObjective(std::make_unique<PointDistanceSquared>(marker, kFinalState, marker.At(sim->RestState().x) +
-                                                                                    Vec3(0.0, 0.01, 0.02)),
+    nlp->AddObjective(std::make_unique<PointDistanceSquared>(marker, kFinalState,
+                                                             marker.At(sim->RestState().x) + Vec3(0.0, 0.01, 0.02)),
                       1e3);
     nlp->AddRegularization(force_offset, num_force_variables, 1e-2);
     nlp->AddConstraint(std::make_unique<PointCoordinate>(marker, 2, Vec3::UnitZ(), "tip_z_at_2"), -1.0, 1.0);
-    nlp->AddConstraint(std::make_unique<AxisAlignment>(MeanOf(n, NodesAtXMin(mesh)), MeanOf(n, tip), kFinalState,
-                                                       Vec3(0.1, 0.0, 1.0)),
-                       -1.0, 1.0);
+    nlp->AddConstraint(
+        std::make_unique<AxisAlignment>(MeanOf(n, NodesAtXMin(mesh)), MeanOf(n, tip), kFinalState, Vec3(0.1, 0.0, 1.0)),
+        -1.0, 1.0);
     nlp->AddConstraint(std::make_unique<PointTravel>(CentreOfMass(sim->LumpedMass()), 0, kFinalState, Vec3::UnitX()),
                        -0.1, 0.1);
     LinearConstraint row;

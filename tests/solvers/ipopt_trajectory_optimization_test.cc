@@ -70,9 +70,8 @@ class CubeThrow : public TrajectoryOptimizationProblem {
     nlp->AddVariables(std::move(v0));
     const TrackedPoint com = CentreOfMass(sim->LumpedMass());
     const Vec3 c0 = com.At(sim->RestState().x);
-    nlp->AddObjective(std::make_unique<PointDistanceSquared>(com, kFinalState, c0 + Vec3(0.02, 0, 0), "travel",
-                                                             Vec3(1, 1, 0)),
-                      1e4);
+    nlp->AddObjective(
+        std::make_unique<PointDistanceSquared>(com, kFinalState, c0 + Vec3(0.02, 0, 0), "travel", Vec3(1, 1, 0)), 1e4);
     nlp->AddConstraint(std::make_unique<PointCoordinate>(com, kFinalState, Vec3::UnitZ(), "rise"), c0.z() + rise_,
                        1e20);
     return nlp;
@@ -120,7 +119,8 @@ TEST(IpoptTrajectoryOptimizationTest, PdRunIsRepeatedWithNewtonAndTheTimeRatioIs
   const auto& newton = report.runs[1].summary;
   EXPECT_NEAR(pd.initial_objective, newton.initial_objective, 1e-4 * newton.initial_objective);
   EXPECT_NEAR(pd.objective, newton.objective, 1e-4 * newton.initial_objective);
-  const double expected = (newton.forward_seconds + newton.backward_seconds) / (pd.forward_seconds + pd.backward_seconds);
+  const double expected =
+      (newton.forward_seconds + newton.backward_seconds) / (pd.forward_seconds + pd.backward_seconds);
   EXPECT_DOUBLE_EQ(report.newton_time_ratio, expected);
 
   const nlohmann::json j = ReportJson(report);
@@ -164,8 +164,8 @@ TEST(IpoptTrajectoryOptimizationTest, RunWritesFramesHistoriesPlotAndOneJsonObje
   EXPECT_EQ(code, 0) << err;
   // stdout is exactly one JSON object with the listed keys; the log and table on stderr.
   const nlohmann::json j = nlohmann::json::parse(out);
-  for (const char* key : {"status", "objective", "initial_objective", "constraint_violation", "evaluations",
-                          "forward_s", "backward_s"}) {
+  for (const char* key :
+       {"status", "objective", "initial_objective", "constraint_violation", "evaluations", "forward_s", "backward_s"}) {
     EXPECT_TRUE(j.contains(key)) << key;
     EXPECT_TRUE(j["newton_cholesky"].contains(key)) << key;
   }

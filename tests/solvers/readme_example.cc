@@ -30,8 +30,8 @@ int main(int argc, char** argv) {
   setup.scene.material = MaterialParameters{1e5, 0.45, 1e3};
   setup.solver.method = Method::kNewtonCholesky;  // h = 0.01 s by default
   setup.solver.rel_tolerance = 1e-9;
-  setup.motion = ReadCapturedMotion(argv[2]);     // markers and samples
-  solvers::CalibrationModel model(setup);         // fits {E, nu}; exact forward-mode Jacobian
+  setup.motion = ReadCapturedMotion(argv[2]);  // markers and samples
+  solvers::CalibrationModel model(setup);      // fits {E, nu}; exact forward-mode Jacobian
 
   double material[2];
   model.InitialMaterialBlock(material);
@@ -39,9 +39,9 @@ int main(int argc, char** argv) {
   ceres::Problem::Options problem_options;
   problem_options.evaluation_callback = &callback;
   ceres::Problem problem(problem_options);
-  solvers::AddMarkerResidualBlocks(&problem, &model, {material});    // one block per frame
-  problem.SetManifold(material, new solvers::CoordinateManifold(
-                                    {solvers::CoordinateMap::Log(), solvers::CoordinateMap::Linear()}));
+  solvers::AddMarkerResidualBlocks(&problem, &model, {material});  // one block per frame
+  problem.SetManifold(
+      material, new solvers::CoordinateManifold({solvers::CoordinateMap::Log(), solvers::CoordinateMap::Linear()}));
   problem.SetParameterLowerBound(material, 1, 0.01);  // Poisson's ratio in [0.01, 0.49]
   problem.SetParameterUpperBound(material, 1, 0.49);
 

@@ -22,7 +22,8 @@ namespace {
 void WriteBoxObj(const std::string& path) {
   std::ofstream out(path);
   const double l[3] = {0.08, 0.02, 0.02};
-  for (int i = 0; i < 8; ++i) out << "v " << (i & 4 ? l[0] : 0) << " " << (i & 2 ? l[1] : 0) << " " << (i & 1 ? l[2] : 0) << "\n";
+  for (int i = 0; i < 8; ++i)
+    out << "v " << (i & 4 ? l[0] : 0) << " " << (i & 2 ? l[1] : 0) << " " << (i & 1 ? l[2] : 0) << "\n";
   // Quads (1-based, counterclockwise seen from outside), fan-triangulated by ReadObj.
   out << "f 1 2 4 3\nf 5 7 8 6\nf 1 5 6 2\nf 3 4 8 7\nf 1 3 7 5\nf 2 6 8 4\n";
 }
@@ -51,8 +52,10 @@ TEST(ReadmeExampleTest, RecoversTheMaterialOfSyntheticCapturedMotion) {
   // Markers: the far corners and a point inside the last element.
   std::vector<Marker> markers;
   for (int i = 0; i < scene.mesh.num_vertices(); ++i)
-    if (scene.mesh.vertices(0, i) > 0.08 - 1e-6) markers.push_back(Marker{static_cast<int>(markers.size()), i, -1, Vec3::Zero(), 0});
-  markers.push_back(Marker{static_cast<int>(markers.size()), -1, scene.mesh.num_elements() - 1, Vec3(0.2, -0.3, 0.5), 0});
+    if (scene.mesh.vertices(0, i) > 0.08 - 1e-6)
+      markers.push_back(Marker{static_cast<int>(markers.size()), i, -1, Vec3::Zero(), 0});
+  markers.push_back(
+      Marker{static_cast<int>(markers.size()), -1, scene.mesh.num_elements() - 1, Vec3(0.2, -0.3, 0.5), 0});
   std::vector<double> times;
   for (int f = 1; f <= 10; ++f) times.push_back(0.024 * f);
   WriteCapturedMotion(csv, SampleMarkers(scene.mesh, truth.states, 0.01, markers, times), "readme example");

@@ -18,7 +18,6 @@ namespace diffpd {
 // size_x size_y size_z / (nx ny nz).
 // Throws InvalidInputError if a cell count is < 1, a size is not finite and
 // > 0, or the origin is not finite.
-Mesh MakeBoxHexMesh(const Eigen::Vector3i& cells, const Vec3& size,
-                    const Vec3& origin = Vec3::Zero());
+Mesh MakeBoxHexMesh(const Eigen::Vector3i& cells, const Vec3& size, const Vec3& origin = Vec3::Zero());
 
 }  // namespace diffpd

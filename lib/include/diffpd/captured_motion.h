@@ -39,20 +39,20 @@ namespace diffpd {
 
 // A point fixed in the material: a mesh vertex, or a point of an element.
 struct Marker {
-  int id = 0;       // >= 0, unique within a CapturedMotion
-  int vertex = -1;  // >= 0: the marker is this vertex (and element is -1)
-  int element = -1; // >= 0: the marker is the point `local` of this element
+  int id = 0;                 // >= 0, unique within a CapturedMotion
+  int vertex = -1;            // >= 0: the marker is this vertex (and element is -1)
+  int element = -1;           // >= 0: the marker is the point `local` of this element
   Vec3 local = Vec3::Zero();  // tet4 barycentric (b1, b2, b3) or hex8 (xi, eta, zeta)
-  int line = 0;     // line of the declaration in its file (0: not from a file)
+  int line = 0;               // line of the declaration in its file (0: not from a file)
 };
 
 // Where marker `marker` was at time `time`.
 struct MarkerSample {
-  double time = 0;                  // s, >= 0
-  int marker = 0;                   // a Marker::id
-  Vec3 position = Vec3::Zero();     // m
-  Vec3 weight = Vec3::Ones();       // per-axis residual weights, >= 0
-  int line = 0;                     // line in its file (0: not from a file)
+  double time = 0;               // s, >= 0
+  int marker = 0;                // a Marker::id
+  Vec3 position = Vec3::Zero();  // m
+  Vec3 weight = Vec3::Ones();    // per-axis residual weights, >= 0
+  int line = 0;                  // line in its file (0: not from a file)
 };
 
 struct CapturedMotion {
@@ -86,8 +86,8 @@ struct CapturedMotion {
 //   "m.csv:7: time = -0.1 is invalid: must be >= 0 (s)"
 //   "m.csv:7: wz = -1 is invalid: weights must be >= 0"
 //   "m.csv:7: unknown marker id 9 (declared ids: 0, 1)"
-//   "m.csv:9: time 0.1 of marker 0 is not after its previous sample at time 0.2 (line 8): times must increase strictly per marker"
-//   "m.csv: no marker declared", "m.csv: no samples"
+//   "m.csv:9: time 0.1 of marker 0 is not after its previous sample at time 0.2 (line 8): times must increase strictly
+//   per marker" "m.csv: no marker declared", "m.csv: no samples"
 CapturedMotion ReadCapturedMotion(const std::string& path);
 
 // Writes `motion` in the format above with 17 significant digits (exact
@@ -115,8 +115,8 @@ std::vector<std::pair<int, double>> MarkerStencil(const Marker& marker, const Me
 // Samples are ordered by time, then by marker. Throws what MarkerStencil and
 // MarkerObservations throw, and InvalidInputError for a negative noise.
 CapturedMotion SampleMarkers(const Mesh& mesh, const std::vector<State>& states, double time_step,
-                             const std::vector<Marker>& markers, const std::vector<double>& times,
-                             double noise = 0, unsigned long long seed = 0);
+                             const std::vector<Marker>& markers, const std::vector<double>& times, double noise = 0,
+                             unsigned long long seed = 0);
 
 // The linear map from a simulated trajectory x_0..x_K (step h) to the
 // positions of the captured samples: sample s at time t, with

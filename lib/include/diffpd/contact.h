@@ -92,9 +92,9 @@ namespace diffpd {
 // A fixed collision surface. The body stays on the side where gap(x) >= 0.
 struct ContactSurface {
   enum class Kind {
-    kPlane,       // n . x = offset; outside n . x > offset (n normalised)
-    kSphere,      // |x - center| = radius; the body stays outside the ball
-    kHeightField, // z = height(x, y); the body stays above (z > height)
+    kPlane,        // n . x = offset; outside n . x > offset (n normalised)
+    kSphere,       // |x - center| = radius; the body stays outside the ball
+    kHeightField,  // z = height(x, y); the body stays above (z > height)
   };
   Kind kind = Kind::kPlane;
   Vec3 normal = Vec3(0, 0, 1);  // plane: outward normal, finite, non-zero
@@ -127,8 +127,8 @@ struct ContactSurface {
 
 // How PD solves with the active set erased from the prefactorised A.
 enum class ContactLinearSolve {
-  kWoodbury,    // low-rank (Sherman-Morrison-Woodbury) update of A's factor
-  kRefactorize, // factorise A with the active rows and columns erased
+  kWoodbury,     // low-rank (Sherman-Morrison-Woodbury) update of A's factor
+  kRefactorize,  // factorise A with the active rows and columns erased
 };
 
 struct FrictionalContact {
@@ -149,11 +149,11 @@ struct FrictionalContactOptions {
 };
 
 struct PenaltyContact {
-  Vec3 normal = Vec3(0, 0, 1);   // outward normal of the allowed half-space, non-zero
-  double offset = 0;             // m: the half-space is n . x >= offset (n normalised)
-  std::vector<int> nodes;        // candidate nodes
-  double stiffness = 1e4;        // w, N/m, finite and > 0
-  double friction = 0;           // mu, finite and >= 0 (0: frictionless, no state force)
+  Vec3 normal = Vec3(0, 0, 1);      // outward normal of the allowed half-space, non-zero
+  double offset = 0;                // m: the half-space is n . x >= offset (n normalised)
+  std::vector<int> nodes;           // candidate nodes
+  double stiffness = 1e4;           // w, N/m, finite and > 0
+  double friction = 0;              // mu, finite and >= 0 (0: frictionless, no state force)
   double friction_velocity = 1e-2;  // eps, m/s, finite and > 0
 };
 

@@ -24,21 +24,20 @@ class InvalidInputError : public std::invalid_argument {
 // Why a numerical solve failed.
 enum class SolverStatus {
   kConverged = 0,
-  kMaxIterations,        // the iteration limit was reached before the tolerance
-  kLineSearchFailed,     // no step along the search direction decreased the objective
-  kNonFinite,            // a NaN or infinity appeared in the state or a residual
-  kFactorizationFailed,  // the (sparse) matrix was not positive definite
-  kInvertedElement,      // a material that cannot handle inversion met J <= 0
-  kDiverged,             // an iterative linear solve's residual grew or stagnated
-  kActiveSetNotConverged // the contact active-set loop did not settle
+  kMaxIterations,         // the iteration limit was reached before the tolerance
+  kLineSearchFailed,      // no step along the search direction decreased the objective
+  kNonFinite,             // a NaN or infinity appeared in the state or a residual
+  kFactorizationFailed,   // the (sparse) matrix was not positive definite
+  kInvertedElement,       // a material that cannot handle inversion met J <= 0
+  kDiverged,              // an iterative linear solve's residual grew or stagnated
+  kActiveSetNotConverged  // the contact active-set loop did not settle
 };
 
 const char* ToString(SolverStatus status);
 
 class SolverError : public std::runtime_error {
  public:
-  SolverError(SolverStatus status, const std::string& message)
-      : std::runtime_error(message), status_(status) {}
+  SolverError(SolverStatus status, const std::string& message) : std::runtime_error(message), status_(status) {}
   SolverStatus status() const { return status_; }
 
  private:
@@ -46,19 +45,17 @@ class SolverError : public std::runtime_error {
 };
 
 namespace internal {
-[[noreturn]] void CheckFailed(const char* file, int line, const char* condition,
-                              const std::string& message);
+[[noreturn]] void CheckFailed(const char* file, int line, const char* condition, const std::string& message);
 }  // namespace internal
 
 }  // namespace diffpd
 
 // Internal invariant check; always on, aborts with file, line and message.
-#define DIFFPD_CHECK(condition, message)                                        \
-  do {                                                                          \
-    if (!(condition)) {                                                         \
-      std::ostringstream diffpd_check_stream_;                                  \
-      diffpd_check_stream_ << message;                                          \
-      ::diffpd::internal::CheckFailed(__FILE__, __LINE__, #condition,           \
-                                      diffpd_check_stream_.str());              \
-    }                                                                           \
+#define DIFFPD_CHECK(condition, message)                                                           \
+  do {                                                                                             \
+    if (!(condition)) {                                                                            \
+      std::ostringstream diffpd_check_stream_;                                                     \
+      diffpd_check_stream_ << message;                                                             \
+      ::diffpd::internal::CheckFailed(__FILE__, __LINE__, #condition, diffpd_check_stream_.str()); \
+    }                                                                                              \
   } while (false)

@@ -15,9 +15,9 @@
 namespace diffpd {
 
 struct MaterialParameters {
-  double youngs_modulus = 1e6;  // E, Pa; must be finite and > 0
-  double poissons_ratio = 0.45; // nu, dimensionless; must lie in (-1, 0.5)
-  double density = 1e3;         // rho, kg/m^3; must be finite and > 0
+  double youngs_modulus = 1e6;   // E, Pa; must be finite and > 0
+  double poissons_ratio = 0.45;  // nu, dimensionless; must lie in (-1, 0.5)
+  double density = 1e3;          // rho, kg/m^3; must be finite and > 0
 
   // Throws InvalidInputError naming the parameter, its value and its range,
   // checking E, then nu, then rho; e.g.
@@ -32,8 +32,7 @@ struct MaterialParameters {
   //   1 / (2 (1 + nu)),  -E / (2 (1 + nu)^2),
   //   nu / ((1 + nu)(1 - 2 nu)),  E (1 + 2 nu^2) / ((1 + nu)(1 - 2 nu))^2.
   // Any output pointer may be nullptr (not wanted).
-  void LameDerivatives(double* dmu_dE, double* dmu_dnu, double* dlambda_dE,
-                       double* dlambda_dnu) const;
+  void LameDerivatives(double* dmu_dE, double* dmu_dnu, double* dlambda_dE, double* dlambda_dnu) const;
 };
 
 // One number per material parameter, in the parameters' units: a direction

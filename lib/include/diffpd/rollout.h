@@ -26,10 +26,10 @@ struct StepInput {
 
 // Outcome of one step.
 struct StepReport {
-  int iterations = 0;          // Newton / PD / L-BFGS iterations (0 for semi-implicit)
-  int line_search_steps = 0;   // total backtracking halvings
-  double initial_residual = 0; // ||grad g(x0)||
-  double final_residual = 0;   // ||grad g(x_{i+1})||
+  int iterations = 0;           // Newton / PD / L-BFGS iterations (0 for semi-implicit)
+  int line_search_steps = 0;    // total backtracking halvings
+  double initial_residual = 0;  // ||grad g(x0)||
+  double final_residual = 0;    // ||grad g(x_{i+1})||
   double seconds = 0;
   // Solves repeated from x_i because the first result's g was above g(x_i)
   // (SolverOptions::bound_step_energy): 0 or 1.
@@ -83,15 +83,15 @@ struct BackwardReport {
 
 // dL/d(input) for every differentiable input of a rollout.
 struct RolloutGradient {
-  VectorXd x0;                              // 3n
-  VectorXd v0;                              // 3n
-  std::vector<VectorXd> external_force;     // per step, 3n
-  std::vector<VectorXd> activation;         // per step, one per muscle (empty if none)
-  StateForceGradient state_forces;          // declared state-force parameters
+  VectorXd x0;                           // 3n
+  VectorXd v0;                           // 3n
+  std::vector<VectorXd> external_force;  // per step, 3n
+  std::vector<VectorXd> activation;      // per step, one per muscle (empty if none)
+  StateForceGradient state_forces;       // declared state-force parameters
   // The base material's parameters (Scene::material; elements in no region).
-  double youngs_modulus = 0;                // dL/dE, per Pa
-  double poissons_ratio = 0;                // dL/dnu
-  double density = 0;                       // dL/drho, per kg/m^3
+  double youngs_modulus = 0;  // dL/dE, per Pa
+  double poissons_ratio = 0;  // dL/dnu
+  double density = 0;         // dL/drho, per kg/m^3
   // One per Scene::material_regions entry, in order (empty without regions):
   // dL/dE_r (per Pa), dL/dnu_r, dL/drho_r (per kg/m^3) of region r.
   std::vector<MaterialComponents> region_materials;

@@ -79,8 +79,7 @@ class Simulator {
   // Equilibrium under the declared forces (gravity, `input.external_force`)
   // and Dirichlet conditions, by Newton (newton-pcg if that is the method,
   // else newton-cholesky), starting from `initial_positions` (3n).
-  VectorXd SolveQuasiStatic(const VectorXd& initial_positions, const StepInput& input,
-                            StepReport* report = nullptr);
+  VectorXd SolveQuasiStatic(const VectorXd& initial_positions, const StepInput& input, StepReport* report = nullptr);
 
   // Number of numeric factorisations of the PD matrix A so far.
   int num_pd_factorizations() const;

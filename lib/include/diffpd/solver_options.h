@@ -40,7 +40,7 @@ struct SolverOptions {
   // over the free DoFs, x0 = x_i + h v_i, whichever start the solve takes.
   double abs_tolerance = 1e-9;  // N
   double rel_tolerance = 1e-6;
-  int max_iterations = 1000;    // per step (Newton or PD iterations)
+  int max_iterations = 1000;  // per step (Newton or PD iterations)
   // After a step's solve from x0, compare g there with g(x_i), the previous
   // total energy (kinetic + elastic + the explicit forces' potential); if the
   // result is above it (a far stationary point: a very stiff, nearly

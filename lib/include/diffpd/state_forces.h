@@ -46,21 +46,21 @@ namespace diffpd {
 struct Hydrodynamics {
   // 3 x t node indices of the wetted triangles (see BoundaryTriangles).
   Eigen::Matrix3Xi triangles;
-  double fluid_density = 1e3;    // rho_f, kg/m^3, finite and >= 0
-  double drag_tangential = 0.05; // Cd at phi = 0, finite and >= 0
-  double drag_normal = 2.05;     // Cd at phi = 90 degrees, finite and >= 0
-  double thrust = 0.0;           // Ct at phi = 90 degrees, finite (any sign)
+  double fluid_density = 1e3;         // rho_f, kg/m^3, finite and >= 0
+  double drag_tangential = 0.05;      // Cd at phi = 0, finite and >= 0
+  double drag_normal = 2.05;          // Cd at phi = 90 degrees, finite and >= 0
+  double thrust = 0.0;                // Ct at phi = 90 degrees, finite (any sign)
   Vec3 flow_velocity = Vec3::Zero();  // m/s, finite
 };
 
 // dL/d(parameter) of the declared state forces (zero where not declared).
 struct StateForceGradient {
-  double linear_damping = 0;   // per (1/s)
-  double fluid_density = 0;    // per kg/m^3
+  double linear_damping = 0;  // per (1/s)
+  double fluid_density = 0;   // per kg/m^3
   double drag_tangential = 0;
   double drag_normal = 0;
   double thrust = 0;
-  Vec3 flow_velocity = Vec3::Zero();  // per m/s
+  Vec3 flow_velocity = Vec3::Zero();     // per m/s
   std::vector<double> penalty_friction;  // per Scene::penalty_contacts entry, dL/dmu
 };
 

@@ -20,14 +20,14 @@ namespace diffpd {
 // tangent along d is the derivative of the rollout at epsilon = 0 when every
 // input theta is replaced by theta + epsilon d_theta. Empty vectors mean zero.
 struct InputDirection {
-  VectorXd x0;                          // 3n, m: initial positions
-  VectorXd v0;                          // 3n, m/s: initial velocities
-  std::vector<VectorXd> external_force; // empty, or one per step (each 3n or empty), N
-  std::vector<VectorXd> activation;     // empty, or one per step (each one per muscle or empty)
+  VectorXd x0;                           // 3n, m: initial positions
+  VectorXd v0;                           // 3n, m/s: initial velocities
+  std::vector<VectorXd> external_force;  // empty, or one per step (each 3n or empty), N
+  std::vector<VectorXd> activation;      // empty, or one per step (each one per muscle or empty)
   // The base material (Scene::material; elements in no region).
-  double youngs_modulus = 0;            // Pa
-  double poissons_ratio = 0;            // dimensionless
-  double density = 0;                   // kg/m^3
+  double youngs_modulus = 0;  // Pa
+  double poissons_ratio = 0;  // dimensionless
+  double density = 0;         // kg/m^3
   // Empty (zero), or one per Scene::material_regions entry, in order: the
   // direction's components for region r's E (Pa), nu and rho (kg/m^3).
   std::vector<MaterialComponents> region_materials;

@@ -50,7 +50,6 @@ Mesh ReadTetGen(const std::string& node_path, const std::string& ele_path);
 //   "tetgen failed (exit status 1) with switches '...': <its last 5 output lines>"
 //   (or "(killed by signal 6)": TetGen 1.5 aborts on a surface it cannot mesh),
 // or when TetGen writes no .node/.ele file.
-Mesh TetrahedralizeSurface(const SurfaceMesh& surface, const std::string& switches = "pq1.414Y",
-                           double scale = 1.0);
+Mesh TetrahedralizeSurface(const SurfaceMesh& surface, const std::string& switches = "pq1.414Y", double scale = 1.0);
 
 }  // namespace diffpd

@@ -20,8 +20,8 @@ namespace diffpd {
 // cells = (10, 10, 10), dx = 0.01 gives 552 hexes and 823 vertices.
 // Throws InvalidInputError if sdf is empty, a cell count is < 1, dx is not
 // finite and > 0, the origin is not finite, sdf returns NaN, or no cell is kept.
-Mesh VoxelizeSdf(const std::function<double(const Vec3&)>& sdf, const Vec3& origin,
-                 const Eigen::Vector3i& cells, double dx);
+Mesh VoxelizeSdf(const std::function<double(const Vec3&)>& sdf, const Vec3& origin, const Eigen::Vector3i& cells,
+                 double dx);
 
 // Voxelizes a closed triangle surface (outward or inward oriented) after
 // scaling its vertices by `scale` about the origin. The grid of cubes of edge

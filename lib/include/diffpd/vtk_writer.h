@@ -45,8 +45,7 @@ class PvdWriter {
   // WriteVtu and records it at `time` (seconds; finite, strictly greater
   // than the previous frame's). Throws what WriteVtu throws, and
   // InvalidInputError for a bad time.
-  void AddFrame(double time, const Mesh& mesh, const Eigen::Matrix3Xd& positions,
-                const VtkPointData& point_data = {});
+  void AddFrame(double time, const Mesh& mesh, const Eigen::Matrix3Xd& positions, const VtkPointData& point_data = {});
 
   // Writes <directory>/<basename>.pvd listing every frame added so far (file
   // names relative to the .pvd). May be called repeatedly, e.g. after each

@@ -67,8 +67,10 @@ void ActiveSetErasure::Set(const std::vector<int>& nodes, ContactLinearSolve mod
   // kCacheSlack; then all of them go (re-solved if they return).
   if (columns_.size() > 2 * nodes_.size() + kCacheSlack) {
     for (auto it = columns_.begin(); it != columns_.end();) {
-      if (std::binary_search(nodes_.begin(), nodes_.end(), it->first)) ++it;
-      else it = columns_.erase(it);
+      if (std::binary_search(nodes_.begin(), nodes_.end(), it->first))
+        ++it;
+      else
+        it = columns_.erase(it);
     }
   }
   MatrixXd cap(s, s);

@@ -76,8 +76,8 @@ class ActiveSetErasure {
   bool active_ = false;     // erasure on (a non-empty set is set)
   ContactLinearSolve mode_ = ContactLinearSolve::kWoodbury;
   std::unordered_map<int, VectorXd> columns_;  // node -> A^-1 e_node
-  MatrixXd w_;                                  // n x s (s <= kDenseCorrectionMax), else empty
-  Eigen::LLT<MatrixXd> capacitance_;            // of C = W_S
+  MatrixXd w_;                                 // n x s (s <= kDenseCorrectionMax), else empty
+  Eigen::LLT<MatrixXd> capacitance_;           // of C = W_S
   std::unique_ptr<CholmodSolver> erased_solver_;
   int num_column_solves_ = 0;
   int num_factorizations_ = 0;

@@ -52,8 +52,8 @@ ContactPin ComputeContactPin(const ContactSurface& surface, const Vec3& x, const
   return ContactPin{surface.Project(x), surface.ProjectJacobian(x), Mat3::Zero()};
 }
 
-VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const VectorXd& force,
-                            const ImplicitSolver& solve, StepReport* report) {
+VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const VectorXd& force, const ImplicitSolver& solve,
+                            StepReport* report) {
   const FrictionalContactOptions& opt = sim.scene.frictional_contact_options;
   const double h = sim.h();
   const int n = sim.num_dofs();
@@ -96,8 +96,10 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
         // Only converged passes lock a node (the lock makes the final set
         // depend on the path; loose solves must not choose it). A node back
         // in on a loose solve ends screening instead.
-        if (screening_pass) *cycled = *cycled || screen_released[c];
-        else if (released[c]) locked[c] = 1;
+        if (screening_pass)
+          *cycled = *cycled || screen_released[c];
+        else if (released[c])
+          locked[c] = 1;
         changed = true;
       }
     }
@@ -197,8 +199,8 @@ void AddPinGradient(SimulatorImpl& sim, StepLinearization& lin, const State& pre
     for (const int i : c.nodes) surface_of[i] = &c.surface;
   for (const int i : nodes) {
     DIFFPD_CHECK(surface_of[i] != nullptr, "pinned node " << i << " is not a frictional contact candidate");
-    const ContactPin pin = ComputeContactPin(*surface_of[i], previous.x.segment<3>(3 * i),
-                                             previous.v.segment<3>(3 * i), sim.h());
+    const ContactPin pin =
+        ComputeContactPin(*surface_of[i], previous.x.segment<3>(3 * i), previous.v.segment<3>(3 * i), sim.h());
     const Vec3 dl_dpin = b.segment<3>(3 * i) - hz.segment<3>(3 * i);
     gx->segment<3>(3 * i) += pin.d_dx.transpose() * dl_dpin;
     gv->segment<3>(3 * i) += pin.d_dv.transpose() * dl_dpin;

@@ -28,8 +28,8 @@ ContactPin ComputeContactPin(const ContactSurface& surface, const Vec3& x, const
 // (3n). Fills report (iterations summed over passes, contact_nodes,
 // contact_forces, active_set_passes) and returns x_{i+1}. Throws
 // SolverError(kActiveSetNotConverged) after max_passes solves.
-VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const VectorXd& force,
-                            const ImplicitSolver& solve, StepReport* report);
+VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const VectorXd& force, const ImplicitSolver& solve,
+                            StepReport* report);
 
 // Backward of the pins of one step, with its active set `nodes` pinned (a
 // ContactPinScope alive) and z = H^-1 b the step's adjoint: dL/dpin =

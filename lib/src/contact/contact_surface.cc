@@ -32,16 +32,20 @@ ContactSurface ContactSurface::HeightField(std::function<double(double, double)>
 
 double ContactSurface::Gap(const Vec3& x) const {
   switch (kind) {
-    case Kind::kPlane: return normal.normalized().dot(x) - offset;
-    case Kind::kSphere: return (x - center).norm() - radius;
-    case Kind::kHeightField: return x(2) - height(x(0), x(1));
+    case Kind::kPlane:
+      return normal.normalized().dot(x) - offset;
+    case Kind::kSphere:
+      return (x - center).norm() - radius;
+    case Kind::kHeightField:
+      return x(2) - height(x(0), x(1));
   }
   return 0;
 }
 
 Vec3 ContactSurface::GapGradient(const Vec3& x) const {
   switch (kind) {
-    case Kind::kPlane: return normal.normalized();
+    case Kind::kPlane:
+      return normal.normalized();
     case Kind::kSphere: {
       const Vec3 d = x - center;
       const double r = d.norm();
@@ -61,8 +65,10 @@ Vec3 ContactSurface::Project(const Vec3& x) const {
       const Vec3 n = normal.normalized();
       return x - (n.dot(x) - offset) * n;
     }
-    case Kind::kSphere: return center + radius * GapGradient(x);
-    case Kind::kHeightField: return Vec3(x(0), x(1), height(x(0), x(1)));
+    case Kind::kSphere:
+      return center + radius * GapGradient(x);
+    case Kind::kHeightField:
+      return Vec3(x(0), x(1), height(x(0), x(1)));
   }
   return x;
 }

@@ -87,8 +87,8 @@ bool AnyNeedsSvd(const std::vector<ElasticEnergy>& energies) {
   return need_svd;
 }
 
-double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, double mu,
-                       double lambda, Mat3* stress, Mat9* dstress, Mat3* v_cache) {
+double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, double mu, double lambda,
+                       Mat3* stress, Mat9* dstress, Mat3* v_cache) {
   Svd3 svd;
   if (AnyNeedsSvd(energies)) {
     svd = v_cache ? ComputeSvd3(F, *v_cache) : ComputeSvd3(F);
@@ -97,8 +97,8 @@ double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F
   return EvaluateDensity(energies, F, svd, mu, lambda, stress, dstress);
 }
 
-double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, const Svd3& svd,
-                       double mu, double lambda, Mat3* stress, Mat9* dstress, const VolumeProjection* volume) {
+double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, const Svd3& svd, double mu,
+                       double lambda, Mat3* stress, Mat9* dstress, const VolumeProjection* volume) {
   double psi = 0;
   if (stress) stress->setZero();
   if (dstress) dstress->setZero();
@@ -153,9 +153,12 @@ ElasticForces::ElasticForces(const FemModel& fem, std::vector<ElasticEnergy> ene
 double ElasticForces::PdWeight(double mu, double lambda) const {
   double w = 0;
   for (const ElasticEnergy e : energies_) {
-    if (e == ElasticEnergy::kPdCorotated) w += 2 * mu;
-    else if (e == ElasticEnergy::kPdVolume) w += lambda;
-    else w += 2 * mu + lambda;
+    if (e == ElasticEnergy::kPdCorotated)
+      w += 2 * mu;
+    else if (e == ElasticEnergy::kPdVolume)
+      w += lambda;
+    else
+      w += 2 * mu + lambda;
   }
   return w;
 }
@@ -169,7 +172,8 @@ void ElasticForces::GatherElementBuffer(VectorXd* out, int threads) const {
 #pragma omp parallel for schedule(static) num_threads(nt) if (nt != 1 && n >= 4 * kMinParallelElements)
   for (int i = 0; i < n; ++i) {
     Vec3 sum = Vec3::Zero();
-    for (int j = off[i]; j < off[i + 1]; ++j) sum += Eigen::Map<const Vec3>(element_buffer_.data() + 3 * static_cast<size_t>(inc[j]));
+    for (int j = off[i]; j < off[i + 1]; ++j)
+      sum += Eigen::Map<const Vec3>(element_buffer_.data() + 3 * static_cast<size_t>(inc[j]));
     out->segment<3>(3 * i) = sum;
   }
 }
@@ -221,8 +225,7 @@ void ElasticForces::ForEachDecomposedElement(const VectorXd& x, int threads, Bod
 }
 
 template <int K>
-double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, const LameField& lame, VectorXd* grad,
-                                            int threads) {
+double ElasticForces::EnergyAndGradientImpl(const VectorXd& x, const LameField& lame, VectorXd* grad, int threads) {
   if (!x.allFinite()) throw SolverError(SolverStatus::kNonFinite, "positions are not finite");
   const int q_per = fem_.samples_per_element();
   // The general path for element e (F, svd, volume: its samples').
@@ -318,8 +321,10 @@ void ElasticForces::PartLameDots(const VectorXd& x, const VectorXd& z, const std
                                  int num_parts, VectorXd* dmu, VectorXd* dlambda, int threads) {
   DIFFPD_CHECK(part_of_element.empty() || static_cast<int>(part_of_element.size()) == fem_.num_elements(),
                "part_of_element has " << part_of_element.size() << " entries");
-  if (fem_.nodes_per_element() == 4) PartLameDotsImpl<4>(x, z, part_of_element, num_parts, dmu, dlambda, threads);
-  else PartLameDotsImpl<8>(x, z, part_of_element, num_parts, dmu, dlambda, threads);
+  if (fem_.nodes_per_element() == 4)
+    PartLameDotsImpl<4>(x, z, part_of_element, num_parts, dmu, dlambda, threads);
+  else
+    PartLameDotsImpl<8>(x, z, part_of_element, num_parts, dmu, dlambda, threads);
 }
 
 template <int K>
@@ -340,10 +345,11 @@ void ElasticForces::StressDifferentialsImpl(const VectorXd& x, const LameField& 
   });
 }
 
-void ElasticForces::StressDifferentials(const VectorXd& x, const LameField& lame, std::vector<Mat9>* d,
-                                        int threads) {
-  if (fem_.nodes_per_element() == 4) StressDifferentialsImpl<4>(x, lame, d, threads);
-  else StressDifferentialsImpl<8>(x, lame, d, threads);
+void ElasticForces::StressDifferentials(const VectorXd& x, const LameField& lame, std::vector<Mat9>* d, int threads) {
+  if (fem_.nodes_per_element() == 4)
+    StressDifferentialsImpl<4>(x, lame, d, threads);
+  else
+    StressDifferentialsImpl<8>(x, lame, d, threads);
 }
 
 template <int K>
@@ -366,8 +372,10 @@ void ElasticForces::ApplyHessianImpl(const std::vector<Mat9>& d, const VectorXd&
 }
 
 void ElasticForces::ApplyHessian(const std::vector<Mat9>& d, const VectorXd& z, VectorXd* out, int threads) {
-  if (fem_.nodes_per_element() == 4) ApplyHessianImpl<4>(d, z, out, threads);
-  else ApplyHessianImpl<8>(d, z, out, threads);
+  if (fem_.nodes_per_element() == 4)
+    ApplyHessianImpl<4>(d, z, out, threads);
+  else
+    ApplyHessianImpl<8>(d, z, out, threads);
 }
 
 namespace {
@@ -452,8 +460,7 @@ void ElasticForces::PackedElementHessiansImpl(const VectorXd& x, const LameField
     SampleDecompositions<K>(x, e0, count, F, svd, volume, /*warm_start=*/false);
     Eigen::Matrix<double, N, N> ke;
     for (int j = 0; j < count; ++j) {
-      ElementStiffness<K, /*kUpper=*/true>(e0 + j, F + j * q_per, svd + j * q_per, volume + j * q_per, lame,
-                                           ke.data());
+      ElementStiffness<K, /*kUpper=*/true>(e0 + j, F + j * q_per, svd + j * q_per, volume + j * q_per, lame, ke.data());
       PackElement(K, e0 + j, ke.data(), packed->data());
     }
   });
@@ -461,8 +468,10 @@ void ElasticForces::PackedElementHessiansImpl(const VectorXd& x, const LameField
 
 void ElasticForces::PackedElementHessians(const VectorXd& x, const LameField& lame, std::vector<double>* packed,
                                           int threads) {
-  if (fem_.nodes_per_element() == 4) PackedElementHessiansImpl<4>(x, lame, packed, threads);
-  else PackedElementHessiansImpl<8>(x, lame, packed, threads);
+  if (fem_.nodes_per_element() == 4)
+    PackedElementHessiansImpl<4>(x, lame, packed, threads);
+  else
+    PackedElementHessiansImpl<8>(x, lame, packed, threads);
 }
 
 template <int K>
@@ -499,8 +508,10 @@ void ElasticForces::ApplyElementMatricesImpl(const std::vector<double>& packed, 
 
 void ElasticForces::ApplyElementMatrices(const std::vector<double>& packed, const VectorXd& z, VectorXd* out,
                                          int threads) {
-  if (fem_.nodes_per_element() == 4) ApplyElementMatricesImpl<4>(packed, z, out, threads);
-  else ApplyElementMatricesImpl<8>(packed, z, out, threads);
+  if (fem_.nodes_per_element() == 4)
+    ApplyElementMatricesImpl<4>(packed, z, out, threads);
+  else
+    ApplyElementMatricesImpl<8>(packed, z, out, threads);
 }
 
 template <int K, bool kUpper>
@@ -550,8 +561,7 @@ void ElasticForces::ElementHessiansImpl(const VectorXd& x, const LameField& lame
 
 template <int K>
 void ElasticForces::AddElementHessianProductsImpl(const VectorXd& x, const LameField& lame,
-                                                  const std::vector<int>& elements, const MatrixXd& z,
-                                                  MatrixXd* out) {
+                                                  const std::vector<int>& elements, const MatrixXd& z, MatrixXd* out) {
   constexpr int N = 3 * K;
   const Mesh& mesh = fem_.mesh();
   Mat3 F[kSvdBatch];
@@ -571,17 +581,21 @@ void ElasticForces::AddElementHessianProductsImpl(const VectorXd& x, const LameF
 
 void ElasticForces::AddElementHessianProducts(const VectorXd& x, const LameField& lame,
                                               const std::vector<int>& elements, const MatrixXd& z, MatrixXd* out) {
-  DIFFPD_CHECK(z.rows() == x.size() && out->rows() == x.size() && out->cols() == z.cols(),
-               "AddElementHessianProducts: shapes " << z.rows() << "x" << z.cols() << ", " << out->rows() << "x"
-                                                    << out->cols());
-  if (fem_.nodes_per_element() == 4) AddElementHessianProductsImpl<4>(x, lame, elements, z, out);
-  else AddElementHessianProductsImpl<8>(x, lame, elements, z, out);
+  DIFFPD_CHECK(
+      z.rows() == x.size() && out->rows() == x.size() && out->cols() == z.cols(),
+      "AddElementHessianProducts: shapes " << z.rows() << "x" << z.cols() << ", " << out->rows() << "x" << out->cols());
+  if (fem_.nodes_per_element() == 4)
+    AddElementHessianProductsImpl<4>(x, lame, elements, z, out);
+  else
+    AddElementHessianProductsImpl<8>(x, lame, elements, z, out);
 }
 
 void ElasticForces::ElementHessians(const VectorXd& x, const LameField& lame, bool project_spd,
                                     std::vector<double>* blocks, int threads) {
-  if (fem_.nodes_per_element() == 4) ElementHessiansImpl<4>(x, lame, project_spd, blocks, threads);
-  else ElementHessiansImpl<8>(x, lame, project_spd, blocks, threads);
+  if (fem_.nodes_per_element() == 4)
+    ElementHessiansImpl<4>(x, lame, project_spd, blocks, threads);
+  else
+    ElementHessiansImpl<8>(x, lame, project_spd, blocks, threads);
 }
 
 }  // namespace diffpd::internal

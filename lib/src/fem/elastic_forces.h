@@ -82,13 +82,12 @@ class ElasticForces {
   // half the memory traffic of full blocks).
   void ApplyElementMatrices(const std::vector<double>& packed, const VectorXd& z, VectorXd* out, int threads);
 
-
  private:
   template <int K>
   double EnergyAndGradientImpl(const VectorXd& x, const LameField& lame, VectorXd* grad, int threads);
   template <int K>
-  void PartLameDotsImpl(const VectorXd& x, const VectorXd& z, const std::vector<int>& part_of_element,
-                        int num_parts, VectorXd* dmu, VectorXd* dlambda, int threads);
+  void PartLameDotsImpl(const VectorXd& x, const VectorXd& z, const std::vector<int>& part_of_element, int num_parts,
+                        VectorXd* dmu, VectorXd* dlambda, int threads);
   template <int K>
   void StressDifferentialsImpl(const VectorXd& x, const LameField& lame, std::vector<Mat9>* d, int threads);
   template <int K>
@@ -156,13 +155,12 @@ class ElasticForces {
 // `energies` at F, with one SVD shared by the energies that need it (warm
 // started from and written back to *v_cache when given). Throws SolverError
 // for inverted neo-Hookean elements.
-double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, double mu,
-                       double lambda, Mat3* stress, Mat9* dstress, Mat3* v_cache = nullptr);
+double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, double mu, double lambda,
+                       Mat3* stress, Mat9* dstress, Mat3* v_cache = nullptr);
 // The same with the signed SVD of F given (ignored when no energy needs it).
 // `volume`, when given, is the pd-volume projection of svd.sigma precomputed.
-double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, const Svd3& svd,
-                       double mu, double lambda, Mat3* stress, Mat9* dstress,
-                       const VolumeProjection* volume = nullptr);
+double EvaluateDensity(const std::vector<ElasticEnergy>& energies, const Mat3& F, const Svd3& svd, double mu,
+                       double lambda, Mat3* stress, Mat9* dstress, const VolumeProjection* volume = nullptr);
 // True when one of `energies` needs the SVD of F.
 bool AnyNeedsSvd(const std::vector<ElasticEnergy>& energies);
 

@@ -7,8 +7,8 @@
 namespace diffpd::internal {
 
 struct LameField {
-  double mu = 0;      // Pa, used when element_mu is nullptr
-  double lambda = 0;  // Pa, used when element_lambda is nullptr
+  double mu = 0;                           // Pa, used when element_mu is nullptr
+  double lambda = 0;                       // Pa, used when element_lambda is nullptr
   const double* element_mu = nullptr;      // num_elements values (Pa), or nullptr
   const double* element_lambda = nullptr;  // num_elements values (Pa), or nullptr
 

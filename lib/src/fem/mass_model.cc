@@ -26,8 +26,8 @@ MassModel::MassModel(const FemModel& fem, const std::vector<int>& part_of_elemen
 }
 
 void MassModel::SetDensities(const std::vector<double>& densities) {
-  DIFFPD_CHECK(static_cast<int>(densities.size()) == num_parts(),
-               densities.size() << " densities for " << num_parts() << " parts");
+  DIFFPD_CHECK(static_cast<int>(densities.size()) == num_parts(), densities.size()
+                                                                      << " densities for " << num_parts() << " parts");
   bool uniform = true;
   for (const double rho : densities) uniform = uniform && rho == densities[0];
   if (uniform) {

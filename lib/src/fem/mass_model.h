@@ -24,8 +24,8 @@ class MassModel {
   int num_parts() const { return static_cast<int>(part_unit_mass_.size()); }
   // Sets rho_p (num_parts values, kg/m^3, validated by the caller) and M.
   void SetDensities(const std::vector<double>& densities);
-  const VectorXd& mass() const { return mass_; }            // M (3n, kg)
-  const VectorXd& unit_mass() const { return unit_mass_; }  // m = sum_p m_p (3n, m^3)
+  const VectorXd& mass() const { return mass_; }                                    // M (3n, kg)
+  const VectorXd& unit_mass() const { return unit_mass_; }                          // m = sum_p m_p (3n, m^3)
   const VectorXd& part_unit_mass(int part) const { return part_unit_mass_[part]; }  // m_p (3n)
 
   // dM along a density direction: sum_p drho_p m_p (3n); drho has num_parts entries.

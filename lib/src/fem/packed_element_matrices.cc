@@ -81,8 +81,10 @@ DIFFPD_SIMD_INLINE void AddPackedSampleStiffnessK(const PackedSampleLanes& s, do
 
 DIFFPD_SIMD_CLONES
 void AddPackedSampleStiffness(int nodes_per_element, const PackedSampleLanes& sample, double* packed_group) {
-  if (nodes_per_element == 4) AddPackedSampleStiffnessK<4>(sample, packed_group);
-  else AddPackedSampleStiffnessK<8>(sample, packed_group);
+  if (nodes_per_element == 4)
+    AddPackedSampleStiffnessK<4>(sample, packed_group);
+  else
+    AddPackedSampleStiffnessK<8>(sample, packed_group);
 }
 
 // One clone per vector width (simd_dispatch.h); every loop over lanes is a
@@ -106,8 +108,8 @@ void ApplyPackedGroup(int nodes_per_element, const double* packed, const double 
         for (int i = 0; i < 3; ++i)
           y[3 * a + i][l] += block[i] * z[3 * b][l] + block[i + 3] * z[3 * b + 1][l] + block[i + 6] * z[3 * b + 2][l];
         for (int k = 0; k < 3; ++k)
-          y[3 * b + k][l] += block[3 * k] * z[3 * a][l] + block[3 * k + 1] * z[3 * a + 1][l] +
-                             block[3 * k + 2] * z[3 * a + 2][l];
+          y[3 * b + k][l] +=
+              block[3 * k] * z[3 * a][l] + block[3 * k + 1] * z[3 * a + 1][l] + block[3 * k + 2] * z[3 * a + 2][l];
       }
     }
 #pragma omp simd

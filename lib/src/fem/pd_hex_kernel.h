@@ -34,9 +34,9 @@ struct PdHexElement {
   const double* grads = nullptr;           // the same in sample order: FemModel::grad of its first sample
   const double* sample_volume = nullptr;   // 8 sample volumes (m^3)
   PdHexWeights weights;
-  Mat3* v_cache = nullptr;  // 8 samples' last V: warm start, written back
-  double* fe = nullptr;     // out: 3 x 8 nodal forces dE_e/dx_e (N), column-major
-  double* energy = nullptr; // out: E_e (J)
+  Mat3* v_cache = nullptr;   // 8 samples' last V: warm start, written back
+  double* fe = nullptr;      // out: 3 x 8 nodal forces dE_e/dx_e (N), column-major
+  double* energy = nullptr;  // out: E_e (J)
 };
 
 // Elements per call: two hexahedra fill one SVD batch (svd3.h), whose lanes

@@ -55,9 +55,9 @@ void HydrodynamicForceVjp(const Hydrodynamics& params, const Vec3& area_vector, 
   *g_velocity = scale * (ct * t1_u + cd * t2_u + cth * t3_u);
   *g_area = scale * (ct * t1_n + cd * t2_n + cth * t3_n);
   if (grad) {
-    const double w1 = w.dot(u) * m * s;                 // w . T1
-    const double w2 = uw * p * p / (m * s);             // w . T2
-    const double w3 = nw * p * s / m;                   // w . T3
+    const double w1 = w.dot(u) * m * s;      // w . T1
+    const double w2 = uw * p * p / (m * s);  // w . T2
+    const double w3 = nw * p * s / m;        // w . T3
     grad->fluid_density += -0.5 * (ct * w1 + cd * w2 + cth * w3);
     grad->drag_tangential += scale * (w1 - w2);
     grad->drag_normal += scale * w2;

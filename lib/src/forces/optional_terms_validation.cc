@@ -69,8 +69,8 @@ void ValidateMuscles(const Scene& scene) {
     }
     if (muscle.fibers.size() != 1 && muscle.fibers.size() != muscle.elements.size()) {
       std::ostringstream s;
-      s << "scene: " << name << " has " << muscle.fibers.size() << " fibre directions for "
-        << muscle.elements.size() << " elements (need one per element or a single shared one)";
+      s << "scene: " << name << " has " << muscle.fibers.size() << " fibre directions for " << muscle.elements.size()
+        << " elements (need one per element or a single shared one)";
       throw InvalidInputError(s.str());
     }
     for (size_t t = 0; t < muscle.fibers.size(); ++t) CheckDirection(Indexed(name + ".fibers", t), muscle.fibers[t]);

@@ -21,7 +21,8 @@ Vec3 MeanVelocity(const VectorXd& v, int a, int b, int c) {
 }  // namespace
 
 StateForces::StateForces(const Scene& scene)
-    : damping_(scene.linear_damping), hydro_(scene.hydrodynamics),
+    : damping_(scene.linear_damping),
+      hydro_(scene.hydrodynamics),
       num_penalty_contacts_(static_cast<int>(scene.penalty_contacts.size())) {
   for (size_t c = 0; c < scene.penalty_contacts.size(); ++c) {
     const PenaltyContact& pc = scene.penalty_contacts[c];
@@ -56,8 +57,8 @@ void StateForces::Add(const VectorXd& x, const VectorXd& v, const VectorXd& mass
   }
 }
 
-void StateForces::AddVjp(const VectorXd& x, const VectorXd& v, const VectorXd& mass, const VectorXd& w,
-                         VectorXd* gx, VectorXd* gv, StateForceGradient* grad, VectorXd* dmass) const {
+void StateForces::AddVjp(const VectorXd& x, const VectorXd& v, const VectorXd& mass, const VectorXd& w, VectorXd* gx,
+                         VectorXd* gv, StateForceGradient* grad, VectorXd* dmass) const {
   if (empty()) return;
   if (damping_) {
     const VectorXd mw = mass.cwiseProduct(w);

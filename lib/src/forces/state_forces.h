@@ -27,8 +27,8 @@ class StateForces {
   // Given w = dL/dF (3n): *gx += (dF/dx)^T w, *gv += (dF/dv)^T w, the
   // parameter gradients into *grad (penalty_friction sized on first use) and,
   // if dmass is not nullptr, *dmass += (dF/dM)^T w (3n, per DoF's mass).
-  void AddVjp(const VectorXd& x, const VectorXd& v, const VectorXd& mass, const VectorXd& w, VectorXd* gx,
-              VectorXd* gv, StateForceGradient* grad, VectorXd* dmass) const;
+  void AddVjp(const VectorXd& x, const VectorXd& v, const VectorXd& mass, const VectorXd& w, VectorXd* gx, VectorXd* gv,
+              StateForceGradient* grad, VectorXd* dmass) const;
 
  private:
   struct FrictionNode {

@@ -40,7 +40,8 @@ std::string Where(const std::string& what, int line) {
 // Checks of one marker declaration that do not need the mesh.
 void CheckMarker(const Marker& m, const std::string& what) {
   const std::string at = Where(what, m.line);
-  if (m.id < 0) throw InvalidInputError(at + "marker id " + std::to_string(m.id) + " is invalid: must be an integer >= 0");
+  if (m.id < 0)
+    throw InvalidInputError(at + "marker id " + std::to_string(m.id) + " is invalid: must be an integer >= 0");
   const bool is_vertex = m.vertex >= 0 && m.element < 0;
   const bool is_point = m.element >= 0 && m.vertex < 0;
   if (!is_vertex && !is_point)
@@ -62,7 +63,8 @@ void CheckSample(const MarkerSample& s, const std::map<int, const Marker*>& ids,
     if (!std::isfinite(s.position(d)))
       throw InvalidInputError(at + axes[d] + " = " + Format(s.position(d)) + " is not finite");
   for (int d = 0; d < 3; ++d) {
-    if (!std::isfinite(s.weight(d))) throw InvalidInputError(at + weights[d] + " = " + Format(s.weight(d)) + " is not finite");
+    if (!std::isfinite(s.weight(d)))
+      throw InvalidInputError(at + weights[d] + " = " + Format(s.weight(d)) + " is not finite");
     if (s.weight(d) < 0)
       throw InvalidInputError(at + weights[d] + " = " + Format(s.weight(d)) + " is invalid: weights must be >= 0");
   }
@@ -76,8 +78,7 @@ void CheckSample(const MarkerSample& s, const std::map<int, const Marker*>& ids,
     std::string prev = "at time " + Format(it->second.first);
     if (it->second.second > 0) prev += " (line " + std::to_string(it->second.second) + ")";
     throw InvalidInputError(at + "time " + Format(s.time) + " of marker " + std::to_string(s.marker) +
-                            " is not after its previous sample " + prev +
-                            ": times must increase strictly per marker");
+                            " is not after its previous sample " + prev + ": times must increase strictly per marker");
   }
   (*last)[s.marker] = {s.time, s.line};
 }
@@ -211,8 +212,8 @@ void WriteCapturedMotion(const std::string& path, const CapturedMotion& motion, 
   for (const MarkerSample& s : motion.samples) weights = weights || s.weight != Vec3::Ones();
   out << (weights ? "time,marker,x,y,z,wx,wy,wz\n" : "time,marker,x,y,z\n");
   for (const MarkerSample& s : motion.samples) {
-    std::snprintf(buffer, sizeof buffer, "%.17g,%d,%.17g,%.17g,%.17g", s.time, s.marker, s.position(0),
-                  s.position(1), s.position(2));
+    std::snprintf(buffer, sizeof buffer, "%.17g,%d,%.17g,%.17g,%.17g", s.time, s.marker, s.position(0), s.position(1),
+                  s.position(2));
     out << buffer;
     if (weights) {
       std::snprintf(buffer, sizeof buffer, ",%.17g,%.17g,%.17g", s.weight(0), s.weight(1), s.weight(2));
@@ -249,8 +250,7 @@ std::vector<std::pair<int, double>> MarkerStencil(const Marker& marker, const Me
     for (int a = 0; a < 3; ++a) stencil.emplace_back(mesh.elements(a + 1, marker.element), c(a));
   } else {
     if (c.cwiseAbs().maxCoeff() > 1 + tol)
-      throw InvalidInputError(name + "local coordinates " + coords +
-                              " are outside the reference hexahedron [-1, 1]^3");
+      throw InvalidInputError(name + "local coordinates " + coords + " are outside the reference hexahedron [-1, 1]^3");
     for (int a = 0; a < 8; ++a) {
       const Vec3 corner(2 * ((a >> 2) & 1) - 1, 2 * ((a >> 1) & 1) - 1, 2 * (a & 1) - 1);
       const double w = (1 + c(0) * corner(0)) * (1 + c(1) * corner(1)) * (1 + c(2) * corner(2)) / 8;
@@ -265,8 +265,7 @@ int MarkerObservations::RequiredSteps(const CapturedMotion& motion, double time_
   return std::max(1, static_cast<int>(std::ceil(steps - 1e-9)));
 }
 
-MarkerObservations::MarkerObservations(const CapturedMotion& motion, const Mesh& mesh, double time_step,
-                                       int num_steps)
+MarkerObservations::MarkerObservations(const CapturedMotion& motion, const Mesh& mesh, double time_step, int num_steps)
     : num_steps_(num_steps) {
   if (!std::isfinite(time_step) || time_step <= 0)
     throw InvalidInputError("time step = " + Format(time_step) + " is invalid: must be finite and > 0 (s)");
@@ -293,8 +292,8 @@ MarkerObservations::MarkerObservations(const CapturedMotion& motion, const Mesh&
         msg << "line " << s.line << ": ";
       else
         msg << "sample " << terms_.size() << ": ";
-      msg << "time " << s.time << " s is after the end of the simulation ("
-          << num_steps << " steps of " << time_step << " s = " << num_steps * time_step << " s)";
+      msg << "time " << s.time << " s is after the end of the simulation (" << num_steps << " steps of " << time_step
+          << " s = " << num_steps * time_step << " s)";
       throw InvalidInputError(msg.str());
     }
     std::vector<Term> terms;

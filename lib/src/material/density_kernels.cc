@@ -41,8 +41,7 @@ IsotropicDifferentialCoefficients CorotatedCoefficients(const Svd3& svd, double 
     c.dp_dsigma(i, j) += lambda * (J - 1.0) * s(k);
     c.dp_dsigma(j, i) += lambda * (J - 1.0) * s(k);
     c.symmetric(pair) = 2.0 * mu - lambda * (J - 1.0) * s(k);
-    c.skew(pair) = 2.0 * mu * (1.0 - 2.0 / std::max(s(i) + s(j), floor)) +
-                   lambda * (J - 1.0) * s(k);
+    c.skew(pair) = 2.0 * mu * (1.0 - 2.0 / std::max(s(i) + s(j), floor)) + lambda * (J - 1.0) * s(k);
   }
   c.dp_dsigma.diagonal().array() += 2.0 * mu;
   return c;
@@ -94,8 +93,8 @@ Mat9 StressDifferential(ElasticEnergy energy, const Mat3& F, double mu, double l
   return StressDifferential(energy, F, svd, mu, lambda);
 }
 
-double EnergyAndStress(ElasticEnergy energy, const Mat3& F, const Svd3& svd, double mu,
-                       double lambda, Mat3* stress, const VolumeProjection* volume) {
+double EnergyAndStress(ElasticEnergy energy, const Mat3& F, const Svd3& svd, double mu, double lambda, Mat3* stress,
+                       const VolumeProjection* volume) {
   switch (energy) {
     case ElasticEnergy::kCorotated:
       return CorotatedEnergyAndStress(svd, mu, lambda, stress);
@@ -111,9 +110,9 @@ double EnergyAndStress(ElasticEnergy energy, const Mat3& F, const Svd3& svd, dou
   return ::diffpd::EnergyDensity(energy, F, mu, lambda);
 }
 
-Mat9 StressDifferential(ElasticEnergy energy, const Mat3& F, const Svd3& svd, double mu,
-                        double lambda) {
-  if (NeedsSvd(energy)) return AssembleIsotropicDifferential(svd, StressDifferentialCoefficients(energy, svd, mu, lambda));
+Mat9 StressDifferential(ElasticEnergy energy, const Mat3& F, const Svd3& svd, double mu, double lambda) {
+  if (NeedsSvd(energy))
+    return AssembleIsotropicDifferential(svd, StressDifferentialCoefficients(energy, svd, mu, lambda));
   return ::diffpd::StressDifferential(energy, F, mu, lambda);
 }
 

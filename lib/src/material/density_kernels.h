@@ -39,16 +39,16 @@ Mat9 StressDifferential(ElasticEnergy energy, const Mat3& F, double mu, double l
 // energies that do not need it): the energy density, and the stress into
 // *stress when stress != nullptr. `volume`, when given, is
 // ProjectSingularValuesToUnitDeterminant(svd.sigma) precomputed (pd-volume).
-double EnergyAndStress(ElasticEnergy energy, const Mat3& F, const Svd3& svd, double mu,
-                       double lambda, Mat3* stress, const VolumeProjection* volume = nullptr);
-Mat9 StressDifferential(ElasticEnergy energy, const Mat3& F, const Svd3& svd, double mu,
-                        double lambda);
+double EnergyAndStress(ElasticEnergy energy, const Mat3& F, const Svd3& svd, double mu, double lambda, Mat3* stress,
+                       const VolumeProjection* volume = nullptr);
+Mat9 StressDifferential(ElasticEnergy energy, const Mat3& F, const Svd3& svd, double mu, double lambda);
 // The singular-value form of StressDifferential for the energies with
 // NeedsSvd (aborts for the others): dP/dF =
 // AssembleIsotropicDifferential(svd, coefficients), so the coefficients of
 // several energies at one F add up and assemble once. `volume` as above.
 IsotropicDifferentialCoefficients StressDifferentialCoefficients(ElasticEnergy energy, const Svd3& svd, double mu,
-                                                                 double lambda, const VolumeProjection* volume = nullptr);
+                                                                 double lambda,
+                                                                 const VolumeProjection* volume = nullptr);
 
 // The PD form (w/2) |F - Proj(F)|^2 of a projective energy (IsProjective must
 // hold; aborts otherwise): the weight w (Pa; 2 mu for pd-corotated, lambda for

@@ -57,8 +57,7 @@ double EnergyDensity(ElasticEnergy energy, const Mat3& F, double mu, double lamb
     case ElasticEnergy::kPdCorotated:
       return mu * (F - internal::ProjectToRotation(internal::ComputeSvd3(F))).squaredNorm();
     case ElasticEnergy::kPdVolume:
-      return 0.5 * lambda *
-             (F - internal::ProjectToUnitDeterminant(internal::ComputeSvd3(F))).squaredNorm();
+      return 0.5 * lambda * (F - internal::ProjectToUnitDeterminant(internal::ComputeSvd3(F))).squaredNorm();
   }
   UnknownEnergy(energy);
 }
@@ -105,8 +104,7 @@ Mat9 StressDifferential(ElasticEnergy energy, const Mat3& F, double mu, double l
       const Mat9 dR = internal::RotationProjectionDifferential(internal::ComputeSvd3(F));
       const Vec9 cofactor = Flatten(Cofactor(F));
       return 2.0 * mu * (identity - dR) +
-             lambda * (cofactor * cofactor.transpose() +
-                       (F.determinant() - 1.0) * CofactorDifferential(F));
+             lambda * (cofactor * cofactor.transpose() + (F.determinant() - 1.0) * CofactorDifferential(F));
     }
     case ElasticEnergy::kNeoHookean: {
       // dP = mu dF + (lambda log J - mu) d(F^-T) + lambda <F^-T, dF> F^-T,
@@ -118,15 +116,13 @@ Mat9 StressDifferential(ElasticEnergy energy, const Mat3& F, double mu, double l
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j)
           for (int k = 0; k < 3; ++k)
-            for (int l = 0; l < 3; ++l)
-              D(i + 3 * j, k + 3 * l) += (mu - lambda * log_J) * F_inv(l, i) * F_inv(j, k);
+            for (int l = 0; l < 3; ++l) D(i + 3 * j, k + 3 * l) += (mu - lambda * log_J) * F_inv(l, i) * F_inv(j, k);
       return D;
     }
     case ElasticEnergy::kPdCorotated:
       return 2.0 * mu * (identity - internal::RotationProjectionDifferential(internal::ComputeSvd3(F)));
     case ElasticEnergy::kPdVolume:
-      return lambda *
-             (identity - internal::UnitDeterminantProjectionDifferential(internal::ComputeSvd3(F)));
+      return lambda * (identity - internal::UnitDeterminantProjectionDifferential(internal::ComputeSvd3(F)));
   }
   UnknownEnergy(energy);
 }

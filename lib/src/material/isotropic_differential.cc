@@ -45,9 +45,7 @@ Mat9 AssembleIsotropicDifferential(const Svd3& svd, const IsotropicDifferentialC
   return result;
 }
 
-double DenominatorFloor(const Vec3& sigma) {
-  return kProjectionDenominatorFloor * std::max(sigma(0), 1.0);
-}
+double DenominatorFloor(const Vec3& sigma) { return kProjectionDenominatorFloor * std::max(sigma(0), 1.0); }
 
 IsotropicDifferentialCoefficients DividedDifferenceCoefficients(const Vec3& sigma, const Vec3& p,
                                                                 const Mat3& dp_dsigma) {
@@ -58,8 +56,7 @@ IsotropicDifferentialCoefficients DividedDifferenceCoefficients(const Vec3& sigm
     const int i = kPairFirst[k], j = kPairSecond[k];
     // sigma_i >= sigma_j for i < j in a signed SVD.
     const double difference = sigma(i) - sigma(j);
-    const double threshold =
-        kRepeatedSingularValueTolerance * std::max(std::abs(sigma(i)), std::abs(sigma(j)));
+    const double threshold = kRepeatedSingularValueTolerance * std::max(std::abs(sigma(i)), std::abs(sigma(j)));
     if (difference > threshold) {
       c.symmetric(k) = (p(i) - p(j)) / difference;
     } else {

@@ -22,8 +22,7 @@ void MaterialParameters::Validate() const {
     throw InvalidInputError(InvalidMessage("youngs_modulus", youngs_modulus, "finite and > 0 (Pa)"));
   }
   if (!(poissons_ratio > -1.0 && poissons_ratio < 0.5)) {
-    throw InvalidInputError(
-        InvalidMessage("poissons_ratio", poissons_ratio, "finite and in (-1, 0.5)"));
+    throw InvalidInputError(InvalidMessage("poissons_ratio", poissons_ratio, "finite and in (-1, 0.5)"));
   }
   if (!(std::isfinite(density) && density > 0.0)) {
     throw InvalidInputError(InvalidMessage("density", density, "finite and > 0 (kg/m^3)"));
@@ -50,11 +49,16 @@ void MaterialParameters::LameDerivatives(double* dmu_dE, double* dmu_dnu, double
 
 const char* ToString(ElasticEnergy energy) {
   switch (energy) {
-    case ElasticEnergy::kLinear: return "linear";
-    case ElasticEnergy::kCorotated: return "corotated";
-    case ElasticEnergy::kNeoHookean: return "neohookean";
-    case ElasticEnergy::kPdCorotated: return "pd-corotated";
-    case ElasticEnergy::kPdVolume: return "pd-volume";
+    case ElasticEnergy::kLinear:
+      return "linear";
+    case ElasticEnergy::kCorotated:
+      return "corotated";
+    case ElasticEnergy::kNeoHookean:
+      return "neohookean";
+    case ElasticEnergy::kPdCorotated:
+      return "pd-corotated";
+    case ElasticEnergy::kPdVolume:
+      return "pd-volume";
   }
   DIFFPD_CHECK(false, "unknown ElasticEnergy " << static_cast<int>(energy));
 }

@@ -29,8 +29,7 @@ Mat3 ProjectToUnitDeterminant(const Svd3& svd) {
 
 Mat9 UnitDeterminantProjectionDifferential(const Svd3& svd) {
   const VolumeProjection projection = ProjectSingularValuesToUnitDeterminant(svd.sigma);
-  return AssembleIsotropicDifferential(
-      svd, UnitDeterminantProjectionCoefficients(svd.sigma, projection));
+  return AssembleIsotropicDifferential(svd, UnitDeterminantProjectionCoefficients(svd.sigma, projection));
 }
 
 Vec3 ProjectToSphere(const Vec3& f, double radius) {

@@ -22,8 +22,8 @@ Mat9 RotationProjectionDifferential(const Svd3& svd);
 // |d - sigma|^2 subject to d0 d1 d2 = 1 (Lagrange conditions solved by a
 // safeguarded Newton iteration on the multiplier).
 struct VolumeProjection {
-  Vec3 d;           // projected singular values
-  double multiplier; // Lagrange multiplier of the determinant constraint
+  Vec3 d;             // projected singular values
+  double multiplier;  // Lagrange multiplier of the determinant constraint
 };
 VolumeProjection ProjectSingularValuesToUnitDeterminant(const Vec3& sigma);
 // out[i] = ProjectSingularValuesToUnitDeterminant(sigma[i]) for i < count
@@ -57,8 +57,8 @@ Mat3 UnitDeterminantProjectionJacobian(const Vec3& sigma, const VolumeProjection
 // (d_i, d_j of different signs, or one of them on the shrinking branch
 // d < sigma/2), where p jumps as sigma_i and sigma_j cross, use the divided
 // difference with a clamped denominator instead of the repeated-value limit.
-IsotropicDifferentialCoefficients UnitDeterminantProjectionCoefficients(
-    const Vec3& sigma, const VolumeProjection& projection);
+IsotropicDifferentialCoefficients UnitDeterminantProjectionCoefficients(const Vec3& sigma,
+                                                                        const VolumeProjection& projection);
 
 // Implementation notes for the declarations above (projections.cc,
 // volume_projection.cc):

@@ -106,9 +106,18 @@ void FinishSvd(Mat3 B, double det_sign_reference, int exponent, Svd3* svd) {
   Mat3& V = svd->V;
   Vec3 norms = B.colwise().squaredNorm().transpose();
   bool odd = false;
-  if (norms(0) < norms(1)) { SwapColumns(B, V, norms, 0, 1); odd = !odd; }
-  if (norms(0) < norms(2)) { SwapColumns(B, V, norms, 0, 2); odd = !odd; }
-  if (norms(1) < norms(2)) { SwapColumns(B, V, norms, 1, 2); odd = !odd; }
+  if (norms(0) < norms(1)) {
+    SwapColumns(B, V, norms, 0, 1);
+    odd = !odd;
+  }
+  if (norms(0) < norms(2)) {
+    SwapColumns(B, V, norms, 0, 2);
+    odd = !odd;
+  }
+  if (norms(1) < norms(2)) {
+    SwapColumns(B, V, norms, 1, 2);
+    odd = !odd;
+  }
   if (odd) {
     B.col(2) = -B.col(2);
     V.col(2) = -V.col(2);

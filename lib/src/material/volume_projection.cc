@@ -118,21 +118,21 @@ class ClosestRoot {
 };
 
 // Midpoint for bisection of a positive bracket: geometric when wide.
-inline double Midpoint(double lo, double hi) {
-  return hi > 4.0 * lo ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
-}
+inline double Midpoint(double lo, double hi) { return hi > 4.0 * lo ? std::sqrt(lo * hi) : 0.5 * (lo + hi); }
 
 // Root of the path's h in [lo, hi] (0 < lo <= hi) where h changes sign,
 // increasing (direction = +1) or decreasing (direction = -1) through it.
 // Newton steps, bisection whenever a step leaves the bracket.
-PathPoint FindRoot(const StationaryPath& path, double lo, double hi, double direction,
-                   double guess) {
+PathPoint FindRoot(const StationaryPath& path, double lo, double hi, double direction, double guess) {
   double t = std::clamp(guess, lo, hi);
   PathPoint p = path.Evaluate(t);
   for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
     const double f = direction * p.h;
     if (std::abs(f) <= 4.0 * kEps) break;
-    if (f < 0.0) lo = t; else hi = t;
+    if (f < 0.0)
+      lo = t;
+    else
+      hi = t;
     if (hi - lo <= 4.0 * kEps * hi) break;
     double next = t - p.h / p.dh;
     if (!(next > lo && next < hi)) next = Midpoint(lo, hi);
@@ -165,8 +165,7 @@ void GrowingBranchRoots(const StationaryPath& path, ClosestRoot* roots) {
   }
   const double hi = std::max(lo, 1.0);  // d_j >= t there, so h(1) >= 0
   const double product = std::abs(s.prod());
-  const double guess = product > 0.0 && std::isfinite(product) ? std::abs(sk) / std::cbrt(product)
-                                                               : Midpoint(lo, hi);
+  const double guess = product > 0.0 && std::isfinite(product) ? std::abs(sk) / std::cbrt(product) : Midpoint(lo, hi);
   roots->push_back(FindRoot(path, lo, hi, 1.0, guess));
 }
 
@@ -196,7 +195,10 @@ void ShrinkingBranchRoots(const StationaryPath& path, ClosestRoot* roots) {
       double lo = ta, hi = tb;  // h' changes sign between lo and hi
       for (int iteration = 0; iteration < 60 && hi - lo > 4.0 * kEps * hi; ++iteration) {
         const double mid = 0.5 * (lo + hi);
-        if ((path.Evaluate(mid).dh > 0.0) == (a.dh > 0.0)) lo = mid; else hi = mid;
+        if ((path.Evaluate(mid).dh > 0.0) == (a.dh > 0.0))
+          lo = mid;
+        else
+          hi = mid;
       }
       const PathPoint extremum = path.Evaluate(0.5 * (lo + hi));
       if ((extremum.h < 0.0) != (a.h < 0.0)) {
@@ -381,8 +383,8 @@ Mat3 UnitDeterminantProjectionJacobian(const Vec3& sigma, const VolumeProjection
   return kkt.fullPivLu().solve(rhs).topRows<3>();
 }
 
-IsotropicDifferentialCoefficients UnitDeterminantProjectionCoefficients(
-    const Vec3& sigma, const VolumeProjection& projection) {
+IsotropicDifferentialCoefficients UnitDeterminantProjectionCoefficients(const Vec3& sigma,
+                                                                        const VolumeProjection& projection) {
   const Vec3& d = projection.d;
   const Mat3 jacobian = UnitDeterminantProjectionJacobian(sigma, projection);
   IsotropicDifferentialCoefficients c = DividedDifferenceCoefficients(sigma, d, jacobian);
@@ -393,8 +395,7 @@ IsotropicDifferentialCoefficients UnitDeterminantProjectionCoefficients(
     const bool larger_i = (2.0 * d(i) - sigma(i)) * d(i) >= 0.0;
     const bool larger_j = (2.0 * d(j) - sigma(j)) * d(j) >= 0.0;
     if (same_sign && larger_i == larger_j) continue;
-    const double threshold =
-        kRepeatedSingularValueTolerance * std::max(std::abs(sigma(i)), std::abs(sigma(j)));
+    const double threshold = kRepeatedSingularValueTolerance * std::max(std::abs(sigma(i)), std::abs(sigma(j)));
     const double denominator = std::max({sigma(i) - sigma(j), threshold, DenominatorFloor(sigma)});
     c.symmetric(k) = (d(i) - d(j)) / denominator;
   }

@@ -17,7 +17,7 @@ struct GmshData {
   std::unordered_map<long, int> node_of_tag;  // tag -> index in positions
   std::vector<Vec3> positions;                // in $Nodes order
   std::optional<ElementType> type;
-  std::vector<std::vector<int>> elements;     // node indices into positions, our order
+  std::vector<std::vector<int>> elements;  // node indices into positions, our order
 };
 
 void ExpectEnd(internal::LineReader* reader, const std::string& section) {
@@ -74,8 +74,7 @@ void ReadElements(internal::LineReader* reader, GmshData* data) {
     const long count = reader->ParseInt(3, "numElementsInBlock");
     const bool keep = gmsh_type == 4 || gmsh_type == 5;
     if (dimension == 3 && !keep) {
-      reader->Fail("3D element type " + std::to_string(gmsh_type) +
-                   " is not supported (only 4 = tet4 and 5 = hex8)");
+      reader->Fail("3D element type " + std::to_string(gmsh_type) + " is not supported (only 4 = tet4 and 5 = hex8)");
     }
     const ElementType type = gmsh_type == 4 ? ElementType::kTet4 : ElementType::kHex8;
     const int k = NodesPerElement(type);
@@ -89,8 +88,8 @@ void ReadElements(internal::LineReader* reader, GmshData* data) {
       const std::string tag = reader->tokens()[0];
       if (reader->tokens().size() != static_cast<size_t>(k) + 1) {
         reader->Fail("element " + tag + " has " + std::to_string(reader->tokens().size() - 1) +
-                     " node tags, expected " + std::to_string(k) + " for type " + std::to_string(gmsh_type) +
-                     " (" + ToString(type) + ")");
+                     " node tags, expected " + std::to_string(k) + " for type " + std::to_string(gmsh_type) + " (" +
+                     ToString(type) + ")");
       }
       std::vector<int> nodes(k);
       for (int a = 0; a < k; ++a) {

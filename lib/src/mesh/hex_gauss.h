@@ -22,8 +22,7 @@ inline Eigen::Vector3d HexGaussPoint(int g) {
 inline Eigen::Matrix<double, 8, 3> HexShapeGradients(const Eigen::Vector3d& xi) {
   Eigen::Matrix<double, 8, 3> grad;
   for (int a = 0; a < 8; ++a) {
-    const Eigen::Vector3d s(((a >> 2) & 1) ? 1.0 : -1.0, ((a >> 1) & 1) ? 1.0 : -1.0,
-                            (a & 1) ? 1.0 : -1.0);
+    const Eigen::Vector3d s(((a >> 2) & 1) ? 1.0 : -1.0, ((a >> 1) & 1) ? 1.0 : -1.0, (a & 1) ? 1.0 : -1.0);
     const Eigen::Vector3d f = (Eigen::Vector3d::Ones() + s.cwiseProduct(xi));
     grad(a, 0) = s(0) * f(1) * f(2) / 8.0;
     grad(a, 1) = f(0) * s(1) * f(2) / 8.0;
@@ -34,8 +33,7 @@ inline Eigen::Matrix<double, 8, 3> HexShapeGradients(const Eigen::Vector3d& xi) 
 
 // Jacobian d x / d(xi, eta, zeta) (3 x 3) of hex element e at Gauss point g;
 // `positions` is 3 x n, `elements` 8 x m.
-inline Eigen::Matrix3d HexJacobian(const Eigen::Matrix3Xd& positions, const Eigen::MatrixXi& elements,
-                                   int e, int g) {
+inline Eigen::Matrix3d HexJacobian(const Eigen::Matrix3Xd& positions, const Eigen::MatrixXi& elements, int e, int g) {
   const Eigen::Matrix<double, 8, 3> grad = HexShapeGradients(HexGaussPoint(g));
   Eigen::Matrix3d jacobian = Eigen::Matrix3d::Zero();
   for (int a = 0; a < 8; ++a) jacobian += positions.col(elements(a, e)) * grad.row(a);

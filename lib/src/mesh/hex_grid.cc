@@ -40,8 +40,7 @@ Mesh MeshFromCells(const HexGrid& grid, const std::vector<bool>& keep) {
       for (int k = 0; k < nz; ++k) {
         if (!keep[grid.CellIndex(i, j, k)]) continue;
         for (int a = 0; a < 8; ++a) {
-          mesh.elements(a, e) =
-              vertex_of_point[grid.PointIndex(i + (a >> 2 & 1), j + (a >> 1 & 1), k + (a & 1))];
+          mesh.elements(a, e) = vertex_of_point[grid.PointIndex(i + (a >> 2 & 1), j + (a >> 1 & 1), k + (a & 1))];
         }
         ++e;
       }

@@ -11,9 +11,9 @@
 namespace diffpd::internal {
 
 struct HexGrid {
-  Eigen::Vector3d origin;    // corner of cell (0, 0, 0), metres
-  Eigen::Vector3i cells;     // number of cells per axis, each >= 1
-  Eigen::Vector3d spacing;   // cell edge lengths, metres, each > 0
+  Eigen::Vector3d origin;   // corner of cell (0, 0, 0), metres
+  Eigen::Vector3i cells;    // number of cells per axis, each >= 1
+  Eigen::Vector3d spacing;  // cell edge lengths, metres, each > 0
 
   long num_cells() const { return static_cast<long>(cells(0)) * cells(1) * cells(2); }
   // Cell (i, j, k) has index (i ny + j) nz + k.
@@ -22,9 +22,7 @@ struct HexGrid {
   long PointIndex(int i, int j, int k) const {
     return (static_cast<long>(i) * (cells(1) + 1) + j) * (cells(2) + 1) + k;
   }
-  Eigen::Vector3d Point(int i, int j, int k) const {
-    return origin + Eigen::Vector3d(i, j, k).cwiseProduct(spacing);
-  }
+  Eigen::Vector3d Point(int i, int j, int k) const { return origin + Eigen::Vector3d(i, j, k).cwiseProduct(spacing); }
   Eigen::Vector3d CellCentre(int i, int j, int k) const {
     return origin + Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5).cwiseProduct(spacing);
   }

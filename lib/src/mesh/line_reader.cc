@@ -24,8 +24,7 @@ bool ParseDouble(const std::string& token, double* value) {
   return result.ec == std::errc() && result.ptr == end && begin != end && std::isfinite(*value);
 }
 
-LineReader::LineReader(std::string path, char comment)
-    : path_(std::move(path)), comment_(comment), stream_(path_) {
+LineReader::LineReader(std::string path, char comment) : path_(std::move(path)), comment_(comment), stream_(path_) {
   if (!stream_) throw InvalidInputError("cannot open '" + path_ + "'");
 }
 

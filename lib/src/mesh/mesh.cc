@@ -43,16 +43,20 @@ double BoundingBoxVolume(const Eigen::Matrix3Xd& x, const Eigen::MatrixXi& eleme
 
 int NodesPerElement(ElementType type) {
   switch (type) {
-    case ElementType::kTet4: return 4;
-    case ElementType::kHex8: return 8;
+    case ElementType::kTet4:
+      return 4;
+    case ElementType::kHex8:
+      return 8;
   }
   DIFFPD_CHECK(false, "unknown ElementType " << static_cast<int>(type));
 }
 
 const char* ToString(ElementType type) {
   switch (type) {
-    case ElementType::kTet4: return "tet4";
-    case ElementType::kHex8: return "hex8";
+    case ElementType::kTet4:
+      return "tet4";
+    case ElementType::kHex8:
+      return "hex8";
   }
   return "unknown";
 }
@@ -71,8 +75,7 @@ void ValidateMesh(const Mesh& mesh, const std::string& what) {
   if (m == 0) Fail(what, "the mesh has no elements");
   if (mesh.elements.rows() != k) {
     std::ostringstream s;
-    s << "elements must have " << k << " rows for " << ToString(mesh.type) << ", got "
-      << mesh.elements.rows();
+    s << "elements must have " << k << " rows for " << ToString(mesh.type) << ", got " << mesh.elements.rows();
     Fail(what, s.str());
   }
   for (int v = 0; v < n; ++v) {
@@ -86,8 +89,7 @@ void ValidateMesh(const Mesh& mesh, const std::string& what) {
       const int v = mesh.elements(a, e);
       if (v < 0 || v >= n) {
         std::ostringstream s;
-        s << "element " << e << " references vertex " << v << ", but the mesh has " << n
-          << " vertices";
+        s << "element " << e << " references vertex " << v << ", but the mesh has " << n << " vertices";
         Fail(what, s.str());
       }
       for (int b = 0; b < a; ++b) {

@@ -40,8 +40,8 @@ SurfaceMesh ReadObj(const std::string& path) {
         if (index < 0) {
           const long count = static_cast<long>(vertices.size());
           if (-index > count) {
-            reader.Fail("face index " + std::to_string(index) + " out of range (" +
-                        std::to_string(count) + " vertices read before this line)");
+            reader.Fail("face index " + std::to_string(index) + " out of range (" + std::to_string(count) +
+                        " vertices read before this line)");
           }
           index = count + index + 1;  // to 1-based
         }
@@ -61,8 +61,8 @@ SurfaceMesh ReadObj(const std::string& path) {
     for (const FaceCorner& corner : face) {
       if (corner.index > n) {
         throw InvalidInputError(path + ":" + std::to_string(corner.line) + ": face index " +
-                                std::to_string(corner.index) + " out of range (file has " +
-                                std::to_string(n) + " vertices)");
+                                std::to_string(corner.index) + " out of range (file has " + std::to_string(n) +
+                                " vertices)");
       }
     }
     for (size_t c = 1; c + 1 < face.size(); ++c) {

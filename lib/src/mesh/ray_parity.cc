@@ -56,8 +56,7 @@ void CollectCrossings(const SurfaceMesh& surface, const HexGrid& grid, int d,
     const int cv0 = first(lo(1), v), cv1 = last(hi(1), v, nv);
     for (int cu = cu0; cu <= cu1; ++cu) {
       for (int cv = cv0; cv <= cv1; ++cv) {
-        const Vec2 q(grid.origin(u) + (cu + 0.5) * grid.spacing(u),
-                     grid.origin(v) + (cv + 0.5) * grid.spacing(v));
+        const Vec2 q(grid.origin(u) + (cu + 0.5) * grid.spacing(u), grid.origin(v) + (cv + 0.5) * grid.spacing(v));
         double w[3];  // w[c]: edge opposite corner c, scaled to be positive inside
         bool inside = true;
         for (int c = 0; c < 3 && inside; ++c) {

@@ -25,8 +25,7 @@ std::string FindOnPath(const std::string& program) {
     if (directory.empty()) directory = ".";
     const std::string candidate = directory + "/" + program;
     struct stat info;
-    if (stat(candidate.c_str(), &info) == 0 && S_ISREG(info.st_mode) &&
-        access(candidate.c_str(), X_OK) == 0) {
+    if (stat(candidate.c_str(), &info) == 0 && S_ISREG(info.st_mode) && access(candidate.c_str(), X_OK) == 0) {
       return candidate;
     }
   }

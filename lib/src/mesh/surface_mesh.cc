@@ -56,8 +56,7 @@ void ValidateWatertight(const SurfaceMesh& surface, const std::string& what) {
       const int v = surface.triangles(c, t);
       std::ostringstream s;
       if (v < 0 || v >= n) {
-        s << what << ": triangle " << t << " references vertex " << v << ", but the surface has " << n
-          << " vertices";
+        s << what << ": triangle " << t << " references vertex " << v << ", but the surface has " << n << " vertices";
         throw InvalidInputError(s.str());
       }
       if (surface.triangles((c + 1) % 3, t) == v) {
@@ -71,9 +70,8 @@ void ValidateWatertight(const SurfaceMesh& surface, const std::string& what) {
       const bool forward = u < v;
       if (use.count == 1 && use.first_forward == forward) {
         std::ostringstream s;
-        s << what << ": edge (" << std::min(u, v) << ", " << std::max(u, v)
-          << ") has the same direction in triangles " << use.first_triangle << " and " << t
-          << " (inconsistent orientation)";
+        s << what << ": edge (" << std::min(u, v) << ", " << std::max(u, v) << ") has the same direction in triangles "
+          << use.first_triangle << " and " << t << " (inconsistent orientation)";
         throw InvalidInputError(s.str());
       }
       if (use.count == 0) {

@@ -36,8 +36,8 @@ void ReadItemNumber(const LineReader& reader, const char* name, long item, long*
 }
 
 [[noreturn]] void FailShort(const LineReader& reader, long read, long count, const char* items) {
-  throw InvalidInputError(reader.path() + ": file ends after " + std::to_string(read) + " of " +
-                          std::to_string(count) + " " + items);
+  throw InvalidInputError(reader.path() + ": file ends after " + std::to_string(read) + " of " + std::to_string(count) +
+                          " " + items);
 }
 
 }  // namespace

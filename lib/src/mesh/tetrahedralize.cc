@@ -64,8 +64,8 @@ void WriteSmesh(const fs::path& path, const SurfaceMesh& surface) {
   out.precision(17);
   out << surface.vertices.cols() << " 3 0 0\n";
   for (int v = 0; v < surface.vertices.cols(); ++v) {
-    out << v + 1 << ' ' << surface.vertices(0, v) << ' ' << surface.vertices(1, v) << ' '
-        << surface.vertices(2, v) << '\n';
+    out << v + 1 << ' ' << surface.vertices(0, v) << ' ' << surface.vertices(1, v) << ' ' << surface.vertices(2, v)
+        << '\n';
   }
   out << surface.triangles.cols() << " 0\n";
   for (int t = 0; t < surface.triangles.cols(); ++t) {
@@ -139,8 +139,8 @@ Mesh TetrahedralizeSurface(const SurfaceMesh& surface, const std::string& switch
   const fs::path node = directory.path() / "surface.1.node";
   const fs::path ele = directory.path() / "surface.1.ele";
   if (!fs::exists(node) || !fs::exists(ele)) {
-    throw std::runtime_error("tetgen with switches '" + switches + "' wrote no surface.1.node/.ele: " +
-                             Tail(result.output, 5));
+    throw std::runtime_error("tetgen with switches '" + switches +
+                             "' wrote no surface.1.node/.ele: " + Tail(result.output, 5));
   }
   Mesh mesh = internal::ReadTetGenFiles(node.string(), ele.string());
   for (int e = 0; e < mesh.num_elements(); ++e) {

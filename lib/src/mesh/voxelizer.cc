@@ -23,8 +23,8 @@ void CheckSpacing(const char* function, const char* name, double value) {
 
 }  // namespace
 
-Mesh VoxelizeSdf(const std::function<double(const Vec3&)>& sdf, const Vec3& origin,
-                 const Eigen::Vector3i& cells, double dx) {
+Mesh VoxelizeSdf(const std::function<double(const Vec3&)>& sdf, const Vec3& origin, const Eigen::Vector3i& cells,
+                 double dx) {
   if (!sdf) throw InvalidInputError("VoxelizeSdf: sdf is empty");
   CheckSpacing("VoxelizeSdf", "dx", dx);
   for (int d = 0; d < 3; ++d) {
@@ -86,9 +86,8 @@ Mesh VoxelizeSurface(const SurfaceMesh& surface, double dx, double scale) {
   for (bool inside : keep) any = any || inside;
   if (!any) {
     std::ostringstream s;
-    s << "VoxelizeSurface: no cell centre lies inside the surface (dx = " << dx << ", grid "
-      << cells(0) << " x " << cells(1) << " x " << cells(2)
-      << " cells); use a smaller dx or check that the surface is closed";
+    s << "VoxelizeSurface: no cell centre lies inside the surface (dx = " << dx << ", grid " << cells(0) << " x "
+      << cells(1) << " x " << cells(2) << " cells); use a smaller dx or check that the surface is closed";
     throw InvalidInputError(s.str());
   }
   return internal::MeshFromCells(grid, keep);

@@ -108,8 +108,7 @@ void CholmodSolver::MakeCopy() {
       for (int j = super[s]; j < super[s + 1]; ++j) node_of_column[j] = static_cast<int>(s);
   }
   copy_ = ParallelTriangularSolve::Create(
-      n, static_cast<const int*>(f->Perm), [&](int j) { return FactorColumn(*f, node_of_column, j); },
-      solve_threads_);
+      n, static_cast<const int*>(f->Perm), [&](int j) { return FactorColumn(*f, node_of_column, j); }, solve_threads_);
 }
 
 void CholmodSolver::set_solve_threads(int threads) {

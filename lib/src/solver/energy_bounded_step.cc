@@ -28,8 +28,8 @@ VectorXd SolveEnergyBounded(StepObjective& objective, const VectorXd& predicted,
   // convexity near its minimum, g(x) - g(x*) <= |grad g(x)| |x - x*|) and by
   // g's rounding (x_i itself nearly optimal: a body at rest). Only a larger
   // excess is a far stationary point.
-  const double slack = report->final_residual * (x - previous).norm() +
-                       kRoundingSlack * (std::abs(value) + std::abs(previous_value));
+  const double slack =
+      report->final_residual * (x - previous).norm() + kRoundingSlack * (std::abs(value) + std::abs(previous_value));
   if (value <= previous_value + slack) return x;
   // A stationary point above the previous total energy: descend from x_i.
   objective.SetReferenceResidual(report->initial_residual);

@@ -17,8 +17,8 @@ class HessianAssembler {
   // *h = diag(diagonal) + sum_e K_e, with every row and column of a fixed DoF
   // replaced by the identity's. `blocks` holds the (3K)^2 column-major element
   // matrices (local DoF 3a + i) one after another; `fixed` has 3n flags.
-  void Assemble(const std::vector<double>& blocks, const VectorXd& diagonal,
-                const std::vector<char>& fixed, SparseMatrix* h) const;
+  void Assemble(const std::vector<double>& blocks, const VectorXd& diagonal, const std::vector<char>& fixed,
+                SparseMatrix* h) const;
 
  private:
   int k_ = 0;

@@ -60,9 +60,8 @@ LineSearchResult BacktrackingLineSearch(StepObjective& objective, const VectorXd
   if (options.accept_rounding_floor && grad->norm() <= StepObjective::kRoundingFloorStall * floor)
     return LineSearchResult{options.max_line_search_steps, true};
   std::ostringstream msg;
-  msg << ToString(options.method) << ": the line search found no decrease of g after "
-      << options.max_line_search_steps << " halvings (|grad g| = " << grad->norm()
-      << ", estimated rounding floor " << floor << ")";
+  msg << ToString(options.method) << ": the line search found no decrease of g after " << options.max_line_search_steps
+      << " halvings (|grad g| = " << grad->norm() << ", estimated rounding floor " << floor << ")";
   throw SolverError(SolverStatus::kLineSearchFailed, msg.str());
 }
 

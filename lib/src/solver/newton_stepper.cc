@@ -31,7 +31,8 @@ VectorXd SolveNewtonSystem(SimulatorImpl& sim, const SparseMatrix& h, const Vect
       ok = cg.info() == Eigen::Success;
     }
     if (!ok)
-      throw SolverError(SolverStatus::kDiverged, "newton-pcg: the conjugate-gradient solve did not reach its tolerance");
+      throw SolverError(SolverStatus::kDiverged,
+                        "newton-pcg: the conjugate-gradient solve did not reach its tolerance");
     return dx;
   }
   CholmodSolver& llt = sim.newton_solver();

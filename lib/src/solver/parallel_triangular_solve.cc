@@ -333,14 +333,30 @@ DIFFPD_SIMD_INLINE void BackwardBlock(const double* tri, const int* rows, const 
 static_assert(ParallelTriangularSolve::kBlockWidth == 8, "the switches cover widths 1..8");
 #define DIFFPD_WIDTH_CASES(CALL) \
   switch (w) {                   \
-    case 1: CALL(1); break;      \
-    case 2: CALL(2); break;      \
-    case 3: CALL(3); break;      \
-    case 4: CALL(4); break;      \
-    case 5: CALL(5); break;      \
-    case 6: CALL(6); break;      \
-    case 7: CALL(7); break;      \
-    default: CALL(8); break;     \
+    case 1:                      \
+      CALL(1);                   \
+      break;                     \
+    case 2:                      \
+      CALL(2);                   \
+      break;                     \
+    case 3:                      \
+      CALL(3);                   \
+      break;                     \
+    case 4:                      \
+      CALL(4);                   \
+      break;                     \
+    case 5:                      \
+      CALL(5);                   \
+      break;                     \
+    case 6:                      \
+      CALL(6);                   \
+      break;                     \
+    case 7:                      \
+      CALL(7);                   \
+      break;                     \
+    default:                     \
+      CALL(8);                   \
+      break;                     \
   }
 
 template <int K>
@@ -395,20 +411,36 @@ DIFFPD_SIMD_INLINE void BackwardBlocksK(const FactorArrays& f, int first, int la
 DIFFPD_SIMD_CLONES
 void ForwardBlocks(int k_rhs, const FactorArrays& f, int first, int last, double* y, double* top_buffer) {
   switch (k_rhs) {
-    case 1: ForwardBlocksK<1>(f, first, last, y, top_buffer); break;
-    case 2: ForwardBlocksK<2>(f, first, last, y, top_buffer); break;
-    case 3: ForwardBlocksK<3>(f, first, last, y, top_buffer); break;
-    default: ForwardBlocksK<4>(f, first, last, y, top_buffer); break;
+    case 1:
+      ForwardBlocksK<1>(f, first, last, y, top_buffer);
+      break;
+    case 2:
+      ForwardBlocksK<2>(f, first, last, y, top_buffer);
+      break;
+    case 3:
+      ForwardBlocksK<3>(f, first, last, y, top_buffer);
+      break;
+    default:
+      ForwardBlocksK<4>(f, first, last, y, top_buffer);
+      break;
   }
 }
 
 DIFFPD_SIMD_CLONES
 void BackwardBlocks(int k_rhs, const FactorArrays& f, int first, int last, double* y) {
   switch (k_rhs) {
-    case 1: BackwardBlocksK<1>(f, first, last, y); break;
-    case 2: BackwardBlocksK<2>(f, first, last, y); break;
-    case 3: BackwardBlocksK<3>(f, first, last, y); break;
-    default: BackwardBlocksK<4>(f, first, last, y); break;
+    case 1:
+      BackwardBlocksK<1>(f, first, last, y);
+      break;
+    case 2:
+      BackwardBlocksK<2>(f, first, last, y);
+      break;
+    case 3:
+      BackwardBlocksK<3>(f, first, last, y);
+      break;
+    default:
+      BackwardBlocksK<4>(f, first, last, y);
+      break;
   }
 }
 
@@ -417,7 +449,7 @@ void BackwardBlocks(int k_rhs, const FactorArrays& f, int first, int last, doubl
 template <int K>
 void ParallelTriangularSolve::SolveColumns(const double* b, double* x) const {
   static_assert(K >= 1 && K <= 4, "1 to 4 right-hand sides per solve");
-  const FactorArrays f{blocks_.data(), triangle_.data(), rows_.data(),
+  const FactorArrays f{blocks_.data(), triangle_.data(),      rows_.data(),
                        values_.data(), values_by_row_.data(), top_slot_.data()};
   const int n = n_;
   std::vector<double> y(static_cast<size_t>(K) * n);
@@ -455,8 +487,7 @@ void ParallelTriangularSolve::SolveColumns(const double* b, double* x) const {
 #pragma omp parallel num_threads(threads)
     {
       for (int t = omp_get_thread_num(); t < threads; t += omp_get_num_threads())
-        for (const int task : thread_tasks_[t])
-          BackwardBlocks(K, f, tasks_[task].first, tasks_[task].second, y.data());
+        for (const int task : thread_tasks_[t]) BackwardBlocks(K, f, tasks_[task].first, tasks_[task].second, y.data());
     }
   }
   for (int i = 0; i < n; ++i)

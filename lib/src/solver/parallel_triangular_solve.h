@@ -63,14 +63,14 @@ class ParallelTriangularSolve {
   // Up to kBlockWidth consecutive columns of one supernode: their triangle
   // and the rectangle of rows below it (layout: the solve kernels').
   struct Block {
-    int col;           // first column
-    int width;         // columns, <= kBlockWidth
-    int num_rows;      // rows below the triangle, ascending
-    int num_own_rows;  // in a subtree task: the leading rows inside its subtree
-    long rows_at;      // into rows_
-    long values_at;    // into values_: num_rows x width, column-major, columns zero-padded to a multiple of 8 rows
+    int col;                // first column
+    int width;              // columns, <= kBlockWidth
+    int num_rows;           // rows below the triangle, ascending
+    int num_own_rows;       // in a subtree task: the leading rows inside its subtree
+    long rows_at;           // into rows_
+    long values_at;         // into values_: num_rows x width, column-major, columns zero-padded to a multiple of 8 rows
     long values_by_row_at;  // into values_by_row_: the same entries num_rows x width, row-major
-    long triangle_at;  // into triangle_: width x width, column-major, 1 / L(k, k) on the diagonal
+    long triangle_at;       // into triangle_: width x width, column-major, 1 / L(k, k) on the diagonal
   };
 
  private:

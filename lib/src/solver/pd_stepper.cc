@@ -19,7 +19,8 @@ namespace diffpd::internal {
 VectorXd PdSolve(StepObjective& objective, const VectorXd& x0, StepReport* report) {
   SimulatorImpl& sim = objective.sim();
   if (!sim.elastic.all_projective())
-    throw InvalidInputError("method pd needs projective energies only (pd-corotated, pd-volume); use pd-lbfgs or newton");
+    throw InvalidInputError(
+        "method pd needs projective energies only (pd-corotated, pd-volume); use pd-lbfgs or newton");
   PdSystem& pd = sim.pd_system();
   VectorXd x = x0;
   VectorXd grad;
@@ -46,8 +47,8 @@ VectorXd NewtonFallback(StepObjective& objective, const VectorXd& x, const Solve
   try {
     out = NewtonSolve(objective, x, &newton);
   } catch (const SolverError& e) {
-    throw SolverError(e.status(), std::string("Newton fallback of ") + e.what() + "; Newton took over after: " +
-                                      stall.what());
+    throw SolverError(e.status(),
+                      std::string("Newton fallback of ") + e.what() + "; Newton took over after: " + stall.what());
   }
   AppendSolve(newton, report);
   report->newton_fallback = true;

@@ -27,7 +27,6 @@ CholmodLayout PdFactorLayout(int num_nodes) {
 
 }  // namespace
 
-
 namespace {
 
 // sum_{e : keep(e)} L_e in the pattern of the whole mesh's Laplacian (the
@@ -88,7 +87,9 @@ PdSystem::PdSystem(const FemModel& fem, const std::vector<char>& fixed, const st
     for (size_t g = 0; g < groups_.size(); ++g)
       if (groups_[g].fixed_node == mask) found = static_cast<int>(g);
     if (found < 0) {
-      groups_.push_back(Group{{}, mask, SparseMatrix(),
+      groups_.push_back(Group{{},
+                              mask,
+                              SparseMatrix(),
                               std::make_unique<CholmodSolver>(PdFactorLayout(n), CholmodOrdering::kNestedDissection,
                                                               CholmodSolveKernel::kParallelCopy)});
       found = static_cast<int>(groups_.size()) - 1;

@@ -97,7 +97,7 @@ class PdSystem {
   std::vector<double> densities_, weights_;
   int num_factorizations_ = 0;
   double factorization_seconds_ = 0;
-  SparseMatrix auxiliary_;                 // 0 x 0 when none
+  SparseMatrix auxiliary_;  // 0 x 0 when none
   std::vector<int> active_nodes_;
   ContactLinearSolve active_mode_ = ContactLinearSolve::kWoodbury;
   std::vector<ActiveSetErasure> erasures_;  // per group, while active_nodes_ is set

@@ -104,8 +104,10 @@ class ConjugateGradientColumn final : public ColumnIteration {
   const VectorXd& PreconditionerInput() override { return r_; }
   ColumnStatus Advance(const VectorXd& s) override {
     const double rs = r_.dot(s);
-    if (p_.size() == 0) p_ = s;
-    else p_ = s + (rs / rs_) * p_;
+    if (p_.size() == 0)
+      p_ = s;
+    else
+      p_ = s + (rs / rs_) * p_;
     rs_ = rs;
     const VectorXd hp = apply_h_(p_);
     const double curvature = p_.dot(hp);
@@ -128,7 +130,8 @@ std::unique_ptr<ColumnIteration> MakeColumn(const PreconditionedSolveOptions& op
       return std::make_unique<FixedPointColumn>(b, options.rel_tolerance, apply_h);
     case PdBackwardMethod::kLbfgs:
       return std::make_unique<LbfgsColumn>(b, options.rel_tolerance, apply_h, options.lbfgs_history);
-    case PdBackwardMethod::kConjugateGradient: break;
+    case PdBackwardMethod::kConjugateGradient:
+      break;
   }
   return std::make_unique<ConjugateGradientColumn>(b, options.rel_tolerance, apply_h);
 }
@@ -162,8 +165,10 @@ void SolvePreconditioned(const PreconditionedSolveOptions& options, const Matrix
     for (int j = 0; j < na; ++j) {
       const int c = active[j];
       const ColumnStatus status = column[c]->Advance(preconditioned.col(j));
-      if (status == ColumnStatus::kConverged) (*ok)[c] = 1;
-      else if (status == ColumnStatus::kRunning) still.push_back(c);
+      if (status == ColumnStatus::kConverged)
+        (*ok)[c] = 1;
+      else if (status == ColumnStatus::kRunning)
+        still.push_back(c);
     }
     active.swap(still);
   }

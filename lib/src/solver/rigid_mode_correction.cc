@@ -28,7 +28,7 @@ RigidModeCorrection::RigidModeCorrection(const VectorXd& x, const std::vector<ch
   for (Eigen::Index i = 0; i < n; ++i) {
     const Vec3 p = x.segment<3>(3 * i) - centre;
     for (int a = 0; a < 3; ++a) {
-      uncut_(3 * i + a, a) = 1;                                  // translation along a
+      uncut_(3 * i + a, a) = 1;                                   // translation along a
       uncut_.block<3, 1>(3 * i, 3 + a) = Vec3::Unit(a).cross(p);  // rotation about a
     }
   }
@@ -69,7 +69,8 @@ MatrixXd RigidModeHessianProducts(SimulatorImpl& sim, const RigidModeCorrection&
   const Eigen::Index dofs = x.size();
   const int k = RigidModeCorrection::kModes;
   const MatrixXd& uncut = rigid.uncut_modes();
-  DIFFPD_CHECK(elastic_gradient.size() == dofs, "RigidModeHessianProducts: gradient of size " << elastic_gradient.size());
+  DIFFPD_CHECK(elastic_gradient.size() == dofs,
+               "RigidModeHessianProducts: gradient of size " << elastic_gradient.size());
   // Elastic part on the uncut modes, from the frame indifference of E (rows
   // of fixed DoFs are zeroed at the end).
   MatrixXd h = MatrixXd::Zero(dofs, k);

@@ -18,9 +18,7 @@ namespace {
 using internal::SimulatorImpl;
 using Clock = std::chrono::steady_clock;
 
-double Seconds(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+double Seconds(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 void CheckVector(const VectorXd& v, Eigen::Index size, const char* name, bool allow_empty) {
   if (allow_empty && v.size() == 0) return;
@@ -112,8 +110,9 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
   State next;
   if (sim.options.method == Method::kSemiImplicit) {
     if (!sim.scene.frictional_contacts.empty())
-      throw InvalidInputError("semi-implicit: frictional contact needs an implicit method (newton-cholesky, "
-                              "newton-pcg, pd, pd-lbfgs); use penalty contact instead");
+      throw InvalidInputError(
+          "semi-implicit: frictional contact needs an implicit method (newton-cholesky, "
+          "newton-pcg, pd, pd-lbfgs); use penalty contact instead");
     VectorXd grad;
     sim.elastic.EnergyAndGradient(state.x, sim.lame(), &grad, sim.threads());
     sim.aux.AddEnergyAndGradient(state.x, sim.activation, &grad);
@@ -124,10 +123,14 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
                                                   StepReport* r) -> VectorXd {
       switch (sim.options.method) {
         case Method::kNewtonCholesky:
-        case Method::kNewtonPcg: return internal::NewtonSolve(objective, x0, r);
-        case Method::kPd: return internal::PdSolve(objective, x0, r);
-        case Method::kPdLbfgs: return internal::PdLbfgsSolve(objective, x0, r);
-        case Method::kSemiImplicit: break;
+        case Method::kNewtonPcg:
+          return internal::NewtonSolve(objective, x0, r);
+        case Method::kPd:
+          return internal::PdSolve(objective, x0, r);
+        case Method::kPdLbfgs:
+          return internal::PdLbfgsSolve(objective, x0, r);
+        case Method::kSemiImplicit:
+          break;
       }
       return x0;
     };
@@ -263,8 +266,7 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
       out.external_force[i] = w;
     }
     // Explicit state forces f(x_i, v_i; M): dL/df = out.external_force[i].
-    sim.state_forces.AddVjp(s0.x, s0.v, mass, out.external_force[i], &gx_prev, &gv_prev, &out.state_forces,
-                            &dmass);
+    sim.state_forces.AddVjp(s0.x, s0.v, mass, out.external_force[i], &gx_prev, &gv_prev, &out.state_forces, &dmass);
     if (loss.dx[i].size()) gx_prev += loss.dx[i];
     if (loss.dv[i].size()) gv_prev += loss.dv[i];
     gx = std::move(gx_prev);

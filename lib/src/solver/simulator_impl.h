@@ -31,10 +31,10 @@ class SimulatorImpl {
   // Material parts (scene/material_regions.h): part 0 the base material,
   // part r + 1 material region r. Empty without regions (one part).
   std::vector<int> part_of_element;
-  MassModel mass_model;       // M from every part's density
+  MassModel mass_model;  // M from every part's density
   ElasticForces elastic;
-  AuxiliaryEnergies aux;      // muscles, penalty contact (empty: no cost)
-  StateForces state_forces;   // damping, hydrodynamics, penalty friction
+  AuxiliaryEnergies aux;     // muscles, penalty contact (empty: no cost)
+  StateForces state_forces;  // damping, hydrodynamics, penalty friction
   // Muscle activation of the step being solved or differentiated (empty:
   // rest). Step, Backward and SolveQuasiStatic set it (ActivationScope in
   // forces/activation_scope.h); anything else building a StepObjective or
@@ -44,7 +44,7 @@ class SimulatorImpl {
   // added (and their pins to fixed_values) by ContactPinScope
   // (contact/contact_pin_scope.h), and removed after.
   std::vector<char> fixed;
-  VectorXd fixed_values;    // 3n, Dirichlet positions (zero at free DoFs)
+  VectorXd fixed_values;  // 3n, Dirichlet positions (zero at free DoFs)
 
   double h() const { return options.time_step; }
   int threads() const { return options.num_threads; }
@@ -178,7 +178,7 @@ class StepObjective {
   bool checkpoint_stopped_ = false;
   double reference_residual_ = -1;
   double rounding_floor_ = -1;  // not computed yet
-  VectorXd last_x_;  // the latest successful Evaluate's point and value
+  VectorXd last_x_;             // the latest successful Evaluate's point and value
   double last_value_ = 0;
   bool have_last_ = false;
 };

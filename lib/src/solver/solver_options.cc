@@ -20,11 +20,16 @@ template <class T>
 
 const char* ToString(Method method) {
   switch (method) {
-    case Method::kSemiImplicit: return "semi-implicit";
-    case Method::kNewtonCholesky: return "newton-cholesky";
-    case Method::kNewtonPcg: return "newton-pcg";
-    case Method::kPd: return "pd";
-    case Method::kPdLbfgs: return "pd-lbfgs";
+    case Method::kSemiImplicit:
+      return "semi-implicit";
+    case Method::kNewtonCholesky:
+      return "newton-cholesky";
+    case Method::kNewtonPcg:
+      return "newton-pcg";
+    case Method::kPd:
+      return "pd";
+    case Method::kPdLbfgs:
+      return "pd-lbfgs";
   }
   return "unknown";
 }

@@ -78,8 +78,7 @@ bool StepLinearization::DirectSolve(const VectorXd& b, VectorXd* z) {
   return z->allFinite();
 }
 
-void StepLinearization::IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, std::vector<char>* ok,
-                                              int* iterations) {
+void StepLinearization::IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, std::vector<char>* ok, int* iterations) {
   PdSystem& pd = sim_.pd_system();
   const SolverOptions& opt = sim_.options;
   MatrixXd rhs = b;
@@ -150,7 +149,8 @@ VectorXd StepLinearization::Solve(const VectorXd& b, BackwardReport* report) {
   if (iterative) {
     if (report) ++report->fallbacks;
     if (sim_.options.verbosity >= 1)
-      std::fprintf(stderr, "%s backward: iterative adjoint solve failed after %d iterations; falling back to a direct solve\n",
+      std::fprintf(stderr,
+                   "%s backward: iterative adjoint solve failed after %d iterations; falling back to a direct solve\n",
                    ToString(m), iterations);
   }
   if (!DirectSolve(b, &z))

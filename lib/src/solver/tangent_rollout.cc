@@ -117,8 +117,8 @@ void CheckDirections(const std::vector<InputDirection>& dirs, int n, int steps, 
     for (const VectorXd& f : d.external_force) CheckDirectionVector(f, n, ip, "external_force");
     if (!d.activation.empty() && static_cast<int>(d.activation.size()) != steps) {
       std::ostringstream msg;
-      msg << "Tangents: direction " << p << " has activation for " << d.activation.size()
-          << " steps, expected 0 or " << steps;
+      msg << "Tangents: direction " << p << " has activation for " << d.activation.size() << " steps, expected 0 or "
+          << steps;
       throw InvalidInputError(msg.str());
     }
     for (const VectorXd& a : d.activation) {
@@ -304,9 +304,10 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
         // Pinned nodes follow their pins; move their coupling to the right.
         for (const int node : pinned) {
           DIFFPD_CHECK(surface_of[node] != nullptr, "pinned node " << node << " is not a frictional contact candidate");
-          const internal::ContactPin pin = internal::ComputeContactPin(
-              *surface_of[node], s0.x.segment<3>(3 * node), s0.v.segment<3>(3 * node), h);
-          dpin.middleRows<3>(3 * node) = pin.d_dx * dx0.middleRows<3>(3 * node) + pin.d_dv * dv0.middleRows<3>(3 * node);
+          const internal::ContactPin pin =
+              internal::ComputeContactPin(*surface_of[node], s0.x.segment<3>(3 * node), s0.v.segment<3>(3 * node), h);
+          dpin.middleRows<3>(3 * node) =
+              pin.d_dx * dx0.middleRows<3>(3 * node) + pin.d_dv * dv0.middleRows<3>(3 * node);
         }
         internal::StepLinearization coupling(sim, s1.x);  // pinned nodes still free here
         for (int p = 0; p < num_dirs; ++p) b.col(p) -= coupling.ApplyUnmasked(dpin.col(p));

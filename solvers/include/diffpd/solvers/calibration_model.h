@@ -123,13 +123,13 @@ struct CalibrationSetup {
 
 // Counters and timings since construction (or ResetStatistics()).
 struct CalibrationStatistics {
-  int rollouts = 0;            // forward simulations (new evaluation points)
-  int jacobians = 0;           // Jacobian evaluations
-  int gradients = 0;           // scalar-loss gradients (one adjoint each)
-  int failures = 0;            // points where the rollout or a derivative failed
-  double forward_seconds = 0;  // simulating
-  double backward_seconds = 0; // tangents / adjoints
-  std::string last_error;      // message of the latest failure
+  int rollouts = 0;             // forward simulations (new evaluation points)
+  int jacobians = 0;            // Jacobian evaluations
+  int gradients = 0;            // scalar-loss gradients (one adjoint each)
+  int failures = 0;             // points where the rollout or a derivative failed
+  double forward_seconds = 0;   // simulating
+  double backward_seconds = 0;  // tangents / adjoints
+  std::string last_error;       // message of the latest failure
 };
 
 // A scalar loss of a rollout: returns L and sets dL/dx_k, dL/dv_k (gradient

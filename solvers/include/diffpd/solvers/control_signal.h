@@ -13,7 +13,7 @@ namespace diffpd::solvers {
 class ControlSignal {
  public:
   virtual ~ControlSignal() = default;
-  virtual int num_coefficients() const = 0;  // p
+  virtual int num_coefficients() const = 0;     // p
   int num_steps() const { return num_steps_; }  // K
   // True when s = B c for a constant K x p matrix B (then Jacobian() is B).
   virtual bool is_linear() const = 0;

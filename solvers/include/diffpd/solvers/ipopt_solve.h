@@ -34,16 +34,16 @@ struct IpoptOptions {
 
 struct IpoptSummary {
   Ipopt::ApplicationReturnStatus status = Ipopt::Internal_Error;
-  std::string status_name;        // e.g. "Solve_Succeeded", "Infeasible_Problem_Detected"
-  double initial_objective = 0;   // at the starting point (NaN if its rollout failed)
-  double objective = 0;           // at the returned point (NaN if its rollout failed)
-  double constraint_violation = 0;// max violation of constraints and bounds at the returned point
-  int iterations = 0;             // Ipopt iterations
-  long evaluations = 0;           // rollouts (forward simulations), one per evaluation point
-  long backward_passes = 0;       // adjoint passes
-  double forward_seconds = 0;     // in Simulator::Simulate during the solve
-  double backward_seconds = 0;    // in Simulator::Backward during the solve
-  double total_seconds = 0;       // wall time of the whole solve
+  std::string status_name;          // e.g. "Solve_Succeeded", "Infeasible_Problem_Detected"
+  double initial_objective = 0;     // at the starting point (NaN if its rollout failed)
+  double objective = 0;             // at the returned point (NaN if its rollout failed)
+  double constraint_violation = 0;  // max violation of constraints and bounds at the returned point
+  int iterations = 0;               // Ipopt iterations
+  long evaluations = 0;             // rollouts (forward simulations), one per evaluation point
+  long backward_passes = 0;         // adjoint passes
+  double forward_seconds = 0;       // in Simulator::Simulate during the solve
+  double backward_seconds = 0;      // in Simulator::Backward during the solve
+  double total_seconds = 0;         // wall time of the whole solve
   // The returned point: Ipopt's, or, when Ipopt ended without success at a
   // point that is infeasible or worse than the best feasible point it
   // evaluated, that best feasible point (returned_best_feasible = true);
@@ -52,11 +52,11 @@ struct IpoptSummary {
   VectorXd x;
   bool returned_best_feasible = false;
   std::vector<double> objective_history;  // objective per Ipopt iteration (0 = start)
-  std::string log;                // Ipopt's output at the chosen print_level
+  std::string log;                        // Ipopt's output at the chosen print_level
   // From derivative_test output: -1 if it did not run, else the number of
   // errors Ipopt's derivative checker reported (0 = "No errors detected").
   int derivative_checker_errors = -1;
-  std::string last_error;         // the NLP's last evaluation failure, if any
+  std::string last_error;  // the NLP's last evaluation failure, if any
 
   // Ipopt found a (locally) optimal or acceptable point.
   bool succeeded() const;
