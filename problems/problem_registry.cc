@@ -1,17 +1,17 @@
 #include "problem_registry.h"
 
-#include "bouncing_ball.h"
-#include "calibrate_bouncing_ball.h"
-#include "calibrate_plant.h"
-#include "calibrate_starfish.h"
-#include "bunny.h"
-#include "cantilever.h"
-#include "routing_tendon_opt.h"
-#include "cantilever_plane.h"
+#include "scenes/bouncing_ball.h"
+#include "calibration/calibrate_bouncing_ball.h"
+#include "calibration/calibrate_plant.h"
+#include "calibration/calibrate_starfish.h"
+#include "control/bunny.h"
+#include "scenes/cantilever.h"
+#include "control/routing_tendon_opt.h"
+#include "scenes/cantilever_plane.h"
 #include "diffpd/error.h"
-#include "locomotion.h"
-#include "rolling_sphere.h"
-#include "routing_tendon.h"
+#include "control/locomotion.h"
+#include "scenes/rolling_sphere.h"
+#include "scenes/routing_tendon.h"
 
 namespace diffpd::problems {
 

@@ -11,7 +11,7 @@
 #include "diffpd/simulator.h"
 #include "diffpd/state_forces.h"
 #include "diffpd/voxelizer.h"
-#include "gradcheck.h"
+#include "tools/gradcheck.h"
 #include "test_scenes.h"
 
 namespace diffpd {

@@ -13,7 +13,7 @@
 #include "diffpd/simulator.h"
 #include "fem/fem_model.h"
 #include "fem/muscle_forces.h"
-#include "gradcheck.h"
+#include "tools/gradcheck.h"
 #include "test_scenes.h"
 
 namespace diffpd {

@@ -10,7 +10,7 @@
 #include "diffpd/state_forces.h"
 #include "fem/fem_model.h"
 #include "forces/state_forces.h"
-#include "gradcheck.h"
+#include "tools/gradcheck.h"
 #include "test_scenes.h"
 
 namespace diffpd {

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "diffpd/simulator.h"
-#include "gradcheck.h"
+#include "tools/gradcheck.h"
 #include "test_scenes.h"
 
 namespace diffpd {

@@ -14,8 +14,3 @@ diffpd_add_test(parallel_triangular_solve_test ${CMAKE_CURRENT_LIST_DIR}/paralle
 diffpd_add_test(lbfgs_pairs_test ${CMAKE_CURRENT_LIST_DIR}/lbfgs_pairs_test.cc)
 diffpd_add_test(thread_count_test ${CMAKE_CURRENT_LIST_DIR}/thread_count_test.cc)
 diffpd_add_test(rigid_mode_correction_test ${CMAKE_CURRENT_LIST_DIR}/rigid_mode_correction_test.cc)
-# Not a test: prints one PD-factor solve's time by CHOLMOD and by the blocked
-# parallel copy at the cantilever's 1x-8x grids (--large: 64x; --json).
-add_executable(solve_benchmark ${CMAKE_CURRENT_LIST_DIR}/solve_benchmark.cc)
-target_link_libraries(solve_benchmark PRIVATE diffpd diffpd_problems diffpd_compile_options)  # nlohmann-json via diffpd_problems
-target_include_directories(solve_benchmark PRIVATE ${PROJECT_SOURCE_DIR}/lib/src ${PROJECT_SOURCE_DIR}/tests)

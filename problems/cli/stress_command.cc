@@ -1,0 +1,131 @@
+// `diffpd stress`: the command-line edge of stress.h.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "tools/bench.h"
+#include "cli/commands.h"
+#include "tools/stress.h"
+
+namespace diffpd::problems {
+namespace {
+
+constexpr const char* kStressFooter = R"(
+Runs every (problem, method, E, nu, dt) case for --steps steps and
+classifies it:
+ ok        : finite states; total energy (kinetic + elastic + gravitational
+             potential) never above its start by more than --energy-tol
+             relative (semi-implicit, which does not dissipate: 0.5, i.e.
+             not exploding); finite gradients from the backward pass of the whole
+             rollout; on the first --gradcheck-steps steps the gradient matches
+             central finite differences (solves at rel_tolerance 1e-10) within
+             --gradcheck-tol (all inputs: x0, v0, forces, E, nu, rho);
+ failed    : a SolverError stopped the case: its status and message;
+ violation : a non-finite result without an error, energy growth, a gradient
+             mismatch or an unexpected error - a library bug.
+Exit code 4 when any case is a violation. JSON: a list of {problem, method,
+youngs_modulus, poissons_ratio, time_step, outcome, message, steps_completed,
+rounding_floor_steps, newton_fallback_steps, max_energy_excess,
+gradcheck_error, gradcheck_unresolved, seconds}; inputs
+whose effect on the loss is within the finite-difference noise are listed
+as unresolved (not tested) rather than passed.
+Solves stop at |grad g| <= --abs-tol + --rtol |grad g(x0)|; by default
+--abs-tol is 10x an estimate of the rounding floor of |grad g| (never below
+1e-9 N), which grows with stiffness and 1/dt^2. Steps whose line search
+stalls at the library's own floor estimate end there (rounding_floor_steps;
+SolverOptions::accept_rounding_floor), and PD-LBFGS steps whose line search
+stalls above it are finished by Newton (newton_fallback_steps).
+Meshes: --refine doublings of each problem's cells (-6: cantilever 8x2x2,
+falling cube 2x2x2; -9: cantilever 4x1x1, cube 1 cell).)";
+
+struct StressArgs {
+  std::vector<std::string> problems = {"cantilever", "falling-cube"};
+  std::vector<std::string> methods = {"pd", "pd-lbfgs", "newton-pcg", "newton-cholesky"};
+  int refine = -6;
+  StressOptions options;
+  bool json = false;
+};
+
+int RunStressArgs(const StressArgs& args) {
+  StressOptions options = args.options;
+  options.methods = ParseMethods(args.methods);
+  options.problems.clear();
+  for (const auto& p : args.problems) options.problems.push_back({p, args.refine});
+  const auto cases = RunStress(options, &std::cerr);
+  int counts[3] = {0, 0, 0};
+  for (const auto& c : cases) ++counts[c.outcome == "ok" ? 0 : c.outcome == "failed" ? 1 : 2];
+  if (args.json) {
+    std::printf("%s\n", StressToJson(cases).dump(2).c_str());
+  } else {
+    std::printf("%-13s %-16s %8s %6s %8s %-10s %7s %11s %11s %9s  %s\n", "problem", "method", "E", "nu", "dt",
+                "outcome", "steps", "energy_exc", "gradcheck", "seconds", "message");
+    for (const auto& c : cases) {
+      std::string message = c.message;
+      if (c.rounding_floor_steps > 0 || c.newton_fallback_steps > 0) {
+        message += message.empty() ? "" : "; ";
+        message += std::to_string(c.rounding_floor_steps) + " steps at the rounding floor, " +
+                   std::to_string(c.newton_fallback_steps) + " finished by Newton";
+      }
+      if (!c.gradcheck_unresolved.empty()) {
+        message += message.empty() ? "" : "; ";
+        message += "below finite-difference noise:";
+        for (const auto& input : c.gradcheck_unresolved) message += " " + input;
+      }
+      std::printf("%-13s %-16s %8.0e %6.3g %8.0e %-10s %7d %11.2e %11.2e %9.3f  %s\n", c.problem.c_str(),
+                  c.method.c_str(), c.youngs_modulus, c.poissons_ratio, c.time_step, c.outcome.c_str(),
+                  c.steps_completed, c.max_energy_excess, c.gradcheck_error, c.seconds, message.c_str());
+    }
+    std::printf("# %zu cases: %d ok, %d failed with a solver error, %d violations\n", cases.size(), counts[0],
+                counts[1], counts[2]);
+  }
+  if (counts[2] > 0) {
+    std::fprintf(stderr, "diffpd stress: %d case(s) violated the stability contract (see the table)\n", counts[2]);
+    return 4;
+  }
+  return 0;
+}
+
+}  // namespace
+
+Subcommand AddStressCommand(CLI::App* parent) {
+  auto args = std::make_shared<StressArgs>();
+  CLI::App* cmd = parent->add_subcommand(
+      "stress", "stability at the extremes of E, nu and dt: each case ok or a clear solver error, never NaN");
+  cmd->footer(kStressFooter);
+  StressOptions& o = args->options;
+  cmd->add_option("--problems", args->problems, "comma-separated problems: cantilever, falling-cube")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--methods", args->methods,
+                  "comma-separated methods: semi-implicit, newton-cholesky, newton-pcg, pd, pd-lbfgs")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--refine", args->refine, "cell doublings of every problem's mesh")->capture_default_str();
+  cmd->add_option("--E", o.youngs_moduli, "comma-separated Young's moduli (Pa)")->delimiter(',')->capture_default_str();
+  cmd->add_option("--nu", o.poissons_ratios, "comma-separated Poisson's ratios")->delimiter(',')->capture_default_str();
+  cmd->add_option("--dt", o.time_steps, "comma-separated time steps (s)")->delimiter(',')->capture_default_str();
+  cmd->add_option("--steps", o.steps, "steps per case")->capture_default_str();
+  cmd->add_option("--rtol", o.rel_tolerance, "relative tolerance of each step's solve")->capture_default_str();
+  cmd->add_option("--abs-tol", o.abs_tolerance, "absolute tolerance of each step's solve (N; default: automatic)");
+  cmd->add_option("--max-iterations", o.max_iterations, "iteration limit of each step's solve")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--threads", o.threads, "threads for element loops (0: OpenMP default)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--energy-tol", o.energy_tolerance, "allowed relative rise of the total energy")
+      ->capture_default_str();
+  cmd->add_option("--gradcheck-steps", o.gradcheck_steps, "steps of the finite-difference check (0: skip)")
+      ->capture_default_str();
+  cmd->add_option("--gradcheck-tol", o.gradcheck_tolerance, "allowed relative error of the gradient check")
+      ->capture_default_str();
+  cmd->add_option("--seed", o.seed, "seed of the loss and check directions")->capture_default_str();
+  cmd->add_flag("--no-rigid-correction{false}", o.rigid_mode_correction,
+                "pd-lbfgs and the PD backward: without the rigid modes' coarse correction");
+  cmd->add_flag("--json", args->json, "print one JSON document (a list) on stdout");
+  return {cmd, [args] { return RunStressArgs(*args); }};
+}
+
+}  // namespace diffpd::problems

@@ -1,0 +1,370 @@
+// calibrate-starfish (problems/calibration/calibrate_starfish.h): the real recordings are
+// parsed as the fact sheet describes them, malformed files are rejected with
+// messages naming file and line, the scene has the fact sheet's boundary,
+// markers and muscles, the tendon-to-activation map (slack, lag) and its
+// derivatives, the reverse-mode loss gradient in E, nu, slack and lag agrees
+// with central finite differences, and a short fit lowers the loss.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include "calibration/calibrate_starfish.h"
+#include "diffpd/error.h"
+
+namespace diffpd::problems {
+namespace {
+
+const std::string kStarfishDir = std::string(DIFFPD_SHARED_DIR) + "/data/starfish/";
+const std::string kCyclic1 = kStarfishDir + "data_horizontal_cyclic1.csv";
+const std::string kCyclic2 = kStarfishDir + "data_horizontal_cyclic2.csv";
+const std::string kHeader = "Time (ms),Tendon (mm),M1 X,M1 Y,M2 X,M2 Y,M3 X,M3 Y,M4 X,M4 Y\n";
+const std::string kRow0 = "0,0,1,2,3,4,5,6,7,8\n";
+
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = (std::filesystem::temp_directory_path() / name).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string ReadError(const std::string& path) {
+  try {
+    ReadStarfishRecording(path);
+  } catch (const InvalidInputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(CalibrateStarfishTest, ReadsTheRealRecordingsInSiUnits) {
+  const StarfishRecording r = ReadStarfishRecording(kCyclic1);
+  ASSERT_EQ(r.num_rows(), 2234);
+  EXPECT_EQ(r.lines.front(), 2);
+  EXPECT_EQ(r.time[0], 0.0);
+  EXPECT_NEAR(r.time[1], 16.666666e-3, 1e-12);
+  EXPECT_EQ(r.tendon[0], 0.0);
+  const double first[8] = {333.90558, 168.04053, 329.55084, 146.81335, 331.14767, 73.042511, 333.68942, 46.489552};
+  for (int c = 0; c < 8; ++c) EXPECT_NEAR(r.markers[0][c], first[c] * 1e-3, 1e-12) << "column " << c + 2;
+  // The tendon is NaN from line 2032 to the end (204 rows); markers never are.
+  EXPECT_FALSE(std::isnan(r.tendon[2029]));
+  EXPECT_TRUE(std::isnan(r.tendon[2030]));
+  EXPECT_EQ(r.lines[2030], 2032);
+  EXPECT_TRUE(std::isnan(r.tendon.back()));
+  const StarfishRecording r2 = ReadStarfishRecording(kCyclic2);
+  ASSERT_EQ(r2.num_rows(), 2493);
+  EXPECT_NEAR(r2.tendon[0], 1.1938052e-3, 1e-12);  // the pre-tension
+}
+
+TEST(CalibrateStarfishTest, RejectsMalformedFilesNamingFileAndLine) {
+  const std::string missing = (std::filesystem::temp_directory_path() / "starfish_missing.csv").string();
+  std::filesystem::remove(missing);
+  EXPECT_EQ(ReadError(missing), "cannot open '" + missing + "'");
+  std::string p = WriteTemp("starfish_empty.csv", "");
+  EXPECT_EQ(ReadError(p), p + ": empty file (expected a header row and data rows)");
+  p = WriteTemp("starfish_header.csv", "a,b,c\n" + kRow0);
+  EXPECT_EQ(ReadError(p), p + ":1: expected a header row of 10 column labels, got 3 fields");
+  p = WriteTemp("starfish_noheader.csv", kRow0 + kRow0);
+  EXPECT_EQ(ReadError(p), p + ":1: expected a header row of column labels, got the number '0'");
+  p = WriteTemp("starfish_columns.csv", kHeader + kRow0 + "16.7,0,1,2,3,4,5,6,7\n");
+  EXPECT_EQ(ReadError(p), p + ":3: expected 10 fields (time ms, tendon mm, M1 x, M1 y, ..., M4 x, M4 y), got 9");
+  p = WriteTemp("starfish_text.csv", kHeader + kRow0 + "16.7,0,1,2,3,abc,5,6,7,8\n");
+  EXPECT_EQ(ReadError(p), p + ":3: M2 y is not a number: 'abc'");
+  p = WriteTemp("starfish_nan_marker.csv", kHeader + kRow0 + "16.7,0,1,2,3,4,NaN,6,7,8\n");
+  EXPECT_EQ(ReadError(p), p + ":3: M3 x = nan is invalid: marker coordinates must be finite (mm)");
+  p = WriteTemp("starfish_inf_tendon.csv", kHeader + kRow0 + "16.7,inf,1,2,3,4,5,6,7,8\n");
+  EXPECT_EQ(ReadError(p), p + ":3: tendon = inf is invalid: must be finite or NaN (mm)");
+  p = WriteTemp("starfish_time.csv", kHeader + kRow0 + "16.5,0,1,2,3,4,5,6,7,8\n10,0,1,2,3,4,5,6,7,8\n");
+  EXPECT_EQ(ReadError(p), p + ":4: time 10 ms is not after the previous row's 16.5 ms (line 3)");
+  p = WriteTemp("starfish_rows.csv", kHeader);
+  EXPECT_EQ(ReadError(p), p + ": no data rows");
+  // A NaN tendon is accepted by the reader, and the window stops before it.
+  p = WriteTemp("starfish_nan_tendon.csv", kHeader + kRow0 + "16.5,1,1,2,3,4,5,6,7,8\n33,NaN,1,2,3,4,5,6,7,8\n");
+  const StarfishRecording r = ReadStarfishRecording(p);
+  const StarfishWindow w = MakeStarfishWindow(r, 0, 10);
+  EXPECT_EQ(w.first, 0);
+  EXPECT_EQ(w.last, 1);
+  EXPECT_EQ(
+      w.note,
+      p + ":4: tendon contraction is NaN from t = 0.033 s; the window stops before it (0.0165 s instead of 10 s)");
+  try {
+    MakeStarfishWindow(r, 0.03, 1);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              p + ":4: tendon contraction is NaN at the window's first row (t = 0.033 s): nothing to simulate");
+  }
+}
+
+TEST(CalibrateStarfishTest, WindowsOfTheRealRecordingStopBeforeTheMissingTendon) {
+  const StarfishRecording r = ReadStarfishRecording(kCyclic1);
+  const StarfishWindow ten = MakeStarfishWindow(r, 0, 10);
+  EXPECT_EQ(ten.first, 0);
+  EXPECT_EQ(ten.last, 600);  // 10 s of 60 Hz frames
+  EXPECT_EQ(ten.note, "");
+  const StarfishWindow late = MakeStarfishWindow(r, 30, 10);
+  EXPECT_EQ(late.last, 2029);
+  EXPECT_NE(late.note.find(":2032: tendon contraction is NaN"), std::string::npos) << late.note;
+}
+
+class StarfishSceneTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { scene_ = new Scene(StarfishCalibration().MakeScene()); }
+  static void TearDownTestSuite() { delete scene_; }
+  static Scene* scene_;
+};
+Scene* StarfishSceneTest::scene_ = nullptr;
+
+TEST_F(StarfishSceneTest, CentralColumnHasYAndZFixedAndXFree) {
+  const Mesh& mesh = scene_->mesh;
+  EXPECT_GT(mesh.num_vertices(), 762);  // the OBJ's vertices plus interior points
+  const std::set<int> fixed(scene_->dirichlet.dofs.begin(), scene_->dirichlet.dofs.end());
+  int column = 0;
+  for (int i = 0; i < mesh.num_vertices(); ++i) {
+    const bool in = std::abs(mesh.vertices(1, i)) < 0.018 && std::abs(mesh.vertices(2, i)) < 0.018;
+    column += in;
+    EXPECT_FALSE(fixed.count(3 * i)) << "x of node " << i;
+    EXPECT_EQ(fixed.count(3 * i + 1) == 1, in) << "y of node " << i;
+    EXPECT_EQ(fixed.count(3 * i + 2) == 1, in) << "z of node " << i;
+  }
+  EXPECT_GT(column, 20);
+  EXPECT_EQ(fixed.size(), 2u * column);
+}
+
+TEST_F(StarfishSceneTest, MarkersAreAtTheFactSheetsRestPositions) {
+  const std::array<int, 4> v = StarfishCalibration::MarkerVertices(scene_->mesh);
+  const Vec3 expected[4] = {
+      {-0.52, -4.50, -69.64}, {-0.19, -10.63, -39.18}, {-0.19, -13.27, 34.80}, {-0.63, -4.50, 65.26}};
+  for (int m = 0; m < 4; ++m)
+    EXPECT_LT((scene_->mesh.vertices.col(v[m]) - 1e-3 * expected[m]).norm(), 1e-3) << "M" << m + 1;
+}
+
+TEST_F(StarfishSceneTest, FourMusclesAlongTheArmsInTheFlatFaceLayer) {
+  ASSERT_EQ(scene_->muscles.size(), 4u);
+  const Mesh& mesh = scene_->mesh;
+  for (int m = 0; m < 4; ++m) {
+    const Muscle& muscle = scene_->muscles[m];
+    EXPECT_GT(muscle.elements.size(), 10u) << "muscle " << m;
+    ASSERT_EQ(muscle.fibers.size(), 1u);
+    const int along = m < 2 ? 2 : 1, across = m < 2 ? 1 : 2;
+    EXPECT_EQ(muscle.fibers[0], m < 2 ? Vec3(0, 0, 1) : Vec3(0, 1, 0));
+    for (int e : muscle.elements) {
+      Vec3 c = Vec3::Zero();
+      int on_face = 0;
+      for (int a = 0; a < 4; ++a) {
+        c += mesh.vertices.col(mesh.elements(a, e)) / 4;
+        on_face += std::abs(mesh.vertices(0, mesh.elements(a, e))) <= 1e-3;
+      }
+      EXPECT_GE(on_face, 3) << "a muscle element has a face on the flat face";
+      EXPECT_LE(std::abs(c(across)), 7.5e-3);
+      EXPECT_GT((m % 2 ? 1 : -1) * c(along), 0.018);
+    }
+  }
+  ASSERT_TRUE(scene_->hydrodynamics.has_value());
+  EXPECT_EQ(scene_->hydrodynamics->triangles.cols(), 1520);  // the OBJ's triangles (TetGen's Y switch)
+  EXPECT_FALSE(scene_->gravity.has_value());
+  EXPECT_DOUBLE_EQ(scene_->material.density, 400);
+}
+
+TEST(StarfishActivationsTest, SlackLagAndLengthShapeTheActivation) {
+  const double h = 0.01;
+  std::vector<double> c(40, 0.0);
+  for (int k = 5; k < 40; ++k) c[k] = 0.0179;
+  // No slack, no lag: the fact sheet's a = 1 - c / 65 mm (above the 1 mm onset).
+  std::vector<double> a = StarfishActivations(c, h, StarfishActuation{0, 0, 0.065}, nullptr);
+  EXPECT_EQ(a[4], 1.0);
+  EXPECT_NEAR(a[5], 1 - (0.0179 - 0.0005) / 0.065, 1e-14);
+  // Slack: nothing below it; the lag: a first-order approach to the held value.
+  a = StarfishActivations(c, h, StarfishActuation{0.005, 0.05, 0.04}, nullptr);
+  EXPECT_EQ(a[4], 1.0);
+  EXPECT_GT(a[5], a[8]);
+  const double filtered = 0.0179 * (1 - std::pow(0.05 / (0.05 + h), 35));  // after 35 steps from 0
+  EXPECT_NEAR(a[39], 1 - (filtered - 0.005 - 0.0005) / 0.04, 1e-12);
+  for (int k = 6; k < 40; ++k) EXPECT_LE(a[k], a[k - 1]);
+  // Derivatives vs central differences.
+  for (int k = 0; k < 40; ++k) c[k] = 0.009 + 0.008 * std::sin(0.7 * k);
+  const StarfishActuation at{0.004, 0.03, 0.05};
+  std::vector<std::array<double, 3>> d;
+  StarfishActivations(c, h, at, &d);
+  const double e = 1e-7;
+  double largest[3] = {0, 0, 0};
+  for (int j = 0; j < 3; ++j) {
+    StarfishActuation plus = at, minus = at;
+    double* p[2] = {j == 0   ? &plus.slack
+                    : j == 1 ? &plus.lag
+                             : &plus.length,
+                    j == 0   ? &minus.slack
+                    : j == 1 ? &minus.lag
+                             : &minus.length};
+    *p[0] += e;
+    *p[1] -= e;
+    const std::vector<double> ap = StarfishActivations(c, h, plus, nullptr);
+    const std::vector<double> am = StarfishActivations(c, h, minus, nullptr);
+    for (int k = 0; k < 40; ++k) {
+      EXPECT_NEAR(d[k][j], (ap[k] - am[k]) / (2 * e), 1e-6) << "parameter " << j << ", step " << k;
+      largest[j] = std::max(largest[j], std::abs(d[k][j]));
+    }
+  }
+  EXPECT_GT(largest[0], 1);    // 1/m
+  EXPECT_GT(largest[1], 0.1);  // 1/s
+  EXPECT_GT(largest[2], 1);    // 1/m
+  try {
+    StarfishActivations(c, h, StarfishActuation{0, -1, 0.065}, nullptr);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInputError& err) {
+    EXPECT_EQ(std::string(err.what()), "tendon lag = -1 is invalid: must be finite and >= 0 (s)");
+  }
+  try {
+    StarfishActivations({0.0, 0.0105}, h, StarfishActuation{0, 0, 0.005}, nullptr);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInputError& err) {
+    EXPECT_EQ(std::string(err.what()), "tendon: activation -1 < 0 at step 1 (slack 0 m, length 0.005 m)");
+  }
+}
+
+// The window of the gradient and fit tests: 0.15 s from 1.15 s of cyclic1
+// (the tendon first moves at 1.18 s), one step per frame.
+class StarfishFitTest : public ::testing::Test {
+ protected:
+  StarfishFitTest() : recording_(ReadStarfishRecording(kCyclic1)), window_(MakeStarfishWindow(recording_, 1.15, 0.15)) {
+    starfish_.set_substeps(1);
+  }
+  StarfishCalibration starfish_;
+  StarfishRecording recording_;
+  StarfishWindow window_;
+};
+
+TEST_F(StarfishFitTest, LossGradientMatchesCentralDifferences) {
+  SolverOptions options = starfish_.Options(Method::kPdLbfgs, 1);
+  options.rel_tolerance = 1e-10;
+  options.abs_tolerance = 1e-10;
+  options.backward_rel_tolerance = 1e-11;
+  const MaterialParameters material{2e5, 0.35, 400};
+  const StarfishActuation actuation{0.004, 0.03, 0.05};
+  auto model = starfish_.MakeModel(recording_, window_, options, material, actuation);
+  auto loss = [&](const double* p, double* gradient) {
+    const double* blocks[2] = {p, p + 2};
+    double cost = 0;
+    EXPECT_TRUE(model->EvaluateLoss(blocks, {}, &cost, gradient)) << model->statistics().last_error;
+    return cost;
+  };
+  const double p0[5] = {2e5, 0.35, 0.004, 0.03, 0.05};
+  double g[5];
+  const double l0 = loss(p0, g);
+  EXPECT_GT(l0, 0);
+  const double step[5] = {2e5 * 1e-4, 1e-4, 1e-6, 1e-5, 1e-6};
+  const char* names[5] = {"dL/dE", "dL/dnu", "dL/dslack", "dL/dlag", "dL/dlength"};
+  for (int i = 0; i < 5; ++i) {
+    double pp[5], pm[5];
+    std::copy(p0, p0 + 5, pp);
+    std::copy(p0, p0 + 5, pm);
+    pp[i] += step[i];
+    pm[i] -= step[i];
+    const double fd = (loss(pp, nullptr) - loss(pm, nullptr)) / (2 * step[i]);
+    EXPECT_NEAR(g[i], fd, 1e-4 * std::abs(fd)) << names[i];
+    EXPECT_GT(std::abs(fd) * p0[i], 1e-3 * l0) << names[i] << ": the loss does depend on it here";
+  }
+}
+
+TEST_F(StarfishFitTest, BodyArmsRegionsGiveTheArmsTheirOwnYoungsModulus) {
+  EXPECT_EQ(ParseStarfishRegions("body-arms"), StarfishRegions::kBodyArms);
+  try {
+    ParseStarfishRegions("legs");
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInputError& e) {
+    EXPECT_EQ(std::string(e.what()), "--regions = 'legs' is invalid: calibrate-starfish knows 'body-arms'");
+  }
+  starfish_.set_regions(StarfishRegions::kBodyArms);
+  const Scene scene = starfish_.MakeScene();
+  ASSERT_EQ(scene.material_regions.size(), 1u);
+  const size_t arms = scene.material_regions[0].elements.size();
+  EXPECT_GT(arms, scene.mesh.num_elements() / 2u);  // the arms are most of the body
+  EXPECT_LT(arms, static_cast<size_t>(scene.mesh.num_elements()));
+  for (const Muscle& m : scene.muscles)  // every muscle lies in an arm
+    for (const int e : m.elements)
+      EXPECT_TRUE(std::count(scene.material_regions[0].elements.begin(), scene.material_regions[0].elements.end(), e));
+  // The model's material block {E, nu, E_arms, nu_arms}: the arms' gradient.
+  SolverOptions options = starfish_.Options(Method::kPdLbfgs, 1);
+  options.rel_tolerance = 1e-10;
+  options.abs_tolerance = 1e-10;
+  options.backward_rel_tolerance = 1e-11;
+  auto model = starfish_.MakeModel(recording_, window_, options, MaterialParameters{2e5, 0.35, 400},
+                                   StarfishActuation{0.004, 0.03, 0.05});
+  ASSERT_EQ(model->parameter_block_sizes(), (std::vector<int>{4, 3}));
+  auto loss = [&](const double* material, double* gradient) {
+    const double actuation[3] = {0.004, 0.03, 0.05};
+    const double* blocks[2] = {material, actuation};
+    double cost = 0;
+    EXPECT_TRUE(model->EvaluateLoss(blocks, {}, &cost, gradient)) << model->statistics().last_error;
+    return cost;
+  };
+  const double p0[4] = {2e5, 0.35, 1e5, 0.35};
+  double g[7];
+  loss(p0, g);
+  for (const int i : {2, 3}) {
+    const double step = i == 2 ? 1e5 * 1e-4 : 1e-4;
+    double pp[4], pm[4];
+    std::copy(p0, p0 + 4, pp);
+    std::copy(p0, p0 + 4, pm);
+    pp[i] += step;
+    pm[i] -= step;
+    const double fd = (loss(pp, nullptr) - loss(pm, nullptr)) / (2 * step);
+    EXPECT_NEAR(g[i], fd, 1e-4 * std::abs(fd)) << "material block entry " << i;
+  }
+  // The fit: the arms' E moves apart from the body's and the loss drops.
+  const StarfishFit fit =
+      starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
+                    StarfishCalibration::ActuationGuess(), 2, nullptr);
+  EXPECT_TRUE(fit.usable) << fit.termination;
+  ASSERT_EQ(fit.region_materials.size(), 1u);
+  EXPECT_NE(fit.region_materials[0].youngs_modulus, fit.material.youngs_modulus);
+  EXPECT_EQ(fit.region_materials[0].poissons_ratio, fit.material.poissons_ratio);
+  EXPECT_LT(fit.final_cost, fit.initial_cost);
+  EXPECT_EQ(fit.statistics.failures, 0) << fit.statistics.last_error;
+}
+
+TEST_F(StarfishFitTest, CoordinatesMapIntoTheBoundsAndBack) {
+  double u[2];
+  StarfishCalibration::ToCoordinates(MaterialParameters{5e5, 0.4, 400}, u);
+  const MaterialParameters m = StarfishCalibration::FromCoordinates(u, 400);
+  EXPECT_NEAR(m.youngs_modulus, 5e5, 1e-6);
+  EXPECT_NEAR(m.poissons_ratio, 0.4, 1e-12);
+  const double far[2] = {-60, 60};
+  const MaterialParameters edge = StarfishCalibration::FromCoordinates(far, 400);
+  EXPECT_NEAR(edge.youngs_modulus, 1e4, 1e-6);
+  EXPECT_NEAR(edge.poissons_ratio, 0.45, 1e-12);
+  EXPECT_THROW(StarfishCalibration::ToCoordinates(MaterialParameters{6e6, 0.4, 400}, u), InvalidInputError);
+  double v[3];
+  StarfishCalibration::ActuationToCoordinates(StarfishActuation{0.003, 0.05, 0.065}, v);
+  const StarfishActuation a = StarfishCalibration::ActuationFromCoordinates(v);
+  EXPECT_NEAR(a.slack, 0.003, 1e-15);
+  EXPECT_NEAR(a.lag, 0.05, 1e-15);
+  EXPECT_NEAR(a.length, 0.065, 1e-15);
+  const double ends[3] = {-60, 60, -60};
+  const StarfishActuation edge_a = StarfishCalibration::ActuationFromCoordinates(ends);
+  EXPECT_NEAR(edge_a.slack, 0, 1e-15);
+  EXPECT_NEAR(edge_a.lag, 0.5, 1e-12);
+  EXPECT_NEAR(edge_a.length, 0.03, 1e-12);
+  try {
+    StarfishCalibration::ActuationToCoordinates(StarfishActuation{0.02, 0.05, 0.065}, v);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInputError& e) {
+    EXPECT_EQ(std::string(e.what()), "tendon slack = 0.02 is outside the fit's interval (0, 0.015) m");
+  }
+}
+
+TEST_F(StarfishFitTest, ShortFitLowersTheLoss) {
+  const StarfishFit fit =
+      starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
+                    StarfishCalibration::ActuationGuess(), 3, nullptr);
+  EXPECT_TRUE(fit.usable) << fit.termination;
+  EXPECT_GE(fit.iterations, 1);
+  EXPECT_LT(fit.final_cost, 0.9 * fit.initial_cost);
+  EXPECT_GT(fit.statistics.gradients, 0);
+  EXPECT_EQ(fit.statistics.failures, 0) << fit.statistics.last_error;
+}
+
+}  // namespace
+}  // namespace diffpd::problems

@@ -1,0 +1,249 @@
+// Stability at the extremes: every case of a reduced grid (a 4 x 1 x 1
+// cantilever and a 2^3 falling cube, 20 steps) is either ok - finite,
+// energy never rising, gradients matching finite differences - or stopped
+// by a SolverError with a specific message; never a NaN, never a violation.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <set>
+#include <utility>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "tools/bench.h"
+#include "diffpd/error.h"
+#include "tools/stress.h"
+
+namespace diffpd::problems {
+namespace {
+
+const char* const kStatusNames[] = {"maximum number of iterations reached",
+                                    "line search failed",
+                                    "non-finite value",
+                                    "factorization failed",
+                                    "inverted element",
+                                    "diverged"};
+
+StressOptions ReducedGrid() {
+  StressOptions o;
+  o.problems = {{"cantilever", -9}, {"falling-cube", -6}};  // 4 x 1 x 1 and 2 x 2 x 2 cells
+  o.methods = {Method::kPd, Method::kNewtonCholesky};
+  o.steps = 20;
+  o.gradcheck_steps = 2;  // two steps chain the adjoint across a step boundary; three cost 1.5x
+  o.threads = 1;
+  return o;
+}
+
+// A failure names its status (ToString(SolverStatus)) and where it happened.
+void ExpectSpecificFailure(const StressCase& c) {
+  const bool names_status = std::any_of(std::begin(kStatusNames), std::end(kStatusNames),
+                                        [&](const char* s) { return c.message.find(s) != std::string::npos; });
+  EXPECT_TRUE(names_status) << c.message;
+  const bool says_where = c.message.find("(step ") != std::string::npos ||
+                          c.message.find("(energy after step ") != std::string::npos ||
+                          c.message.rfind("gradient check", 0) == 0 || c.message.rfind("backward pass", 0) == 0;
+  EXPECT_TRUE(says_where) << c.message;
+  EXPECT_LT(c.steps_completed, 20 + 1);
+}
+
+std::string Name(const StressCase& c) {
+  std::ostringstream s;
+  s << c.problem << " " << c.method << " E=" << c.youngs_modulus << " nu=" << c.poissons_ratio << " h=" << c.time_step;
+  return s.str();
+}
+
+// The extremes E in {1e2, 1e10} Pa, nu in {0, 0.499}, h in {1e-5, 0.1} s as
+// a half fraction of the 2^3 corners in which every pair of axes meets all
+// four combinations of its extremes (a strength-2 covering array), plus the
+// problems' typical material and step.
+TEST(StressTest, EveryExtremeCaseIsOkOrAClearSolverError) {
+  const StressOptions o = ReducedGrid();
+  const double corners[][3] = {{1e2, 0, 0.1},
+                               {1e2, 0.499, 1e-5},
+                               {1e10, 0, 1e-5},
+                               {1e10, 0.499, 0.1},
+                               {1e6, 0.45, 0.01}};  // the last: typical, Newton only (PD's tight solves are slow)
+  std::set<std::string> tested_inputs;
+  int ok = 0;
+  for (const auto& p : o.problems)
+    for (Method m : o.methods)
+      for (const auto& [e, nu, h] : corners) {
+        if (e == 1e6 && m == Method::kPd) continue;
+        const StressCase c = RunStressCase(p, m, e, nu, h, o);
+        SCOPED_TRACE(Name(c) + ": " + c.outcome + " " + c.message);
+        ASSERT_NE(c.outcome, "violation");
+        if (c.outcome == "failed") {
+          ExpectSpecificFailure(c);
+          continue;
+        }
+        ASSERT_EQ(c.outcome, "ok");
+        ++ok;
+        EXPECT_EQ(c.steps_completed, 20);
+        EXPECT_LE(c.max_energy_excess, o.energy_tolerance);
+        EXPECT_LE(c.gradcheck_error, o.gradcheck_tolerance);
+        for (const char* input : {"x0", "v0", "external_force", "youngs_modulus", "poissons_ratio", "density"})
+          if (std::find(c.gradcheck_unresolved.begin(), c.gradcheck_unresolved.end(), input) ==
+              c.gradcheck_unresolved.end())
+            tested_inputs.insert(input);
+        if (e == 1e6) {
+          EXPECT_TRUE(c.gradcheck_unresolved.empty()) << "a typical case resolves every input";
+        }
+      }
+  // Measured: 13 of 18 ok (Newton-Cholesky 9 of 10, PD 4 of 8); the rest
+  // stop at PD's iteration limit or Newton's line search at E = 1e10 Pa,
+  // nu = 0.499, h = 0.1 s.
+  EXPECT_GE(ok, 10);
+  EXPECT_EQ(tested_inputs.size(), 6u) << "every input kind is checked somewhere";
+}
+
+// 10 000 steps on a single-cell cube: long rollouts stay finite, the energy
+// never rises and the backward pass over all of them returns finite values.
+TEST(StressTest, TenThousandStepsStayFiniteAndDissipative) {
+  StressOptions o = ReducedGrid();
+  o.steps = 10000;
+  o.gradcheck_steps = 0;  // checked above; here the length matters
+  const StressProblem cube{"falling-cube", -9};
+  // Soft, nearly incompressible, large steps with PD; stiff, compressible,
+  // tiny steps with Newton.
+  const std::pair<Method, std::array<double, 3>> cases[] = {{Method::kPd, {1e2, 0.499, 0.1}},
+                                                            {Method::kNewtonCholesky, {1e10, 0, 1e-5}}};
+  for (const auto& [m, material] : cases) {
+    const auto& [e, nu, h] = material;
+    const StressCase c = RunStressCase(cube, m, e, nu, h, o);
+    SCOPED_TRACE(Name(c) + ": " + c.message);
+    EXPECT_EQ(c.outcome, "ok");
+    EXPECT_EQ(c.steps_completed, 10000);
+    EXPECT_LE(c.max_energy_excess, o.energy_tolerance);
+  }
+}
+
+// The case the full grid found (session 8): a nearly incompressible, very
+// stiff cantilever at h = 0.01 s whose second step's predictor is so
+// compressed that Newton's descent from it ended at a stationary point with
+// 5.6e6 J (the body had 12 J): the total energy rose by 0.96 (relative)
+// without an error. A result with g above g(x_i), the previous total energy,
+// is now solved again from x_i (SolverOptions::bound_step_energy).
+TEST(StressTest, StiffIncompressibleStepsDoNotClimbToAFarStationaryPoint) {
+  StressOptions o = ReducedGrid();
+  o.steps = 5;
+  o.gradcheck_steps = 0;
+  for (Method m : {Method::kNewtonCholesky, Method::kPdLbfgs}) {
+    const StressCase c = RunStressCase({"cantilever", -6}, m, 1e10, 0.499, 0.01, o);
+    SCOPED_TRACE(Name(c) + ": " + c.message);
+    // Newton completes; PD-LBFGS may stop at the rounding floor (a clear error).
+    if (m == Method::kNewtonCholesky) {
+      EXPECT_EQ(c.outcome, "ok");
+    }
+    EXPECT_NE(c.outcome, "violation");
+    if (c.outcome == "ok") {
+      EXPECT_LE(c.max_energy_excess, o.energy_tolerance);
+    }
+  }
+}
+
+// Symplectic Euler beyond its stability limit: the energy explodes; the case
+// must end in a SolverError (non-finite), not in a NaN state.
+TEST(StressTest, ExplicitIntegrationBeyondItsStabilityLimitFailsClearly) {
+  StressOptions o = ReducedGrid();
+  o.steps = 10000;
+  const StressCase c = RunStressCase({"falling-cube", -6}, Method::kSemiImplicit, 1e10, 0.3, 1e-3, o);
+  EXPECT_EQ(c.outcome, "failed") << c.message;
+  EXPECT_NE(c.message.find("non-finite value"), std::string::npos) << c.message;
+  EXPECT_LT(c.steps_completed, 10000);
+}
+
+// A very stiff cube falling freely at h = 0.1 s: after ~2.5 s it is 30 m
+// from the origin, its deformation gradients are formed from positions of
+// that size, and |grad g| cannot get below the report's automatic tolerance.
+// Until session 9 Newton's line search stopped there (steps 26-29 of 50);
+// now those steps end at the rounding floor and the case completes.
+TEST(StressTest, StiffFallingCubeFarFromTheOriginCompletesAtTheRoundingFloor) {
+  StressOptions o;
+  o.problems = {{"falling-cube", -6}};
+  o.methods = {Method::kNewtonCholesky};
+  o.youngs_moduli = {1e10};
+  o.poissons_ratios = {0.3};
+  o.time_steps = {0.1};
+  o.steps = 32;
+  o.gradcheck_steps = 0;
+  o.threads = 1;
+  const std::vector<StressCase> cases = RunStress(o);
+  ASSERT_EQ(cases.size(), 1u);
+  EXPECT_EQ(cases[0].outcome, "ok") << cases[0].message;
+  EXPECT_EQ(cases[0].steps_completed, 32);
+  EXPECT_GT(cases[0].rounding_floor_steps, 0);
+}
+
+TEST(StressTest, RunStressCoversTheGridAndWritesJson) {
+  StressOptions o = ReducedGrid();
+  o.problems = {{"falling-cube", -9}};
+  o.methods = {Method::kNewtonCholesky};
+  o.youngs_moduli = {1e4, 1e6};
+  o.poissons_ratios = {0.3};
+  o.time_steps = {1e-2};
+  o.steps = 5;
+  const auto cases = RunStress(o);
+  ASSERT_EQ(cases.size(), 2u);
+  EXPECT_EQ(cases[1].youngs_modulus, 1e6);
+  const nlohmann::json rows = nlohmann::json::parse(StressToJson(cases).dump());
+  EXPECT_EQ(rows[0].at("outcome"), "ok");
+  EXPECT_EQ(rows[0].at("steps_completed"), 5);
+  EXPECT_EQ(rows[0].at("rounding_floor_steps"), 0);
+  EXPECT_EQ(rows[0].at("newton_fallback_steps"), 0);
+  EXPECT_TRUE(rows[0].at("gradcheck_unresolved").is_array());
+}
+
+TEST(StressOptionsTest, ValidateNamesTheFieldValueAndRange) {
+  StressOptions o;
+  o.poissons_ratios = {0.5};
+  try {
+    o.Validate();
+    FAIL() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_STREQ(e.what(), "poissons_ratio = 0.5 is invalid: must be finite and in (-1, 0.5)");
+  }
+  o = StressOptions();
+  o.time_steps = {0};
+  EXPECT_THROW(o.Validate(), InvalidInputError);
+  o = StressOptions();
+  o.problems = {{"no-such-problem", 0}};
+  EXPECT_THROW(RunStress(o), InvalidInputError);
+}
+
+TEST(JudgeDerivativeTest, AgreementPassesAndResolvedDisagreementFails) {
+  // Central differences converging to 2.0 with little noise.
+  const std::vector<FiniteDifference> good = {{1e-2, 2.0002, 1e-12}, {1e-3, 2.000002, 1e-11}, {1e-4, 2.0, 1e-10}};
+  const DerivativeVerdict right = JudgeDerivative(2.0, good, 1e-4);
+  EXPECT_TRUE(right.tested);
+  EXPECT_LT(right.error, 1e-9);
+  // An analytic derivative 1% off is caught at every step.
+  const DerivativeVerdict wrong = JudgeDerivative(2.02, good, 1e-4);
+  EXPECT_TRUE(wrong.tested);
+  EXPECT_GT(wrong.error, 9e-3);
+}
+
+TEST(JudgeDerivativeTest, DisagreementWithinTheNoiseIsUnresolvedNotPassed) {
+  // A derivative of 1e-9 against differences dominated by noise of 1e-6.
+  const std::vector<FiniteDifference> noisy = {{1e-2, 3e-7, 1e-6}, {1e-3, -2e-6, 1e-5}, {1e-4, 4e-5, 1e-4}};
+  const DerivativeVerdict v = JudgeDerivative(1e-9, noisy, 1e-4);
+  EXPECT_FALSE(v.tested);
+  EXPECT_GT(v.error, 0.9);
+}
+
+TEST(AutoAbsToleranceTest, GrowsWithStiffnessAndInverseTimeStepAndNeverFallsBelowTheDefault) {
+  Scene scene = MakeRefinedProblem("falling-cube", -6)->MakeScene();
+  EXPECT_EQ(AutoAbsTolerance(scene, 1e-2), 1e-9);  // E = 1e5 Pa: the default holds
+  scene.material.youngs_modulus = 1e10;
+  const double stiff = AutoAbsTolerance(scene, 1e-2);
+  EXPECT_GT(stiff, 1e-9);
+  scene.material.poissons_ratio = 0.499;  // lambda grows 180-fold over nu = 0.4
+  EXPECT_GT(AutoAbsTolerance(scene, 1e-2), 50 * stiff);
+  scene.material.youngs_modulus = 1e2;
+  EXPECT_GT(AutoAbsTolerance(scene, 1e-5), AutoAbsTolerance(scene, 1e-3));
+}
+
+}  // namespace
+}  // namespace diffpd::problems

@@ -1,0 +1,172 @@
+// Speed/accuracy sweeps on a tiny cantilever: errors fall as the tolerance,
+// the time step and the mesh are refined; JSON rows and the gnuplot PNG.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <nlohmann/json.hpp>
+
+#include "diffpd/error.h"
+#include "tools/tradeoff.h"
+
+namespace diffpd::problems {
+namespace {
+
+TradeoffOptions Tiny() {
+  TradeoffOptions o;
+  o.refine = -9;  // 4 x 1 x 1 cells
+  o.steps = 3;
+  o.threads = 1;
+  o.max_iterations = 10000;  // plain PD needs ~2500 iterations per step at 1e-8 here
+  o.sweep_tolerance = o.sweep_time_step = o.sweep_resolution = false;
+  return o;
+}
+
+// Rows of one sweep and method, in order.
+std::vector<TradeoffRow> Select(const std::vector<TradeoffRow>& rows, const std::string& sweep,
+                                const std::string& method) {
+  std::vector<TradeoffRow> out;
+  for (const auto& r : rows)
+    if (r.sweep == sweep && r.method == method) out.push_back(r);
+  return out;
+}
+
+TEST(TradeoffTest, ErrorsFallAsTheToleranceTightens) {
+  TradeoffOptions o = Tiny();
+  o.sweep_tolerance = true;
+  o.methods = {Method::kPd, Method::kPdLbfgs, Method::kNewtonCholesky};
+  o.tolerances = {1e-1, 1e-3, 1e-5, 1e-8};
+  const auto rows = RunTradeoff("cantilever", o);
+  ASSERT_EQ(rows.size(), 12u);
+  for (Method m : o.methods) {
+    const auto r = Select(rows, "tolerance", ToString(m));
+    ASSERT_EQ(r.size(), 4u);
+    for (const auto& row : r) ASSERT_TRUE(row.failure.empty()) << row.failure;
+    // Endpoints: seven decades of tolerance buy at least three of error
+    // (measured: four to six).
+    EXPECT_LT(r.back().state_rel_error, 1e-3 * r.front().state_rel_error) << ToString(m);
+    EXPECT_LT(r.back().grad_rel_error, 1e-3 * r.front().grad_rel_error) << ToString(m);
+    // Monotone within noise in between, and tighter tolerances cost more.
+    for (size_t k = 1; k < r.size(); ++k) {
+      EXPECT_LT(r[k].state_rel_error, 2 * r[k - 1].state_rel_error) << ToString(m) << " " << r[k].value;
+      EXPECT_GE(r[k].iters_per_step, r[k - 1].iters_per_step) << ToString(m) << " " << r[k].value;
+    }
+    EXPECT_EQ(r.front().parameter, "rel_tolerance");
+    EXPECT_EQ(r.front().value, 1e-1);
+  }
+}
+
+TEST(TradeoffTest, StateErrorFallsWithTheTimeStepAtFixedDuration) {
+  TradeoffOptions o = Tiny();
+  o.sweep_time_step = true;
+  o.methods = {Method::kNewtonCholesky};
+  o.rel_tolerance = 1e-8;
+  o.time_step_levels = 3;  // h = 10, 5, 2.5 ms; reference 1.25 ms
+  const auto r = Select(RunTradeoff("cantilever", o), "time_step", "newton-cholesky");
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_DOUBLE_EQ(r[0].value, 0.01);
+  EXPECT_DOUBLE_EQ(r[2].value, 0.0025);
+  EXPECT_EQ(r[0].steps, 3);
+  EXPECT_EQ(r[2].steps, 12);
+  // Implicit Euler is first order; against a reference at h/8 the measured
+  // errors fall 0.50 -> 0.34 -> 0.20.
+  EXPECT_LT(r[1].state_rel_error, r[0].state_rel_error);
+  EXPECT_LT(r[2].state_rel_error, 0.7 * r[0].state_rel_error);
+  EXPECT_GT(r[2].state_rel_error, 1e-3);  // discretisation error, not solver error
+}
+
+TEST(TradeoffTest, CornerErrorIsSmallOnTheReferenceMeshAndLargerOnACoarserOne) {
+  TradeoffOptions o = Tiny();
+  o.refine = -6;  // finest mesh 8 x 2 x 2; coarser 4 x 1 x 1
+  o.sweep_resolution = true;
+  o.methods = {Method::kNewtonCholesky};
+  o.resolution_levels = 2;
+  const auto r = Select(RunTradeoff("cantilever", o), "resolution", "newton-cholesky");
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[0].value, 4);
+  EXPECT_EQ(r[1].value, 32);
+  EXPECT_EQ(r[0].parameter, "elements");
+  // On the reference mesh only the solver tolerance (1e-4) separates them.
+  EXPECT_LT(r[1].state_rel_error, 1e-2);
+  EXPECT_GT(r[0].state_rel_error, 10 * r[1].state_rel_error);
+}
+
+TEST(TradeoffTest, JsonRowsHaveTheDocumentedFields) {
+  TradeoffOptions o = Tiny();
+  o.sweep_tolerance = true;
+  o.methods = {Method::kNewtonCholesky};
+  o.tolerances = {1e-2, 1e-6};
+  const nlohmann::json rows = nlohmann::json::parse(TradeoffToJson(RunTradeoff("cantilever", o)).dump());
+  ASSERT_EQ(rows.size(), 2u);
+  for (const auto& row : rows) {
+    EXPECT_EQ(row.at("sweep"), "tolerance");
+    EXPECT_EQ(row.at("method"), "newton-cholesky");
+    EXPECT_EQ(row.at("parameter"), "rel_tolerance");
+    for (const char* field : {"value", "seconds", "state_rel_error", "grad_rel_error"})
+      EXPECT_TRUE(row.at(field).is_number()) << field;
+  }
+}
+
+TEST(TradeoffOptionsTest, ValidateNamesTheFieldValueAndRange) {
+  TradeoffOptions o;
+  o.tolerances = {1e-3, 2};
+  try {
+    o.Validate();
+    FAIL() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_STREQ(e.what(), "tolerance = 2 is invalid: must be in (0, 1)");
+  }
+  o = TradeoffOptions();
+  o.time_step_levels = 0;
+  EXPECT_THROW(o.Validate(), InvalidInputError);
+}
+
+std::vector<TradeoffRow> SyntheticRows() {
+  std::vector<TradeoffRow> rows;
+  for (const char* sweep : {"tolerance", "time_step", "resolution"})
+    for (const char* method : {"pd", "newton-cholesky"})
+      for (int k = 1; k <= 3; ++k) {
+        TradeoffRow r;
+        r.sweep = sweep;
+        r.method = method;
+        r.seconds = 0.1 * k;
+        r.state_rel_error = std::pow(10.0, -2 * k);
+        r.grad_rel_error = k == 3 ? 0.0 : std::pow(10.0, -k);  // a zero error is drawn at 1e-17
+        rows.push_back(r);
+      }
+  return rows;
+}
+
+TEST(TradeoffPlotTest, WritesAPngWithGnuplot) {
+  if (!GnuplotAvailable()) GTEST_SKIP() << "gnuplot is not installed";
+  const auto path = std::filesystem::temp_directory_path() / "diffpd_tradeoff_test.png";
+  std::filesystem::remove(path);
+  WriteTradeoffPlot(SyntheticRows(), path.string(), "test");
+  std::ifstream in(path, std::ios::binary);
+  char magic[8] = {};
+  in.read(magic, 8);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+  EXPECT_GT(std::filesystem::file_size(path), 1000u);
+  std::filesystem::remove(path);
+}
+
+TEST(TradeoffPlotTest, MissingGnuplotIsAClearError) {
+  const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  setenv("PATH", "/nonexistent-diffpd-test-dir", 1);
+  EXPECT_FALSE(GnuplotAvailable());
+  try {
+    WriteTradeoffPlot(SyntheticRows(), "/tmp/unused.png", "test");
+    ADD_FAILURE() << "expected std::runtime_error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(),
+                 "--plot needs the gnuplot program, which is not on PATH (Debian: apt-get install gnuplot-nox), or "
+                 "leave out --plot");
+  }
+  setenv("PATH", path.c_str(), 1);
+}
+
+}  // namespace
+}  // namespace diffpd::problems
