@@ -11,6 +11,25 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/scenes/rolling_sphere.cc
   ${CMAKE_CURRENT_LIST_DIR}/scenes/bouncing_ball.cc
   ${CMAKE_CURRENT_LIST_DIR}/scenes/routing_tendon.cc
+  # paper: the DiffPD paper's table rows as data
+  ${CMAKE_CURRENT_LIST_DIR}/paper/numpy_random.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/paper_meshes.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/log_material_variables.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/rigid_placement_variables.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/activation_variables.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/trajectory_losses.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/paper_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/paper_rows.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/cantilever_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/rolling_sphere_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/plant_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/bouncing_ball_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/bunny_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/routing_tendon_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/torus_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/quadruped_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/cow_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/row_evaluation.cc
   # calibration: system identification with Ceres
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_problem.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_plant.cc

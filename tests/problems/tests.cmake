@@ -13,3 +13,5 @@ diffpd_add_test(trajectory_optimization_test ${_dir}/control/trajectory_optimiza
 diffpd_add_test(bench_test ${_dir}/tools/bench_test.cc LIBS diffpd_problems)
 diffpd_add_test(tradeoff_test ${_dir}/tools/tradeoff_test.cc LIBS diffpd_problems)
 diffpd_add_test(stress_test ${_dir}/tools/stress_test.cc LIBS diffpd_problems)
+diffpd_add_test(numpy_random_test ${_dir}/paper/numpy_random_test.cc LIBS diffpd_problems)
+diffpd_add_test(paper_rows_test ${_dir}/paper/paper_rows_test.cc LIBS diffpd_problems)
