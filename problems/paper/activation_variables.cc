@@ -61,8 +61,7 @@ void ConstantActivationVariables::CheckFits(const Scene& scene, int num_steps) c
   CheckSceneMuscles(scene, num_muscles_, name());
 }
 
-void ConstantActivationVariables::Apply(const Eigen::Ref<const VectorXd>& values,
-                                        solvers::RolloutSetup* setup) const {
+void ConstantActivationVariables::Apply(const Eigen::Ref<const VectorXd>& values, solvers::RolloutSetup* setup) const {
   for (size_t k = 0; k < setup->inputs.size(); ++k) {
     VectorXd& a = Activation(setup, k, num_muscles_);
     for (size_t j = 0; j < muscles_.size(); ++j) a(muscles_[j]) = values(j);
@@ -80,13 +79,16 @@ void ConstantActivationVariables::PullBack(const Eigen::Ref<const VectorXd>& val
 
 WindowedActivationVariables::WindowedActivationVariables(std::vector<int> muscles, int num_muscles, int num_steps,
                                                          int window)
-    : ControlVariables(0), muscles_(std::move(muscles)), num_muscles_(num_muscles), num_steps_(num_steps),
+    : ControlVariables(0),
+      muscles_(std::move(muscles)),
+      num_muscles_(num_muscles),
+      num_steps_(num_steps),
       window_(window) {
   CheckMuscles(muscles_, num_muscles_, name());
   if (window_ < 1 || num_steps_ < window_ || num_steps_ % window_ != 0) {
     std::ostringstream msg;
-    msg << name() << ": num_steps = " << num_steps_ << " is invalid: must be a positive multiple of window = "
-        << window_ << " (>= 1)";
+    msg << name() << ": num_steps = " << num_steps_
+        << " is invalid: must be a positive multiple of window = " << window_ << " (>= 1)";
     throw InvalidInputError(msg.str());
   }
   Append(num_frames() * static_cast<int>(muscles_.size()));
@@ -98,8 +100,7 @@ void WindowedActivationVariables::CheckFits(const Scene& scene, int num_steps) c
   CheckSteps(num_steps_, num_steps, name());
 }
 
-void WindowedActivationVariables::Apply(const Eigen::Ref<const VectorXd>& values,
-                                        solvers::RolloutSetup* setup) const {
+void WindowedActivationVariables::Apply(const Eigen::Ref<const VectorXd>& values, solvers::RolloutSetup* setup) const {
   const int groups = static_cast<int>(muscles_.size()), frames = num_frames();
   for (int k = 0; k < num_steps_; ++k) {
     const int c = k / window_, next = std::min(c + 1, frames - 1);
@@ -135,8 +136,7 @@ int WindowedActivationVariables::FirstAffectedState(int j) const {
 
 GaitActivationVariables::GaitActivationVariables(std::vector<GaitMuscle> muscles, int num_muscles, int num_steps,
                                                  double peak)
-    : ControlVariables(3), muscles_(std::move(muscles)), num_muscles_(num_muscles), num_steps_(num_steps),
-      peak_(peak) {
+    : ControlVariables(3), muscles_(std::move(muscles)), num_muscles_(num_muscles), num_steps_(num_steps), peak_(peak) {
   std::vector<int> indices;
   for (const GaitMuscle& m : muscles_) indices.push_back(m.muscle);
   CheckMuscles(indices, num_muscles_, name());

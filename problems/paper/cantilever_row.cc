@@ -77,11 +77,11 @@ PaperRow MakeCantileverRow(RowSize size) {
   std::vector<int> all(n);
   for (int i = 0; i < n; ++i) all[i] = i;
   using solvers::InitialStateVariables;
-  auto x0 = std::make_shared<InitialStateVariables>(InitialStateVariables::kPosition, all,
-                                                    InitialStateVariables::kPerNode);
+  auto x0 =
+      std::make_shared<InitialStateVariables>(InitialStateVariables::kPosition, all, InitialStateVariables::kPerNode);
   x0->SetInitial(q0);
-  auto v0 = std::make_shared<InitialStateVariables>(InitialStateVariables::kVelocity, all,
-                                                    InitialStateVariables::kPerNode);
+  auto v0 =
+      std::make_shared<InitialStateVariables>(InitialStateVariables::kVelocity, all, InitialStateVariables::kPerNode);
   auto activation = std::make_shared<ConstantActivationVariables>(muscles, nx);
   activation->SetInitial(a);
   auto force = std::make_shared<ConstantForceVariables>(3 * n);

@@ -50,8 +50,8 @@ struct OptimizerBudget {
   double ftol = 2.220446049250313e-09;  // relative decrease of f that stops it
   int max_iterations = 15000;
   int max_evaluations = 15000;
-  int history = 10;     // maxcor
-  double gtol = 1e-5;   // projected-gradient tolerance
+  int history = 10;    // maxcor
+  double gtol = 1e-5;  // projected-gradient tolerance
 };
 
 // How the paper normalises a loss L: (L - l) / (L_random - l), L_random the
@@ -80,8 +80,8 @@ struct LossTerm {
 };
 
 struct PaperRow {
-  std::string name;   // "plant", "bunny", ...
-  std::string title;  // "Plant (material identification)"
+  std::string name;     // "plant", "bunny", ...
+  std::string title;    // "Plant (material identification)"
   int table_index = 0;  // the row's number in PROBLEMS.md (1-9)
   RowSize size = RowSize::kPaper;
   Scene scene;

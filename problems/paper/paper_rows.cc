@@ -5,8 +5,8 @@
 namespace diffpd::problems {
 
 std::vector<std::string> PaperRowNames() {
-  return {"cantilever", "rolling-sphere", "plant", "bouncing-ball", "bunny", "routing-tendon", "torus", "quadruped",
-          "cow"};
+  return {"cantilever", "rolling-sphere", "plant", "bouncing-ball", "bunny", "routing-tendon",
+          "torus",      "quadruped",      "cow"};
 }
 
 PaperRow MakePaperRow(const std::string& name, RowSize size) {

@@ -40,8 +40,8 @@ PaperRow MakePlantRow(RowSize size) {
   row.base.inputs.assign(row.steps, StepInput{});
   row.base.material = truth;
   using Field = LogMaterialVariables::Field;
-  auto material = std::make_shared<LogMaterialVariables>(std::vector<Field>{Field::kYoungsModulus, Field::kPoissonsRatio},
-                                                         truth);
+  auto material =
+      std::make_shared<LogMaterialVariables>(std::vector<Field>{Field::kYoungsModulus, Field::kPoissonsRatio}, truth);
   const VectorXd lower = Eigen::Vector2d(std::log(1e4), std::log(0.2));
   const VectorXd upper = Eigen::Vector2d(std::log(5e6), std::log(0.45));
   SetBlockBounds(material.get(), lower, upper);

@@ -79,8 +79,8 @@ PaperRow MakeQuadrupedRow(RowSize size) {
 
   std::vector<int> all(n);
   for (int i = 0; i < n; ++i) all[i] = i;
-  row.loss = {{std::make_shared<solvers::PointCoordinate>(solvers::MeanOf(n, all), solvers::kFinalState,
-                                                          Vec3(-1, 0, 0), "mean_position_x"),
+  row.loss = {{std::make_shared<solvers::PointCoordinate>(solvers::MeanOf(n, all), solvers::kFinalState, Vec3(-1, 0, 0),
+                                                          "mean_position_x"),
                1.0}};
   row.baseline = LossBaseline::kDiffPdFinal;
 

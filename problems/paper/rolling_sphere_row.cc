@@ -23,9 +23,9 @@ PaperRow MakeRollingSphereRow(RowSize size) {
   row.steps = paper ? 100 : 5;
 
   Scene& scene = row.scene;
-  scene.mesh = VoxelCells(
-      [&](int i, int j, int k) { return (dx * Vec3(i + 0.5, j + 0.5, k + 0.5) - centre).norm() < radius; },
-      Eigen::Vector3i::Constant(cells), dx);
+  scene.mesh =
+      VoxelCells([&](int i, int j, int k) { return (dx * Vec3(i + 0.5, j + 0.5, k + 0.5) - centre).norm() < radius; },
+                 Eigen::Vector3i::Constant(cells), dx);
   scene.material = MaterialParameters{2e6, 0.4, 1e3};
   scene.energies = {ElasticEnergy::kPdCorotated, ElasticEnergy::kPdVolume};
   scene.gravity = Vec3(0, 0, -9.81);
@@ -50,11 +50,11 @@ PaperRow MakeRollingSphereRow(RowSize size) {
   std::vector<int> all(n);
   for (int i = 0; i < n; ++i) all[i] = i;
   using solvers::InitialStateVariables;
-  auto x0 = std::make_shared<InitialStateVariables>(InitialStateVariables::kPosition, all,
-                                                    InitialStateVariables::kPerNode);
+  auto x0 =
+      std::make_shared<InitialStateVariables>(InitialStateVariables::kPosition, all, InitialStateVariables::kPerNode);
   x0->SetInitial(q0);
-  auto v0_block = std::make_shared<InitialStateVariables>(InitialStateVariables::kVelocity, all,
-                                                          InitialStateVariables::kPerNode);
+  auto v0_block =
+      std::make_shared<InitialStateVariables>(InitialStateVariables::kVelocity, all, InitialStateVariables::kPerNode);
   v0_block->SetInitial(v0);
   row.variables = {x0, v0_block, std::make_shared<ConstantForceVariables>(3 * n)};
   row.loss = {{std::make_shared<LinearFinalStateLoss>(gq, gv), 1.0}};

@@ -11,9 +11,9 @@ namespace diffpd::problems {
 
 struct RowEvaluation {
   double loss = 0;
-  VectorXd gradient;      // dL/dx (num_variables); empty when not requested
-  double forward_s = 0;   // wall seconds of Simulator::Simulate (a material change refactorises here)
-  double backward_s = 0;  // wall seconds of Simulator::Backward and the pull-back
+  VectorXd gradient;               // dL/dx (num_variables); empty when not requested
+  double forward_s = 0;            // wall seconds of Simulator::Simulate (a material change refactorises here)
+  double backward_s = 0;           // wall seconds of Simulator::Backward and the pull-back
   double iterations_per_step = 0;  // forward solver iterations per step
   int newton_fallback_steps = 0;   // PD-LBFGS steps finished by Newton
 };

@@ -15,3 +15,5 @@ diffpd_add_test(tradeoff_test ${_dir}/tools/tradeoff_test.cc LIBS diffpd_problem
 diffpd_add_test(stress_test ${_dir}/tools/stress_test.cc LIBS diffpd_problems)
 diffpd_add_test(numpy_random_test ${_dir}/paper/numpy_random_test.cc LIBS diffpd_problems)
 diffpd_add_test(paper_rows_test ${_dir}/paper/paper_rows_test.cc LIBS diffpd_problems)
+diffpd_add_test(row_gradient_test ${_dir}/paper/row_gradient_test.cc LIBS diffpd_problems)
+diffpd_add_test(activation_variables_test ${_dir}/paper/activation_variables_test.cc LIBS diffpd_problems)
