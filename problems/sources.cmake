@@ -45,6 +45,8 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/tools/bench.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/tradeoff.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/stress.cc
+  ${CMAKE_CURRENT_LIST_DIR}/tools/table.cc
+  ${CMAKE_CURRENT_LIST_DIR}/tools/table_report.cc
   # the diffpd program's subcommands (main.cc is the executable's)
   ${CMAKE_CURRENT_LIST_DIR}/cli/list_command.cc
   ${CMAKE_CURRENT_LIST_DIR}/cli/run_command.cc
@@ -52,9 +54,13 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/cli/bench_command.cc
   ${CMAKE_CURRENT_LIST_DIR}/cli/tradeoff_command.cc
   ${CMAKE_CURRENT_LIST_DIR}/cli/stress_command.cc
-  ${CMAKE_CURRENT_LIST_DIR}/cli/synth_command.cc)
+  ${CMAKE_CURRENT_LIST_DIR}/cli/synth_command.cc
+  ${CMAKE_CURRENT_LIST_DIR}/cli/table_command.cc)
 get_filename_component(DIFFPD_DEFAULT_SHARED_DATA_DIR "${CMAKE_CURRENT_LIST_DIR}/../../shared/data" ABSOLUTE)
 set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/shared_data.cc PROPERTIES
   COMPILE_DEFINITIONS "DIFFPD_SHARED_DATA_DIR=\"${DIFFPD_DEFAULT_SHARED_DATA_DIR}\"")
+get_filename_component(DIFFPD_SOURCE_ROOT "${CMAKE_CURRENT_LIST_DIR}/.." ABSOLUTE)
+set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/tools/table.cc PROPERTIES
+  COMPILE_DEFINITIONS "DIFFPD_SOURCE_DIR=\"${DIFFPD_SOURCE_ROOT}\"")
 set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_problem.cc PROPERTIES
   COMPILE_DEFINITIONS "DIFFPD_PROJECT_DATA_DIR=\"${CMAKE_CURRENT_LIST_DIR}/../data\"")

@@ -64,6 +64,7 @@ Subcommand AddBenchCommand(CLI::App* parent);     // bench_command.cc
 Subcommand AddTradeoffCommand(CLI::App* parent);  // tradeoff_command.cc
 Subcommand AddStressCommand(CLI::App* parent);    // stress_command.cc
 Subcommand AddSynthCommand(CLI::App* parent);     // synth_command.cc
+Subcommand AddTableCommand(CLI::App* parent);     // table_command.cc
 
 // Calibration problems fit with the library's PD-LBFGS settings and a silent
 // simulator: throws InvalidInputError if --lbfgs-scale, --no-rigid-correction

@@ -73,6 +73,7 @@ int main(int argc, char** argv) {
   const auto tradeoff = diffpd::problems::AddTradeoffCommand(&app);
   const auto stress = diffpd::problems::AddStressCommand(&app);
   const auto synth = diffpd::problems::AddSynthCommand(&app);
+  const auto table = diffpd::problems::AddTableCommand(&app);
 
   try {
     app.parse(argc, argv);
@@ -95,6 +96,7 @@ int main(int argc, char** argv) {
     if (*tradeoff.app) return tradeoff.run();
     if (*stress.app) return stress.run();
     if (*synth.app) return synth.run();
+    if (*table.app) return table.run();
   } catch (const diffpd::InvalidInputError& e) {
     std::fprintf(stderr, "diffpd: invalid input: %s\n", e.what());
     return 2;
