@@ -192,11 +192,10 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
     else if (previous->threads != options.threads)
       msg << "resume: the file was measured with " << previous->threads << " threads, this run asks for "
           << options.threads;
-    else if (previous->evaluations != options.evaluations ||
-             previous->newton_evaluations != options.newton_evaluations)
+    else if (previous->evaluations != options.evaluations || previous->newton_evaluations != options.newton_evaluations)
       msg << "resume: the file has " << previous->evaluations << " evaluations per PD method and "
-          << previous->newton_evaluations << " per Newton method, this run asks for " << options.evaluations
-          << " and " << options.newton_evaluations;
+          << previous->newton_evaluations << " per Newton method, this run asks for " << options.evaluations << " and "
+          << options.newton_evaluations;
     if (!msg.str().empty()) throw InvalidInputError(msg.str());
   }
   const Budget budget(options.budget_minutes);
@@ -307,6 +306,8 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
           const RowEvaluation e = EvaluateRow(row, &sim, x, true);
           forward += e.forward_s;
           backward += e.backward_s;
+          m.forward_samples.push_back(e.forward_s);
+          m.backward_samples.push_back(e.backward_s);
           ++m.evaluations;
           m.forward_s = forward / m.evaluations;
           m.backward_s = backward / m.evaluations;
@@ -391,6 +392,8 @@ json TableToJson(const TableResult& result) {
                          {"evaluations", m.evaluations},
                          {"forward_s", m.forward_s},
                          {"backward_s", m.backward_s},
+                         {"forward_samples_s", m.forward_samples},
+                         {"backward_samples_s", m.backward_samples},
                          {"loss", Number(m.loss)},
                          {"normalised_loss", Optional(m.normalised_loss)},
                          {"iterations_per_step", m.iterations_per_step},
@@ -465,6 +468,11 @@ TableResult TableFromJson(const json& j) {
       m.evaluations = Field<int>(mj, "evaluations", mwhere);
       m.forward_s = Field<double>(mj, "forward_s", mwhere);
       m.backward_s = Field<double>(mj, "backward_s", mwhere);
+      // Optional: files written before the samples were recorded lack them.
+      if (mj.contains("forward_samples_s"))
+        m.forward_samples = Field<std::vector<double>>(mj, "forward_samples_s", mwhere);
+      if (mj.contains("backward_samples_s"))
+        m.backward_samples = Field<std::vector<double>>(mj, "backward_samples_s", mwhere);
       m.loss = mj.contains("loss") && mj["loss"].is_number() ? mj["loss"].get<double>() : std::nan("");
       m.iterations_per_step = Field<double>(mj, "iterations_per_step", mwhere);
       m.newton_fallback_steps = Field<int>(mj, "newton_fallback_steps", mwhere);

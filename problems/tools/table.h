@@ -55,11 +55,13 @@ struct TableOptions {
 
 struct TableMethodResult {
   std::string method;
-  std::string failure;  // "" unless an evaluation failed (SolverError or invalid input)
-  int evaluations = 0;  // evaluations done
+  std::string failure;    // "" unless an evaluation failed (SolverError or invalid input)
+  int evaluations = 0;    // evaluations done
   double forward_s = 0;   // mean over the evaluations
   double backward_s = 0;  // mean over the evaluations
-  double loss = 0;        // L at the last evaluation
+  // Every evaluation's seconds, in order (for medians on a noisy machine).
+  std::vector<double> forward_samples, backward_samples;
+  double loss = 0;  // L at the last evaluation
   std::optional<double> normalised_loss;
   double iterations_per_step = 0;  // forward solver iterations per step, last evaluation
   int newton_fallback_steps = 0;   // pd-lbfgs steps finished by Newton, last evaluation

@@ -44,8 +44,8 @@ std::string Sci(const std::optional<double>& v) {
 std::string Seconds(double v) { return v >= 100 ? Fixed(v, 0) : v >= 1 ? Fixed(v, 1) : Fixed(v, 3); }
 
 struct Cells {
-  std::string row, dofs, method, forward, paper_forward, backward, paper_backward, evals, paper_evals, loss,
-      paper_loss, speedup, paper_speedup;
+  std::string row, dofs, method, forward, paper_forward, backward, paper_backward, evals, paper_evals, loss, paper_loss,
+      speedup, paper_speedup;
 };
 
 std::vector<Cells> TableCells(const TableResult& result) {
@@ -80,7 +80,7 @@ std::vector<Cells> TableCells(const TableResult& result) {
   return lines;
 }
 
-const char* kHeader[13] = {"row",   "DoFs / steps", "method",      "fwd s", "paper", "bwd s",   "paper",
+const char* kHeader[13] = {"row",   "DoFs / steps", "method",      "fwd s", "paper",    "bwd s", "paper",
                            "evals", "paper",        "loss (norm)", "paper", "speed-up", "paper"};
 
 std::vector<std::string> Row(const Cells& c) {
@@ -129,14 +129,16 @@ void PrintTable(const TableResult& result, std::FILE* out) {
     for (int k = 0; k < 13; ++k) width[k] = std::max(width[k], row[k].size());
   }
   auto print = [&](const std::vector<std::string>& row) {
-    for (int k = 0; k < 13; ++k) std::fprintf(out, k < 3 ? "%-*s  " : "%*s  ", static_cast<int>(width[k]), row[k].c_str());
+    for (int k = 0; k < 13; ++k)
+      std::fprintf(out, k < 3 ? "%-*s  " : "%*s  ", static_cast<int>(width[k]), row[k].c_str());
     std::fprintf(out, "\n");
   };
   print(std::vector<std::string>(kHeader, kHeader + 13));
   for (const Cells& c : cells) print(Row(c));
   for (const TableRowResult& r : result.rows)
     for (const TableMethodResult& m : r.methods)
-      if (!m.failure.empty()) std::fprintf(out, "# %s %s failed: %s\n", r.row.c_str(), m.method.c_str(), m.failure.c_str());
+      if (!m.failure.empty())
+        std::fprintf(out, "# %s %s failed: %s\n", r.row.c_str(), m.method.c_str(), m.failure.c_str());
   if (result.budget_exhausted) std::fprintf(out, "# the time budget ran out: rows marked '-' were not measured\n");
   std::fprintf(out, "# %s\n", Explanation(result).c_str());
   std::vector<std::string> shared;
@@ -149,8 +151,8 @@ void PrintTable(const TableResult& result, std::FILE* out) {
 
 std::string TableMarkdown(const TableResult& result, const std::string& command) {
   std::ostringstream s;
-  s << "Measured " << result.date << ", commit " << result.commit << ", " << result.machine << ", "
-    << result.threads << " threads, " << result.size << " instances:\n\n    " << command << "\n\n";
+  s << "Measured " << result.date << ", commit " << result.commit << ", " << result.machine << ", " << result.threads
+    << " threads, " << result.size << " instances:\n\n    " << command << "\n\n";
   s << "|";
   for (const char* h : kHeader) s << " " << h << " |";
   s << "\n|";
@@ -209,9 +211,10 @@ void WriteTablePlot(const TableResult& result, const std::string& png_path) {
   script << "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) { set terminal pngcairo size 1200,600 } else { set "
             "terminal png size 1200,600 }\n";
   script << "set output " << GnuplotQuote(png_path) << "\n";
-  script << "set title " << GnuplotQuote("Seconds per evaluation (forward + backward): this library on " +
-                                         std::to_string(result.threads) + " threads (" + result.date.substr(0, 10) +
-                                         ", " + result.commit + ") vs. the paper on 8")
+  script << "set title "
+         << GnuplotQuote("Seconds per evaluation (forward + backward): this library on " +
+                         std::to_string(result.threads) + " threads (" + result.date.substr(0, 10) + ", " +
+                         result.commit + ") vs. the paper on 8")
          << "\n";
   script << "set datafile missing '-'\nset style data histograms\nset style histogram clustered gap 1\n"
             "set style fill solid 0.9 border -1\nset boxwidth 0.9\nset logscale y\nset yrange ["
@@ -222,9 +225,9 @@ void WriteTablePlot(const TableResult& result, const std::string& png_path) {
   const char* paper_names[3] = {"DiffPD", "Newton-PCG", "Newton-Cholesky"};
   script << "plot ";
   for (int k = 0; k < 3; ++k) {
-    script << (k ? ", " : "") << "$data using " << 2 + 2 * k << ":xtic(1) title '" << methods[k]
-           << " (here)' lc rgb '" << colours[k] << "', $data using " << 3 + 2 * k << " title '" << paper_names[k]
-           << " (paper)' lc rgb '" << colours[k] << "' fill pattern 4";
+    script << (k ? ", " : "") << "$data using " << 2 + 2 * k << ":xtic(1) title '" << methods[k] << " (here)' lc rgb '"
+           << colours[k] << "', $data using " << 3 + 2 * k << " title '" << paper_names[k] << " (paper)' lc rgb '"
+           << colours[k] << "' fill pattern 4";
   }
   script << "\nset output\n";
   FILE* pipe = popen("gnuplot", "w");

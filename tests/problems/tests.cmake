@@ -17,3 +17,4 @@ diffpd_add_test(numpy_random_test ${_dir}/paper/numpy_random_test.cc LIBS diffpd
 diffpd_add_test(paper_rows_test ${_dir}/paper/paper_rows_test.cc LIBS diffpd_problems)
 diffpd_add_test(row_gradient_test ${_dir}/paper/row_gradient_test.cc LIBS diffpd_problems)
 diffpd_add_test(activation_variables_test ${_dir}/paper/activation_variables_test.cc LIBS diffpd_problems)
+diffpd_add_test(table_test ${_dir}/tools/table_test.cc LIBS diffpd_problems)
