@@ -64,7 +64,7 @@ std::string CommandLine(const TableArgs& a) {
   std::ostringstream s;
   s << "diffpd table --rows " << Joined(a.rows) << " --methods " << Joined(a.methods) << " --threads "
     << a.options.threads << " --evaluations " << a.options.evaluations << " --newton-evaluations "
-    << a.options.newton_evaluations;
+    << a.options.newton_evaluations << " --draws " << a.options.random_draws;
   if (a.small) s << " --small";
   if (a.options.budget_minutes > 0) s << " --budget-minutes " << a.options.budget_minutes;
   if (!a.json_file.empty()) s << " --json " << a.json_file;
@@ -105,8 +105,8 @@ int RunTableArgs(const TableArgs& args) {
 
 Subcommand AddTableCommand(CLI::App* parent) {
   auto args = std::make_shared<TableArgs>();
-  CLI::App* cmd = parent->add_subcommand(
-      "table", "the DiffPD paper's table (rows 1-9) measured here, beside the paper's numbers");
+  CLI::App* cmd =
+      parent->add_subcommand("table", "the DiffPD paper's table (rows 1-9) measured here, beside the paper's numbers");
   cmd->footer(kTableFooter);
   cmd->add_option("--rows", args->rows, "comma-separated rows, in the order to run them")
       ->delimiter(',')
@@ -119,6 +119,11 @@ Subcommand AddTableCommand(CLI::App* parent) {
       ->capture_default_str();
   cmd->add_option("--budget-minutes", args->options.budget_minutes,
                   "stop before the next evaluation after this many minutes (0: no budget)")
+      ->capture_default_str();
+  cmd->add_option("--draws", args->options.random_draws,
+                  "random draws (of each row's 16, the normalisation) to evaluate in this run; fewer leave the row "
+                  "for a later --resume")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--evaluations", args->options.evaluations, "evaluations per PD method (mean)")
       ->check(CLI::PositiveNumber)

@@ -39,6 +39,9 @@ RowEvaluation EvaluateRow(const PaperRow& row, Simulator* simulator, const Vecto
     const RolloutGradient g = simulator->Backward(rollout, dl);
     out.gradient = row.PullBack(x, g);
     out.backward_s = SecondsSince(start);
+    out.backward_iterations_per_step =
+        rollout.num_steps() > 0 ? double(g.report.linear_iterations) / rollout.num_steps() : 0;
+    out.backward_fallbacks = g.report.fallbacks;
   }
   return out;
 }

@@ -11,11 +11,13 @@ namespace diffpd::problems {
 
 struct RowEvaluation {
   double loss = 0;
-  VectorXd gradient;               // dL/dx (num_variables); empty when not requested
-  double forward_s = 0;            // wall seconds of Simulator::Simulate (a material change refactorises here)
-  double backward_s = 0;           // wall seconds of Simulator::Backward and the pull-back
-  double iterations_per_step = 0;  // forward solver iterations per step
-  int newton_fallback_steps = 0;   // PD-LBFGS steps finished by Newton
+  VectorXd gradient;                        // dL/dx (num_variables); empty when not requested
+  double forward_s = 0;                     // wall seconds of Simulator::Simulate (a material change refactorises here)
+  double backward_s = 0;                    // wall seconds of Simulator::Backward and the pull-back
+  double iterations_per_step = 0;           // forward solver iterations per step
+  int newton_fallback_steps = 0;            // PD-LBFGS steps finished by Newton
+  double backward_iterations_per_step = 0;  // adjoint solver iterations per step (0: direct solves)
+  int backward_fallbacks = 0;               // adjoint solves that fell back to a direct solve
 };
 
 // Simulates the row at variables x with `simulator` (made from row.scene; its

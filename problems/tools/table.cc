@@ -95,6 +95,8 @@ TableRowResult Describe(const PaperRow& row) {
   r.variables = row.num_variables();
   r.time_step = row.time_step;
   r.random_draws = static_cast<int>(row.random_draws.size());
+  r.initial_guess = row.initial_guess == InitialGuess::kBestRandomDraw ? "the best of the 16 random draws"
+                                                                       : "as the paper's script draws or sets it";
   r.paper = row.paper;
   r.notes = row.notes;
   return r;
@@ -177,6 +179,7 @@ void TableOptions::Validate() const {
           "newton-pcg)");
   if (threads < 0) ThrowInvalidOption("threads", threads, ">= 0");
   if (!std::isfinite(budget_minutes)) ThrowInvalidOption("budget minutes", budget_minutes, "finite (<= 0: none)");
+  if (random_draws < 0) ThrowInvalidOption("random draws", random_draws, ">= 0");
   if (evaluations < 1) ThrowInvalidOption("evaluations", evaluations, ">= 1");
   if (newton_evaluations < 1) ThrowInvalidOption("newton evaluations", newton_evaluations, ">= 1");
 }
@@ -203,6 +206,13 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
   result.date = UtcNow();
   result.commit = SourceCommit();
   result.machine = MachineLabel();
+  if (previous) {
+    result.resumed_runs = previous->resumed_runs;
+    result.resumed_runs.push_back(result.date + ", commit " + result.commit + ", " + result.machine);
+    result.date = previous->date;
+    result.commit = previous->commit;
+    result.machine = previous->machine;
+  }
   result.threads = options.threads;
   result.size = SizeName(options.size);
   result.evaluations = options.evaluations;
@@ -227,6 +237,7 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
       for (const TableRowResult& r : previous->rows)
         if (r.row == name) before = &r;
     if (before) {
+      if (!before->initial_guess.empty()) out.initial_guess = before->initial_guess;
       out.random_losses = before->random_losses;
       if (static_cast<int>(out.random_losses.size()) > out.random_draws) out.random_losses.resize(out.random_draws);
       for (const TableMethodResult& m : before->methods)
@@ -238,7 +249,10 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
     };
     bool all_done = static_cast<int>(out.random_losses.size()) == out.random_draws;
     for (Method m : options.methods) all_done = all_done && method_done(m);
-    if (!requested || all_done || result.budget_exhausted) {
+    // Nothing for this run: every method done and no draw it may evaluate left.
+    bool nothing_left = static_cast<int>(out.random_losses.size()) == out.random_draws || options.random_draws == 0;
+    for (Method m : options.methods) nothing_left = nothing_left && method_done(m);
+    if (!requested || nothing_left || result.budget_exhausted) {
       out.complete = all_done;
       Summarise(row, &out);
       continue;
@@ -259,9 +273,10 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
     }
 
     // The normalisation: the random draws' losses with pd-lbfgs.
-    if (static_cast<int>(out.random_losses.size()) < out.random_draws) {
+    const int draws = std::min(out.random_draws, static_cast<int>(out.random_losses.size()) + options.random_draws);
+    if (static_cast<int>(out.random_losses.size()) < draws) {
       Simulator sim(row.scene, pd_options);
-      for (int d = static_cast<int>(out.random_losses.size()); d < out.random_draws; ++d) {
+      for (int d = static_cast<int>(out.random_losses.size()); d < draws; ++d) {
         if (budget.spent()) break;
         try {
           const RowEvaluation e = EvaluateRow(row, &sim, row.random_draws[d], false);
@@ -277,18 +292,25 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
         save();
       }
     }
-    if (static_cast<int>(out.random_losses.size()) < out.random_draws) {
+    if (static_cast<int>(out.random_losses.size()) < draws) {
       result.budget_exhausted = true;
       Summarise(row, &out);
       save();
       continue;
     }
     if (row.initial_guess == InitialGuess::kBestRandomDraw) {
-      int best = 0;
-      for (int d = 1; d < out.random_draws; ++d)
-        if (out.random_losses[d] < out.random_losses[best]) best = d;
-      row.SetInitial(row.random_draws[best]);
-      Progress(progress, "[table] " + name + ": x_init is random draw " + std::to_string(best + 1));
+      if (static_cast<int>(out.random_losses.size()) == out.random_draws) {
+        int best = 0;
+        for (int d = 1; d < out.random_draws; ++d)
+          if (out.random_losses[d] < out.random_losses[best]) best = d;
+        row.SetInitial(row.random_draws[best]);
+        out.initial_guess = "the best of the 16 random draws (draw " + std::to_string(best + 1) + ")";
+      } else {
+        out.initial_guess =
+            "the first draw after seed 42 (the random draws, of which the paper takes the best, were "
+            "not all evaluated)";
+      }
+      Progress(progress, "[table] " + name + ": x_init is " + out.initial_guess);
     }
 
     // The methods.
@@ -314,10 +336,13 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
           m.loss = e.loss;
           m.iterations_per_step = e.iterations_per_step;
           m.newton_fallback_steps = e.newton_fallback_steps;
+          m.backward_iterations_per_step = e.backward_iterations_per_step;
+          m.backward_fallbacks = e.backward_fallbacks;
           std::ostringstream line;
           line << "[table] " << name << " " << m.method << " evaluation " << k + 1 << "/" << count << ": loss "
                << e.loss << ", |grad| " << e.gradient.norm() << ", forward " << Seconds(e.forward_s) << ", backward "
-               << Seconds(e.backward_s) << ", " << e.iterations_per_step << " iterations/step";
+               << Seconds(e.backward_s) << ", " << e.iterations_per_step << " iterations/step, "
+               << e.backward_iterations_per_step << " backward iterations/step";
           Progress(progress, line.str());
         }
         m.complete = m.evaluations == count;
@@ -341,7 +366,7 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
       Summarise(row, &out);
       save();
     }
-    all_done = true;
+    all_done = static_cast<int>(out.random_losses.size()) == out.random_draws;
     for (Method m : options.methods) all_done = all_done && method_done(m);
     out.complete = all_done;
     if (!all_done) result.budget_exhausted = true;
@@ -398,6 +423,8 @@ json TableToJson(const TableResult& result) {
                          {"normalised_loss", Optional(m.normalised_loss)},
                          {"iterations_per_step", m.iterations_per_step},
                          {"newton_fallback_steps", m.newton_fallback_steps},
+                         {"backward_iterations_per_step", m.backward_iterations_per_step},
+                         {"backward_fallbacks", m.backward_fallbacks},
                          {"complete", m.complete}});
     json random = json::array();
     for (double l : r.random_losses) random.push_back(Number(l));
@@ -412,6 +439,7 @@ json TableToJson(const TableResult& result) {
                     {"time_step", r.time_step},
                     {"variables", r.variables},
                     {"evaluation_point", r.evaluation_point},
+                    {"initial_guess", r.initial_guess},
                     {"random_draws", r.random_draws},
                     {"random_losses", random},
                     {"random_loss_mean", Optional(r.random_loss_mean)},
@@ -434,6 +462,7 @@ json TableToJson(const TableResult& result) {
           {"evaluations", result.evaluations},
           {"newton_evaluations", result.newton_evaluations},
           {"budget_exhausted", result.budget_exhausted},
+          {"resumed_runs", result.resumed_runs},
           {"rows", rows}};
 }
 
@@ -447,6 +476,8 @@ TableResult TableFromJson(const json& j) {
   result.evaluations = Field<int>(j, "evaluations", "the document");
   result.newton_evaluations = Field<int>(j, "newton_evaluations", "the document");
   result.budget_exhausted = Field<bool>(j, "budget_exhausted", "the document");
+  if (j.contains("resumed_runs"))
+    result.resumed_runs = Field<std::vector<std::string>>(j, "resumed_runs", "the document");
   const json rows = Field<json>(j, "rows", "the document");
   if (!rows.is_array()) throw InvalidInputError("table JSON: the document.rows has the wrong type");
   for (size_t i = 0; i < rows.size(); ++i) {
@@ -456,6 +487,7 @@ TableResult TableFromJson(const json& j) {
     r.row = Field<std::string>(rj, "row", where);
     r.size = Field<std::string>(rj, "size", where);
     r.complete = Field<bool>(rj, "complete", where);
+    if (rj.contains("initial_guess")) r.initial_guess = Field<std::string>(rj, "initial_guess", where);
     for (const json& l : Field<json>(rj, "random_losses", where))
       r.random_losses.push_back(l.is_null() ? std::nan("") : l.get<double>());
     const json methods = Field<json>(rj, "methods", where);
@@ -476,6 +508,9 @@ TableResult TableFromJson(const json& j) {
       m.loss = mj.contains("loss") && mj["loss"].is_number() ? mj["loss"].get<double>() : std::nan("");
       m.iterations_per_step = Field<double>(mj, "iterations_per_step", mwhere);
       m.newton_fallback_steps = Field<int>(mj, "newton_fallback_steps", mwhere);
+      if (mj.contains("backward_iterations_per_step"))
+        m.backward_iterations_per_step = Field<double>(mj, "backward_iterations_per_step", mwhere);
+      if (mj.contains("backward_fallbacks")) m.backward_fallbacks = Field<int>(mj, "backward_fallbacks", mwhere);
       m.complete = Field<bool>(mj, "complete", mwhere);
       r.methods.push_back(m);
     }

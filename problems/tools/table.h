@@ -44,6 +44,10 @@ struct TableOptions {
   // Wall-clock budget of the run in minutes; <= 0: none.
   double budget_minutes = 0;
   RowSize size = RowSize::kPaper;
+  // Random draws evaluated per row in this run, at most the row's 16 (the
+  // normalisation; the torus's x_init is the best of all 16, the first draw
+  // until all are done). Fewer leave the row incomplete for a later resume.
+  int random_draws = 16;       // >= 0
   int evaluations = 3;         // loss + gradient evaluations per PD method (pd, pd-lbfgs), >= 1
   int newton_evaluations = 1;  // per Newton method, >= 1
 
@@ -63,9 +67,11 @@ struct TableMethodResult {
   std::vector<double> forward_samples, backward_samples;
   double loss = 0;  // L at the last evaluation
   std::optional<double> normalised_loss;
-  double iterations_per_step = 0;  // forward solver iterations per step, last evaluation
-  int newton_fallback_steps = 0;   // pd-lbfgs steps finished by Newton, last evaluation
-  bool complete = false;           // all its evaluations done (or it failed)
+  double iterations_per_step = 0;           // forward solver iterations per step, last evaluation
+  int newton_fallback_steps = 0;            // pd-lbfgs steps finished by Newton, last evaluation
+  double backward_iterations_per_step = 0;  // adjoint solver iterations per step, last evaluation
+  int backward_fallbacks = 0;               // adjoint solves that fell back to a direct one, last evaluation
+  bool complete = false;                    // all its evaluations done (or it failed)
 };
 
 struct TableRowResult {
@@ -75,8 +81,10 @@ struct TableRowResult {
   std::string size;  // "paper" or "small"
   int nodes = 0, dofs = 0, elements = 0, steps = 0, variables = 0;
   double time_step = 0;
-  // Where the losses are evaluated: "x_init" (no optimiser yet).
+  // Where the losses are evaluated: "x_init" (no optimiser yet), and how
+  // x_init was chosen.
   std::string evaluation_point = "x_init";
+  std::string initial_guess;
   // Random draws' losses (pd-lbfgs), in order; their mean is L_random.
   std::vector<double> random_losses;
   int random_draws = 0;  // how many the row has (16, or 0 for a timing row)
@@ -92,19 +100,22 @@ struct TableRowResult {
 };
 
 struct TableResult {
-  std::string date;     // UTC, ISO 8601
-  std::string commit;   // git commit of the sources ("unknown" without git)
+  std::string date;     // UTC, ISO 8601, of the first run
+  std::string commit;   // git commit of the sources ("unknown" without git), of the first run
   std::string machine;  // "<cores>-core <arch>, <CPU model>"
   int threads = 0;
   std::string size;
   int evaluations = 0, newton_evaluations = 0;
   bool budget_exhausted = false;
+  // "<date>, commit <commit>" of each later run that resumed this result.
+  std::vector<std::string> resumed_runs;
   std::vector<TableRowResult> rows;
 };
 
 // Runs the table. `previous` (may be nullptr) is a result to resume from: its
-// complete rows and methods and its random-draw losses are kept (it must have
-// the same size, threads and evaluation counts; InvalidInputError
+// complete rows and methods and its random-draw losses are kept, and so are
+// its date, commit and machine, this run being added to resumed_runs (it must
+// have the same size, threads and evaluation counts; InvalidInputError
 // otherwise). `checkpoint` (may be empty) receives the whole result after
 // every draw and method; progress lines (one per evaluation) go to
 // `progress` (nullptr: silent). Throws InvalidInputError on bad options.

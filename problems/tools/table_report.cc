@@ -121,6 +121,7 @@ std::string Explanation(const TableResult& result) {
 void PrintTable(const TableResult& result, std::FILE* out) {
   std::fprintf(out, "# DiffPD paper table, %s instances: %s, commit %s, %s, %d threads\n", result.size.c_str(),
                result.date.c_str(), result.commit.c_str(), result.machine.c_str(), result.threads);
+  for (const std::string& run : result.resumed_runs) std::fprintf(out, "# resumed %s\n", run.c_str());
   const std::vector<Cells> cells = TableCells(result);
   std::vector<size_t> width(13);
   for (int k = 0; k < 13; ++k) width[k] = std::string(kHeader[k]).size();
