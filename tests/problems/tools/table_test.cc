@@ -106,11 +106,34 @@ TEST(TableTest, ResumeMeasuresOnlyTheUnfinishedMethod) {
   partial.rows[0].complete = false;
   int checkpoints = 0;
   std::ostringstream progress;
-  const TableResult resumed = RunTable(SmallOptions(), &partial, [&](const TableResult&) { ++checkpoints; }, &progress);
+  const TableResult resumed = RunTable(
+      SmallOptions(), &partial, [&](const TableResult&) { ++checkpoints; }, &progress);
   EXPECT_EQ(CountLines(progress.str(), "evaluation"), 1) << progress.str();
   EXPECT_EQ(CountLines(progress.str(), "cantilever newton-cholesky evaluation 1/1"), 1) << progress.str();
   EXPECT_TRUE(resumed.rows[0].complete);
   EXPECT_GE(checkpoints, 1);
+}
+
+TEST(TableTest, FewerDrawsLeaveTheRowIncompleteAndAResumeFinishesThem) {
+  TableOptions o = SmallOptions();
+  o.rows = {"plant"};
+  o.methods = {Method::kPdLbfgs};
+  o.random_draws = 3;
+  const TableResult part = RunTable(o, nullptr, {}, nullptr);
+  EXPECT_EQ(part.rows[0].random_losses.size(), 3u);
+  EXPECT_FALSE(part.rows[0].complete);
+  EXPECT_FALSE(part.rows[0].random_loss_mean);
+  EXPECT_EQ(part.rows[0].method("pd-lbfgs")->evaluations, 2);  // the methods run all the same
+  o.random_draws = 16;
+  std::ostringstream progress;
+  const TableResult whole = RunTable(o, &part, {}, &progress);
+  EXPECT_EQ(whole.rows[0].random_losses.size(), 16u);
+  EXPECT_TRUE(whole.rows[0].complete);
+  EXPECT_EQ(CountLines(progress.str(), "random draw"), 13) << progress.str();
+  EXPECT_EQ(CountLines(progress.str(), "evaluation"), 0) << progress.str();
+  EXPECT_EQ(whole.rows[0].random_losses[1], part.rows[0].random_losses[1]);
+  ASSERT_EQ(whole.resumed_runs.size(), 1u);
+  EXPECT_EQ(whole.date, part.date);
 }
 
 TEST(TableTest, ASpentBudgetStopsBeforeTheFirstEvaluation) {
