@@ -1,6 +1,7 @@
 // `diffpd table`: the command-line edge of table.h and table_report.h.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -41,6 +42,7 @@ struct TableArgs {
   std::string markdown_file;
   std::string plot_file;
   bool small = false;
+  bool report = false;
 };
 
 void WriteFileAtomically(const std::string& path, const std::string& text) {
@@ -78,7 +80,11 @@ int RunTableArgs(const TableArgs& args) {
   options.methods = ParseMethods(args.methods);
   options.size = args.small ? RowSize::kSmall : RowSize::kPaper;
   std::unique_ptr<TableResult> previous;
-  if (args.resume) {
+  if (args.report) {
+    options.measure = false;
+    if (args.json_file.empty()) throw InvalidInputError("--report needs --json FILE (the result to report)");
+  }
+  if (args.resume || args.report) {
     if (args.json_file.empty()) throw InvalidInputError("--resume needs --json FILE (the file to resume from)");
     std::ifstream in(args.json_file);
     if (!in) throw InvalidInputError("--resume: cannot open '" + args.json_file + "'");
@@ -91,10 +97,12 @@ int RunTableArgs(const TableArgs& args) {
     previous = std::make_unique<TableResult>(TableFromJson(j));
   }
   auto checkpoint = [&](const TableResult& r) {
-    if (!args.json_file.empty()) WriteFileAtomically(args.json_file, TableToJson(r).dump(2) + "\n");
+    if (!args.json_file.empty() && !args.report) WriteFileAtomically(args.json_file, TableToJson(r).dump(2) + "\n");
   };
-  const TableResult result = RunTable(options, previous.get(), checkpoint, &std::cerr);
+  TableResult result = RunTable(options, previous.get(), checkpoint, &std::cerr);
   checkpoint(result);
+  std::stable_sort(result.rows.begin(), result.rows.end(),
+                   [](const TableRowResult& a, const TableRowResult& b) { return a.table_index < b.table_index; });
   PrintTable(result, stdout);
   if (!args.markdown_file.empty()) WriteFileAtomically(args.markdown_file, TableMarkdown(result, CommandLine(args)));
   if (!args.plot_file.empty()) WriteTablePlot(result, args.plot_file);
@@ -136,6 +144,8 @@ Subcommand AddTableCommand(CLI::App* parent) {
   cmd->add_option("--markdown", args->markdown_file, "write the table as Markdown to this file");
   cmd->add_option("--plot", args->plot_file, "write a PNG chart of seconds per evaluation (needs gnuplot)");
   cmd->add_flag("--small", args->small, "the reduced instances (seconds per row)");
+  cmd->add_flag("--report", args->report, "measure nothing: print (and --markdown, --plot) the result in --json FILE")
+      ->excludes("--resume");
   return {cmd, [args] { return RunTableArgs(*args); }};
 }
 

@@ -102,6 +102,7 @@ SolverOptions PaperRow::Options(Method method, int threads) const {
   o.time_step = time_step;
   o.rel_tolerance = solver.rel_tolerance;
   o.abs_tolerance = solver.abs_tolerance;
+  o.tolerance_reference = ToleranceReference::kInertia;  // the original's step test
   o.backward_rel_tolerance = solver.rel_tolerance;
   o.max_iterations = solver.max_iterations;
   o.max_line_search_steps = solver.max_line_search_steps;
@@ -121,8 +122,9 @@ std::vector<std::string> CommonRowNotes() {
   return {
       "masses: lumped (each element's rho V shared by its 8 corners), where the original gives every node rho dx^3 "
       "(heavier surface nodes there, and more total mass)",
-      "step tolerance: |grad g| <= abs_tol + rel_tol |grad g(x_i + h v_i)| (relative to the step's first residual), "
-      "where the original uses rel_tol |(m / h^2) rhs| (relative to the inertia term, a looser test)",
+      "step tolerance: the original's test, |grad g| <= abs_tol + rel_tol |(M / h^2)(x_i + h v_i) + f| on the free "
+      "DoFs (relative to the inertial term; this library's default is relative to the step's first residual, a far "
+      "tighter test), with this library's masses M",
       "pd-lbfgs: this library's preconditioner (the PD matrix with its elastic weights scaled by 0.3, and a coarse "
       "correction of the rigid modes of bodies without Dirichlet nodes) where DiffPD uses the PD matrix itself",
       "newton-pcg: CG with incomplete Cholesky stopped at relative residual 1e-8, where the original uses Eigen's "

@@ -130,8 +130,10 @@ struct PaperRow {
   // for the rollout's steps).
   double Loss(const Rollout& rollout, LossGradient* gradient) const;
   // The simulator options of `method` with the row's settings: time step,
-  // tolerances (the adjoint's relative tolerance = rel_tolerance), iteration
-  // and line-search limits, L-BFGS history, `threads` threads.
+  // tolerances (the step test relative to the inertial term, as the original
+  // code's: ToleranceReference::kInertia; the adjoint's relative tolerance =
+  // rel_tolerance), iteration and line-search limits, L-BFGS history,
+  // `threads` threads.
   SolverOptions Options(Method method, int threads) const;
   // Runs `prepare` once with `options` (nothing if empty).
   void Prepare(const SolverOptions& options);

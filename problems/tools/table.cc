@@ -208,7 +208,8 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
   result.machine = MachineLabel();
   if (previous) {
     result.resumed_runs = previous->resumed_runs;
-    result.resumed_runs.push_back(result.date + ", commit " + result.commit + ", " + result.machine);
+    if (options.measure)
+      result.resumed_runs.push_back(result.date + ", commit " + result.commit + ", " + result.machine);
     result.date = previous->date;
     result.commit = previous->commit;
     result.machine = previous->machine;
@@ -227,8 +228,10 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
     if (checkpoint) checkpoint(result);
   };
 
+  if (!options.measure) result.budget_exhausted = previous && previous->budget_exhausted;
   for (const std::string& name : names) {
-    const bool requested = std::find(options.rows.begin(), options.rows.end(), name) != options.rows.end();
+    const bool requested =
+        options.measure && std::find(options.rows.begin(), options.rows.end(), name) != options.rows.end();
     PaperRow row = MakePaperRow(name, options.size);
     result.rows.push_back(Describe(row));
     TableRowResult& out = result.rows.back();

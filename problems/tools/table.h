@@ -50,6 +50,8 @@ struct TableOptions {
   int random_draws = 16;       // >= 0
   int evaluations = 3;         // loss + gradient evaluations per PD method (pd, pd-lbfgs), >= 1
   int newton_evaluations = 1;  // per Newton method, >= 1
+  // false: measure nothing; only rebuild the report of `previous` (RunTable).
+  bool measure = true;
 
   TableOptions();  // rows = every row
   // Throws InvalidInputError naming the field, its value and the valid range

@@ -17,12 +17,13 @@ namespace diffpd::problems::testing {
 // along `directions` random directions d (entries N(0, 1) times the
 // variable's range: its bounds' width, or max(|x_j|, 1e-3) where unbounded),
 // eps = 1e-4, with every solve converged tightly (`method`, relative
-// tolerance 1e-10, adjoint 1e-12, one thread). Expects the relative error
+// tolerance 1e-10 of the start residual, adjoint 1e-12, one thread). Expects the relative error
 // |fd - adjoint| / max(|fd|, |adjoint|) <= tolerance for each direction.
 inline void ExpectRowGradientMatchesCentralDifferences(PaperRow row, int directions = 2, double tolerance = 1e-4,
                                                        Method method = Method::kPdLbfgs) {
   SolverOptions options = row.Options(method, 1);
   options.rel_tolerance = 1e-10;
+  options.tolerance_reference = ToleranceReference::kStartResidual;
   options.abs_tolerance = 1e-13;
   options.backward_rel_tolerance = 1e-12;
   row.Prepare(options);

@@ -100,6 +100,21 @@ TEST(TableTest, JsonRoundTripAndAResumeOfAFinishedRunMeasuresNothing) {
             SmallRun().rows[1].method("newton-cholesky")->forward_s);
 }
 
+TEST(TableTest, AReportOnlyRunOfAPartialResultMeasuresNothingAndAddsNoRun) {
+  TableResult partial = TableFromJson(TableToJson(SmallRun()));
+  partial.rows[0].methods.pop_back();  // the cantilever's newton-cholesky
+  partial.rows[0].complete = false;
+  TableOptions o = SmallOptions();
+  o.measure = false;
+  std::ostringstream progress;
+  const TableResult report = RunTable(o, &partial, {}, &progress);
+  EXPECT_EQ(CountLines(progress.str(), "evaluation"), 0) << progress.str();
+  EXPECT_TRUE(report.resumed_runs.empty());
+  EXPECT_FALSE(report.rows[0].complete);
+  EXPECT_EQ(report.rows[0].method("newton-cholesky"), nullptr);
+  EXPECT_EQ(report.rows[1].method("pd-lbfgs")->forward_s, SmallRun().rows[1].method("pd-lbfgs")->forward_s);
+}
+
 TEST(TableTest, ResumeMeasuresOnlyTheUnfinishedMethod) {
   TableResult partial = TableFromJson(TableToJson(SmallRun()));
   partial.rows[0].methods.pop_back();  // the cantilever's newton-cholesky
