@@ -1,7 +1,5 @@
 #include "diffpd/vtk_writer.h"
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -11,6 +9,7 @@
 
 #include "diffpd/box_mesh.h"
 #include "diffpd/error.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd {
 namespace {
@@ -30,14 +29,9 @@ int Count(const std::string& text, const std::string& pattern) {
 
 class VtkWriterTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    directory_ = std::filesystem::path(::testing::TempDir()) / ("diffpd_vtk_writer_test_" + std::to_string(getpid()));
-    std::filesystem::create_directories(directory_);
-  }
-  void TearDown() override { std::filesystem::remove_all(directory_); }
-  std::string Path(const std::string& name) const { return (directory_ / name).string(); }
+  std::string Path(const std::string& name) const { return directory_.File(name); }
 
-  std::filesystem::path directory_;
+  const testing::TemporaryDirectory directory_{"diffpd-vtk-writer"};
 };
 
 Mesh TwoTets() {

@@ -8,12 +8,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <set>
 
 #include "calibration/calibrate_starfish.h"
 #include "diffpd/error.h"
+#include "util/expect_message.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd::problems {
 namespace {
@@ -24,19 +24,16 @@ const std::string kCyclic2 = kStarfishDir + "data_horizontal_cyclic2.csv";
 const std::string kHeader = "Time (ms),Tendon (mm),M1 X,M1 Y,M2 X,M2 Y,M3 X,M3 Y,M4 X,M4 Y\n";
 const std::string kRow0 = "0,0,1,2,3,4,5,6,7,8\n";
 
-std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = (std::filesystem::temp_directory_path() / name).string();
-  std::ofstream(path) << text;
-  return path;
+// This program's own temporary directory (removed at exit).
+const testing::TemporaryDirectory& Scratch() {
+  static const testing::TemporaryDirectory directory("diffpd-starfish-recordings");
+  return directory;
 }
 
+std::string WriteTemp(const std::string& name, const std::string& text) { return Scratch().WriteFile(name, text); }
+
 std::string ReadError(const std::string& path) {
-  try {
-    ReadStarfishRecording(path);
-  } catch (const InvalidInputError& e) {
-    return e.what();
-  }
-  return "(no error)";
+  return testing::MessageOf<InvalidInputError>([&] { ReadStarfishRecording(path); });
 }
 
 TEST(CalibrateStarfishTest, ReadsTheRealRecordingsInSiUnits) {
@@ -59,8 +56,7 @@ TEST(CalibrateStarfishTest, ReadsTheRealRecordingsInSiUnits) {
 }
 
 TEST(CalibrateStarfishTest, RejectsMalformedFilesNamingFileAndLine) {
-  const std::string missing = (std::filesystem::temp_directory_path() / "starfish_missing.csv").string();
-  std::filesystem::remove(missing);
+  const std::string missing = Scratch().File("starfish_missing.csv");
   EXPECT_EQ(ReadError(missing), "cannot open '" + missing + "'");
   std::string p = WriteTemp("starfish_empty.csv", "");
   EXPECT_EQ(ReadError(p), p + ": empty file (expected a header row and data rows)");

@@ -16,6 +16,7 @@
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
 #include "solvers/ipopt_test_problems.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd::problems {
 namespace {
@@ -81,12 +82,6 @@ class CubeThrow : public TrajectoryOptimizationProblem {
   double rise_;
 };
 
-fs::path FreshDirectory(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("diffpd_ipopt_driver_" + name);
-  fs::remove_all(dir);
-  return dir;
-}
-
 std::string ReadFile(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream s;
@@ -151,7 +146,8 @@ TEST(IpoptTrajectoryOptimizationTest, PdRunIsRepeatedWithNewtonAndTheTimeRatioIs
 }
 
 TEST(IpoptTrajectoryOptimizationTest, RunWritesFramesHistoriesPlotAndOneJsonObject) {
-  const fs::path dir = FreshDirectory("files");
+  const testing::TemporaryDirectory temp("diffpd-ipopt-driver-files");
+  const fs::path dir = temp.path();
   const CubeThrow problem(0.01);
   CommandArgs args;
   args.problem = problem.name();
@@ -200,11 +196,11 @@ TEST(IpoptTrajectoryOptimizationTest, RunWritesFramesHistoriesPlotAndOneJsonObje
   ASSERT_GT(png.size(), 8u) << "no PNG written (is gnuplot installed?)";
   EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
   EXPECT_EQ(nlohmann::json::parse(ReadFile(dir / "summary.json")), j);
-  fs::remove_all(dir);
 }
 
 TEST(IpoptTrajectoryOptimizationTest, UnreachableConstraintIsReportedInfeasibleWithExitCode4) {
-  const fs::path dir = FreshDirectory("infeasible");
+  const testing::TemporaryDirectory temp("diffpd-ipopt-driver-infeasible");
+  const fs::path dir = temp.path();
   const CubeThrow problem(0.5);  // a 1 m/s throw rises under 4 cm in 50 ms
   CommandArgs args;
   args.problem = problem.name();
@@ -224,7 +220,6 @@ TEST(IpoptTrajectoryOptimizationTest, UnreachableConstraintIsReportedInfeasibleW
                      "(Infeasible_Problem_Detected)"),
             std::string::npos)
       << err;
-  fs::remove_all(dir);
 }
 
 TEST(IpoptTrajectoryOptimizationTest, StepsAndTimeStepAreRefusedWithAMessage) {
