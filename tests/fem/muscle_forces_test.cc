@@ -15,6 +15,7 @@
 #include "fem/muscle_forces.h"
 #include "tools/gradcheck.h"
 #include "test_scenes.h"
+#include "util/expect_message.h"
 
 namespace diffpd {
 namespace {
@@ -232,20 +233,12 @@ TEST(MuscleRolloutTest, BadActivationIsRejectedWithAClearMessage) {
   Simulator sim(MuscleBeam(), SolverOptions());
   StepInput wrong_size;
   wrong_size.activation = Eigen::Vector3d(1, 1, 1);
-  try {
-    sim.Step(sim.RestState(), wrong_size);
-    FAIL();
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(), "activation has 3 entries, expected 2 (one per muscle)");
-  }
+  ASSERT_THROW_MESSAGE(sim.Step(sim.RestState(), wrong_size), InvalidInputError,
+                       "activation has 3 entries, expected 2 (one per muscle)");
   StepInput nan;
   nan.activation = Eigen::Vector2d(1, std::nan(""));
-  try {
-    sim.Step(sim.RestState(), nan);
-    FAIL();
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(), "activation[1] = nan is invalid: must be finite and >= 0");
-  }
+  ASSERT_THROW_MESSAGE(sim.Step(sim.RestState(), nan), InvalidInputError,
+                       "activation[1] = nan is invalid: must be finite and >= 0");
   StepInput negative;
   negative.activation = Eigen::Vector2d(-0.5, 1);
   EXPECT_THROW(sim.Step(sim.RestState(), negative), InvalidInputError);

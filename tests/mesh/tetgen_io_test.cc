@@ -110,12 +110,7 @@ TEST(TetrahedralizeSurfaceTest, SphereVolumeMatchesSurface) {
 TEST(TetrahedralizeSurfaceTest, Errors) {
   const SurfaceMesh sphere = ReadObj(DIFFPD_SHARED_DIR "/data/meshes/sphere.obj");
   auto message = [&](const SurfaceMesh& surface, const std::string& switches, double scale) {
-    try {
-      TetrahedralizeSurface(surface, switches, scale);
-    } catch (const std::exception& error) {
-      return std::string(error.what());
-    }
-    return std::string("no exception");
+    return testing::MessageOf<std::exception>([&] { TetrahedralizeSurface(surface, switches, scale); });
   };
   EXPECT_EQ(message(sphere, "-pq", 1.0),
             "TetrahedralizeSurface: switches '-pq' must be one word without '-' or spaces, e.g. \"pq1.414Y\"");

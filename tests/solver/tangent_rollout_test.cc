@@ -10,6 +10,7 @@
 #include "diffpd/state_forces.h"
 #include "diffpd/simulator.h"
 #include "test_scenes.h"
+#include "util/expect_message.h"
 
 namespace diffpd {
 namespace {
@@ -218,12 +219,7 @@ TEST(TangentRolloutTest, RejectsBadDirectionsWithMessages) {
   Simulator sim(testing::SmallBeamScene(), TightOptions(Method::kPd));
   const Rollout rollout = sim.Simulate(sim.RestState(), std::vector<StepInput>(2));
   auto message = [&](const std::vector<InputDirection>& dirs) {
-    try {
-      sim.Tangents(rollout, dirs);
-    } catch (const InvalidInputError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no exception");
+    return testing::MessageOf<InvalidInputError>([&] { sim.Tangents(rollout, dirs); });
   };
   EXPECT_EQ(message({}), "Tangents: no direction given (need at least one)");
   InputDirection bad;
@@ -341,12 +337,8 @@ TEST(TangentRolloutTest, ActivationTangentsMatchFiniteDifferences) {
   const Rollout rollout = sim.Simulate(sim.RestState(), std::vector<StepInput>(2));
   InputDirection bad;
   bad.activation = {VectorXd::Ones(2), VectorXd()};
-  try {
-    sim.Tangents(rollout, {bad});
-    FAIL();
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(), "Tangents: direction 0 has an activation with 2 entries, expected 1 (one per muscle)");
-  }
+  ASSERT_THROW_MESSAGE(sim.Tangents(rollout, {bad}), InvalidInputError,
+                       "Tangents: direction 0 has an activation with 2 entries, expected 1 (one per muscle)");
 }
 
 TEST(TangentRolloutTest, StateForcesAreRejectedUntilSupported) {
@@ -354,14 +346,9 @@ TEST(TangentRolloutTest, StateForcesAreRejectedUntilSupported) {
   scene.linear_damping = 0.5;
   Simulator sim(scene, TightOptions(Method::kNewtonCholesky));
   const Rollout rollout = sim.Simulate(sim.RestState(), std::vector<StepInput>(2));
-  try {
-    sim.Tangents(rollout, {InputDirection::Density()});
-    FAIL();
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(),
-                 "Tangents: explicit state forces (linear damping, hydrodynamics, penalty friction) are not "
-                 "differentiated in forward mode yet; use Backward");
-  }
+  ASSERT_THROW_MESSAGE(sim.Tangents(rollout, {InputDirection::Density()}), InvalidInputError,
+                       "Tangents: explicit state forces (linear damping, hydrodynamics, penalty friction) are not "
+                       "differentiated in forward mode yet; use Backward");
 }
 
 }  // namespace

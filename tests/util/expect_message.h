@@ -48,10 +48,12 @@ struct ThrownMessage {
 template <class E, class Call>
 ThrownMessage CatchMessage(Call&& call) {
   try {
-    std::forward<Call>(call)();
-  } catch (const E& error) {
-    return {true, error.what()};
-  } catch (const std::exception& error) {
+    try {
+      std::forward<Call>(call)();
+    } catch (const E& error) {
+      return {true, error.what()};
+    }
+  } catch (const std::exception& error) {  // (nested: E may itself be std::exception)
     return {false, "(" + TypeName(typeid(error)) + " thrown instead of " + TypeName(typeid(E)) + ": \"" + error.what() +
                        "\")"};
   } catch (...) {

@@ -17,6 +17,7 @@
 #include "diffpd/simulator.h"
 #include "solvers/ipopt_test_problems.h"
 #include "util/temporary_directory.h"
+#include "util/expect_message.h"
 
 namespace diffpd::problems {
 namespace {
@@ -226,14 +227,9 @@ TEST(IpoptTrajectoryOptimizationTest, StepsAndTimeStepAreRefusedWithAMessage) {
   const CubeThrow problem(0.01);
   CommandArgs args;
   args.steps = 10;
-  try {
-    problem.Run(args);
-    FAIL() << "no throw";
-  } catch (const InvalidInputError& e) {
-    EXPECT_EQ(std::string(e.what()),
-              "--steps and --dt are fixed by the optimisation problem 'cube-throw'; use --small for the reduced "
-              "instance");
-  }
+  ASSERT_THROW_MESSAGE(problem.Run(args), InvalidInputError,
+                       "--steps and --dt are fixed by the optimisation problem 'cube-throw'; use --small for the "
+                       "reduced instance");
 }
 
 TEST(IpoptTrajectoryOptimizationTest, IpoptOptionsAreParsedByTheirValue) {
@@ -248,12 +244,8 @@ TEST(IpoptTrajectoryOptimizationTest, IpoptOptionsAreParsedByTheirValue) {
   ASSERT_EQ(o.string_options.size(), 1u);
   EXPECT_EQ(o.string_options[0], std::make_pair(std::string("mu_strategy"), std::string("adaptive")));
   for (const char* bad : {"max_iter", "=3", "tol="}) {
-    try {
-      AddIpoptOption(bad, &o);
-      FAIL() << bad;
-    } catch (const InvalidInputError& e) {
-      EXPECT_EQ(std::string(e.what()), std::string("Ipopt option '") + bad + "' is invalid: expected name=value");
-    }
+    ASSERT_THROW_MESSAGE(AddIpoptOption(bad, &o), InvalidInputError,
+                         std::string("Ipopt option '") + bad + "' is invalid: expected name=value");
   }
   EXPECT_EQ(DefaultOutputDirectory("bunny"), (fs::path("out") / "bunny").string());
 }
