@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <stdexcept>
 
@@ -36,7 +37,8 @@ DifferenceCheck Verdict(double error, double analytic, double numeric, double h,
   c.scale = options.derivative_scale > 0 ? options.derivative_scale : analytic;
   const double value_scale = options.value_scale > 0 ? options.value_scale : measured_values;
   c.noise_floor = options.noise * value_scale / h * std::sqrt(static_cast<double>(columns));
-  c.floor = options.floor >= 0 ? options.floor : c.noise_floor;
+  c.floor_given = options.floor >= 0;
+  c.floor = c.floor_given ? options.floor : c.noise_floor;
   c.tolerance = std::max(options.rtol * c.scale, c.floor);
   c.truncation = truncation;
   return c;
@@ -55,7 +57,9 @@ double DifferenceCheck::margin() const {
   return tolerance / error;
 }
 
-bool DifferenceCheck::marginal() const { return passed() && (margin() < 4 || floor > rtol * scale); }
+bool DifferenceCheck::marginal() const {
+  return passed() && (margin() < 2 || (!floor_given && noise_floor > rtol * scale));
+}
 
 std::string DifferenceCheck::Describe() const {
   std::string s = "central difference ";
@@ -72,8 +76,9 @@ std::string DifferenceCheck::Describe() const {
        Format(noise_floor);
   s += std::isnan(truncation) ? std::string(", truncation not measured") : ", truncation ~" + Format(truncation);
   if (floor > rtol * scale) {
-    s += "; the floor sets the tolerance: the differences resolve the derivative only to " + Format(floor / scale) +
-         " relative";
+    s += floor_given ? "; the given floor sets the tolerance (" + Format(floor / scale) + " relative)"
+                     : "; the noise floor sets the tolerance: the differences resolve the derivative only to " +
+                           Format(floor / scale) + " relative";
   }
   if (!std::isnan(truncation) && truncation > tolerance) {
     s += "; the truncation estimate exceeds the tolerance: f is not smooth within 2h, or h is too large";
@@ -155,6 +160,7 @@ DifferenceCheck CompareCentralDifference(double f_plus, double f_minus, double h
 }
 
 ::testing::AssertionResult Passes(const DifferenceCheck& check) {
+  if (std::getenv("DIFFPD_PRINT_DIFFERENCE_CHECKS")) std::cout << "[ CHECK ] " << check.Describe() << std::endl;
   if (!check.passed()) return ::testing::AssertionFailure() << check.Describe();
   if (check.marginal()) std::cout << "[ MARGINAL ] " << check.Describe() << std::endl;
   return ::testing::AssertionSuccess() << check.Describe();

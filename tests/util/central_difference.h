@@ -70,15 +70,16 @@ struct DifferenceOptions {
 };
 
 struct DifferenceCheck {
-  double step = 0;         // h (along d, or per Jacobian column)
-  double analytic = 0;     // |an|
-  double numeric = 0;      // |fd|
-  double error = 0;        // |fd - an|
-  double scale = 0;        // the quantity's scale rtol applies to
-  double rtol = 0;         //
-  double noise_floor = 0;  // eta * value_scale / h: what evaluation noise can put into fd
-  double floor = 0;        // the absolute floor applied (noise_floor unless given)
-  double tolerance = 0;    // max(rtol * scale, floor)
+  double step = 0;           // h (along d, or per Jacobian column)
+  double analytic = 0;       // |an|
+  double numeric = 0;        // |fd|
+  double error = 0;          // |fd - an|
+  double scale = 0;          // the quantity's scale rtol applies to
+  double rtol = 0;           //
+  double noise_floor = 0;    // eta * value_scale / h: what evaluation noise can put into fd
+  double floor = 0;          // the absolute floor applied (noise_floor unless given)
+  bool floor_given = false;  // the test gave its own floor (DifferenceOptions::floor)
+  double tolerance = 0;      // max(rtol * scale, floor)
   // |fd(2h) - fd(h)| / 3, the truncation error of fd at h (NaN: not measured).
   double truncation = std::numeric_limits<double>::quiet_NaN();
 
@@ -86,8 +87,10 @@ struct DifferenceCheck {
   // tolerance / error: how many times the error fits in the tolerance (>= 1
   // passes; infinite for an exact match).
   double margin() const;
-  // Passed, but with margin < 4, or with the floor above rtol * scale (the
-  // differences resolve the derivative only to floor / scale).
+  // Passed, but with margin < 2, or (policy floor) with the noise floor
+  // above rtol * scale: the differences resolve the derivative only to
+  // noise_floor / scale. A test that gives its own floor has judged the
+  // noise itself; only its margin is judged then.
   bool marginal() const;
   // One line with every number above and the verdict.
   std::string Describe() const;
@@ -121,7 +124,9 @@ DifferenceCheck CompareCentralDifference(double f_plus, double f_minus, double h
                                          const DifferenceOptions& options = DifferenceOptions());
 
 // Success when check.passed(); the failure message is check.Describe(). A
-// marginal pass prints "[ MARGINAL ] <Describe()>" on stdout.
+// marginal pass prints "[ MARGINAL ] <Describe()>" on stdout; with the
+// environment variable DIFFPD_PRINT_DIFFERENCE_CHECKS set, every check prints
+// "[ CHECK ] <Describe()>" (to see the margins of a whole test).
 ::testing::AssertionResult Passes(const DifferenceCheck& check);
 
 }  // namespace diffpd::testing
