@@ -58,7 +58,7 @@ double DifferenceCheck::margin() const {
 }
 
 bool DifferenceCheck::marginal() const {
-  return passed() && (margin() < 2 || (!floor_given && noise_floor > rtol * scale));
+  return passed() && error > 0 && (margin() < 2 || (!floor_given && noise_floor > rtol * scale));
 }
 
 std::string DifferenceCheck::Describe() const {

@@ -87,7 +87,7 @@ struct DifferenceCheck {
   // tolerance / error: how many times the error fits in the tolerance (>= 1
   // passes; infinite for an exact match).
   double margin() const;
-  // Passed, but with margin < 2, or (policy floor) with the noise floor
+  // Passed inexactly, but with margin < 2, or (policy floor) with the noise floor
   // above rtol * scale: the differences resolve the derivative only to
   // noise_floor / scale. A test that gives its own floor has judged the
   // noise itself; only its margin is judged then.

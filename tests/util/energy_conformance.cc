@@ -31,7 +31,7 @@ struct Setup {
   std::vector<VectorXd> states;
   const TermScales* scales;
   double Input(const VectorXd& y) const {
-    if (scales->input > 0) return scales->input;
+    if (scales->input) return scales->input(y);
     const double s = InfNorm(y);
     return s > 0 ? s : 1.0;
   }

@@ -74,8 +74,10 @@ struct TermScales {
   // relative to, at state y; empty: |value(y)|. Near rest an energy is tiny
   // against its terms (mu (sigma - 1)^2 vs mu sigma^2): give it.
   std::function<double(const VectorXd& y)> value;
-  // Typical magnitude of y; <= 0: |y|_inf.
-  double input = 0;
+  // The scale over which the term changes at state y (the input_scale of
+  // the step rule: element size for node positions, DeformationScale for a
+  // deformation gradient); empty: |y|_inf.
+  std::function<double(const VectorXd& y)> input;
 };
 
 struct EnergyTerm {
