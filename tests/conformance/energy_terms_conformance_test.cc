@@ -14,6 +14,8 @@
 // mass and parameter derivatives. A new term adds a row.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cctype>
 #include <functional>
 #include <iostream>
 #include <memory>

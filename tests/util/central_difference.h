@@ -16,6 +16,10 @@
 // one evaluation of f: a few units of rounding for closed forms (default
 // 1e-15), the solve's relative tolerance for a value computed by an iterative
 // solve (a rollout at rel_tolerance 1e-12: h = 1e-4 input_scale).
+// input_scale is the input's magnitude (default |x|_inf), or the distance
+// over which f changes where that is smaller: DeformationScale(F) for a
+// deformation gradient (deformation.h), the element size for node positions,
+// 0.5 - nu for Poisson's ratio (lambda's pole).
 //
 // Tolerance. Relative to the quantity's scale, floored at what the evaluation
 // noise can put into fd:
@@ -53,7 +57,7 @@ struct DifferenceOptions {
   double noise = 1e-15;
   // Pass: |fd - an| <= max(rtol * scale, floor).
   double rtol = 1e-6;
-  // Typical magnitude of the input (units of x); <= 0: |x|_inf (1 if x = 0).
+  // The input's scale (units of x, see above); <= 0: |x|_inf (1 if x = 0).
   double input_scale = 0;
   // Magnitude of f's values the noise is relative to; <= 0: the larger
   // |f(x +- h d)| (2-norm).
@@ -75,7 +79,7 @@ struct DifferenceCheck {
   double numeric = 0;        // |fd|
   double error = 0;          // |fd - an|
   double scale = 0;          // the quantity's scale rtol applies to
-  double rtol = 0;           //
+  double rtol = 0;           // the relative tolerance applied
   double noise_floor = 0;    // eta * value_scale / h: what evaluation noise can put into fd
   double floor = 0;          // the absolute floor applied (noise_floor unless given)
   bool floor_given = false;  // the test gave its own floor (DifferenceOptions::floor)
