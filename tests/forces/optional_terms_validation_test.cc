@@ -9,6 +9,7 @@
 #include "diffpd/error.h"
 #include "diffpd/scene.h"
 #include "test_scenes.h"
+#include "util/expect_message.h"
 
 namespace diffpd {
 namespace {
@@ -32,12 +33,7 @@ void ExpectMessage(const std::function<void(Scene*)>& spoil, const std::string& 
   scene.linear_damping = 0.1;
   scene.Validate();  // the unspoilt scene is valid
   spoil(&scene);
-  try {
-    scene.Validate();
-    ADD_FAILURE() << "no error, expected: " << message;
-  } catch (const InvalidInputError& e) {
-    EXPECT_EQ(std::string(e.what()), message);
-  }
+  EXPECT_THROW_MESSAGE(scene.Validate(), InvalidInputError, message);
 }
 
 TEST(OptionalTermsValidationTest, MuscleErrorsNameTheMuscleAndTheValue) {

@@ -1,15 +1,13 @@
 #include "diffpd/gmsh_io.h"
 
-#include <unistd.h>
-
-#include <filesystem>
-#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "diffpd/error.h"
 #include "diffpd/types.h"
+#include "util/expect_message.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd {
 namespace {
@@ -48,32 +46,17 @@ const char kTets[] =
 
 class ReadGmshTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    directory_ = std::filesystem::path(::testing::TempDir()) / ("diffpd_gmsh_io_test_" + std::to_string(getpid()));
-    std::filesystem::create_directories(directory_);
-  }
-  void TearDown() override { std::filesystem::remove_all(directory_); }
-
-  std::string Write(const std::string& name, const std::string& text) {
-    const std::string path = (directory_ / name).string();
-    std::ofstream(path) << text;
-    return path;
-  }
+  std::string Write(const std::string& name, const std::string& text) { return directory_.WriteFile(name, text); }
 
   // The message of ReadGmsh on `text`, its path replaced by "F".
   std::string ErrorOf(const std::string& text) {
     const std::string path = Write("bad.msh", text);
-    try {
-      ReadGmsh(path);
-    } catch (const InvalidInputError& error) {
-      std::string message = error.what();
-      if (message.rfind(path, 0) == 0) message = "F" + message.substr(path.size());
-      return message;
-    }
-    return "no exception";
+    std::string message = testing::MessageOf<InvalidInputError>([&] { ReadGmsh(path); });
+    if (message.rfind(path, 0) == 0) message = "F" + message.substr(path.size());
+    return message;
   }
 
-  std::filesystem::path directory_;
+  const testing::TemporaryDirectory directory_{"diffpd-gmsh-io"};
 };
 
 TEST_F(ReadGmshTest, HexWithNonContiguousTags) {
@@ -128,13 +111,8 @@ TEST_F(ReadGmshTest, ContentErrors) {
 }
 
 TEST_F(ReadGmshTest, MissingFile) {
-  const std::string missing = (directory_ / "missing.msh").string();
-  try {
-    ReadGmsh(missing);
-    ADD_FAILURE() << "no exception";
-  } catch (const InvalidInputError& error) {
-    EXPECT_EQ(std::string(error.what()), "cannot open '" + missing + "'");
-  }
+  const std::string missing = directory_.File("missing.msh");
+  EXPECT_THROW_MESSAGE(ReadGmsh(missing), InvalidInputError, "cannot open '" + missing + "'");
 }
 
 }  // namespace

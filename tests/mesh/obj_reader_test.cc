@@ -1,46 +1,29 @@
-#include <unistd.h>
-
-#include <filesystem>
-#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "diffpd/error.h"
 #include "diffpd/surface_mesh.h"
+#include "util/expect_message.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd {
 namespace {
 
 class ReadObjTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    directory_ = std::filesystem::path(::testing::TempDir()) / ("diffpd_obj_reader_test_" + std::to_string(getpid()));
-    std::filesystem::create_directories(directory_);
-  }
-  void TearDown() override { std::filesystem::remove_all(directory_); }
-
   // Writes `text` to a file in the test's directory; returns its path.
-  std::string Write(const std::string& name, const std::string& text) {
-    const std::string path = (directory_ / name).string();
-    std::ofstream(path) << text;
-    return path;
-  }
+  std::string Write(const std::string& name, const std::string& text) { return directory_.WriteFile(name, text); }
 
   // The message of ReadObj on a file holding `text`, "<path>" replaced by "F".
   std::string ErrorOf(const std::string& text) {
     const std::string path = Write("bad.obj", text);
-    try {
-      ReadObj(path);
-    } catch (const InvalidInputError& error) {
-      std::string message = error.what();
-      if (message.rfind(path, 0) == 0) message = "F" + message.substr(path.size());
-      return message;
-    }
-    return "no exception";
+    std::string message = testing::MessageOf<InvalidInputError>([&] { ReadObj(path); });
+    if (message.rfind(path, 0) == 0) message = "F" + message.substr(path.size());
+    return message;
   }
 
-  std::filesystem::path directory_;
+  const testing::TemporaryDirectory directory_{"diffpd-obj-reader"};
 };
 
 const char kTetrahedron[] =
@@ -94,13 +77,8 @@ TEST_F(ReadObjTest, Errors) {
             "F:3: face index -3 out of range (2 vertices read before this line)");
   EXPECT_EQ(ErrorOf("# nothing\n"), "F: no vertices");
   EXPECT_EQ(ErrorOf("v 0 0 0\n"), "F: no faces");
-  const std::string missing = (directory_ / "missing.obj").string();
-  try {
-    ReadObj(missing);
-    ADD_FAILURE() << "no exception";
-  } catch (const InvalidInputError& error) {
-    EXPECT_EQ(std::string(error.what()), "cannot open '" + missing + "'");
-  }
+  const std::string missing = directory_.File("missing.obj");
+  EXPECT_THROW_MESSAGE(ReadObj(missing), InvalidInputError, "cannot open '" + missing + "'");
 }
 
 TEST_F(ReadObjTest, ForwardReferencesAreAllowed) {

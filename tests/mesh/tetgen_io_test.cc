@@ -1,10 +1,7 @@
 #include "diffpd/tetgen_io.h"
 
 #include <stdlib.h>
-#include <unistd.h>
 
-#include <filesystem>
-#include <fstream>
 #include <stdexcept>
 #include <string>
 
@@ -12,6 +9,8 @@
 
 #include "diffpd/error.h"
 #include "diffpd/surface_mesh.h"
+#include "util/expect_message.h"
+#include "util/temporary_directory.h"
 #include "mesh/subprocess.h"
 
 namespace diffpd {
@@ -35,34 +34,19 @@ const char kEle1[] =
 
 class TetGenTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    directory_ = std::filesystem::path(::testing::TempDir()) / ("diffpd_tetgen_io_test_" + std::to_string(getpid()));
-    std::filesystem::create_directories(directory_);
-  }
-  void TearDown() override { std::filesystem::remove_all(directory_); }
-
-  std::string Write(const std::string& name, const std::string& text) {
-    const std::string path = (directory_ / name).string();
-    std::ofstream(path) << text;
-    return path;
-  }
+  std::string Write(const std::string& name, const std::string& text) { return directory_.WriteFile(name, text); }
 
   // The message of ReadTetGen on the two texts, with the paths replaced by
   // "N" and "E".
   std::string ErrorOf(const std::string& nodes, const std::string& elements) {
     const std::string node_path = Write("m.node", nodes), ele_path = Write("m.ele", elements);
-    try {
-      ReadTetGen(node_path, ele_path);
-    } catch (const InvalidInputError& error) {
-      std::string message = error.what();
-      if (message.rfind(node_path, 0) == 0) message = "N" + message.substr(node_path.size());
-      if (message.rfind(ele_path, 0) == 0) message = "E" + message.substr(ele_path.size());
-      return message;
-    }
-    return "no exception";
+    std::string message = testing::MessageOf<InvalidInputError>([&] { ReadTetGen(node_path, ele_path); });
+    if (message.rfind(node_path, 0) == 0) message = "N" + message.substr(node_path.size());
+    if (message.rfind(ele_path, 0) == 0) message = "E" + message.substr(ele_path.size());
+    return message;
   }
 
-  std::filesystem::path directory_;
+  const testing::TemporaryDirectory directory_{"diffpd-tetgen-io"};
 };
 
 TEST_F(TetGenTest, ReadsOneBasedFiles) {
@@ -100,13 +84,8 @@ TEST_F(TetGenTest, Errors) {
   EXPECT_EQ(ErrorOf(kNodes1, "2 4 0\n1 1 2 3 4\n2 2 3 5 4\n"),
             "E: element 1 is inverted or degenerate (signed volume -0.333333 m^3)");
   EXPECT_EQ(ErrorOf(kNodes1, "1 4 0\n1 1 2 3 4\n"), "E: vertex 4 is not referenced by any element");
-  const std::string missing = (directory_ / "missing.node").string();
-  try {
-    ReadTetGen(missing, missing);
-    ADD_FAILURE() << "no exception";
-  } catch (const InvalidInputError& error) {
-    EXPECT_EQ(std::string(error.what()), "cannot open '" + missing + "'");
-  }
+  const std::string missing = directory_.File("missing.node");
+  EXPECT_THROW_MESSAGE(ReadTetGen(missing, missing), InvalidInputError, "cannot open '" + missing + "'");
 }
 
 bool HaveTetGen() { return !internal::FindOnPath("tetgen").empty(); }
@@ -131,12 +110,7 @@ TEST(TetrahedralizeSurfaceTest, SphereVolumeMatchesSurface) {
 TEST(TetrahedralizeSurfaceTest, Errors) {
   const SurfaceMesh sphere = ReadObj(DIFFPD_SHARED_DIR "/data/meshes/sphere.obj");
   auto message = [&](const SurfaceMesh& surface, const std::string& switches, double scale) {
-    try {
-      TetrahedralizeSurface(surface, switches, scale);
-    } catch (const std::exception& error) {
-      return std::string(error.what());
-    }
-    return std::string("no exception");
+    return testing::MessageOf<std::exception>([&] { TetrahedralizeSurface(surface, switches, scale); });
   };
   EXPECT_EQ(message(sphere, "-pq", 1.0),
             "TetrahedralizeSurface: switches '-pq' must be one word without '-' or spaces, e.g. \"pq1.414Y\"");

@@ -9,18 +9,12 @@
 #include "diffpd/box_mesh.h"
 #include "diffpd/error.h"
 #include "diffpd/surface_mesh.h"
+#include "util/expect_message.h"
 
 namespace diffpd {
 namespace {
 
-std::string ErrorOf(const std::function<void()>& call) {
-  try {
-    call();
-  } catch (const InvalidInputError& error) {
-    return error.what();
-  }
-  return "no exception";
-}
+std::string ErrorOf(const std::function<void()>& call) { return testing::MessageOf<InvalidInputError>(call); }
 
 double TotalVolume(const Mesh& mesh) {
   double total = 0.0;

@@ -7,18 +7,15 @@
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
 #include "test_scenes.h"
+#include "util/expect_message.h"
 
 namespace diffpd {
 namespace {
 
+// The message of the InvalidInputError f() throws.
 template <class F>
 std::string MessageOf(F&& f) {
-  try {
-    f();
-  } catch (const InvalidInputError& e) {
-    return e.what();
-  }
-  return "(no InvalidInputError)";
+  return testing::MessageOf<InvalidInputError>(std::forward<F>(f));
 }
 
 TEST(SolverOptionsTest, InvalidFieldsAreRejectedWithTheFieldAndRange) {

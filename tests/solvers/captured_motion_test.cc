@@ -10,12 +10,15 @@
 #include "diffpd/captured_motion.h"
 #include "diffpd/error.h"
 #include "test_scenes.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd {
 namespace {
 
+// A file in this program's own temporary directory (removed at exit).
 std::string TempPath(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("diffpd_captured_" + name)).string();
+  static const testing::TemporaryDirectory directory("diffpd-captured-motion");
+  return directory.File(name);
 }
 
 std::string WriteText(const std::string& name, const std::string& text) {

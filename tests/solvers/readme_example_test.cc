@@ -14,6 +14,7 @@
 #include "diffpd/simulator.h"
 #include "diffpd/surface_mesh.h"
 #include "diffpd/voxelizer.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd {
 namespace {
@@ -29,9 +30,8 @@ void WriteBoxObj(const std::string& path) {
 }
 
 TEST(ReadmeExampleTest, RecoversTheMaterialOfSyntheticCapturedMotion) {
-  const auto dir = std::filesystem::temp_directory_path() / "diffpd_readme_example";
-  std::filesystem::create_directories(dir);
-  const std::string obj = (dir / "box.obj").string(), csv = (dir / "motion.csv").string();
+  const testing::TemporaryDirectory dir("diffpd-readme-example");
+  const std::string obj = dir.File("box.obj"), csv = dir.File("motion.csv");
   WriteBoxObj(obj);
   ValidateWatertight(ReadObj(obj), "box");
   // The example's scene with the true material.

@@ -8,12 +8,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <set>
 
 #include "calibration/calibrate_starfish.h"
 #include "diffpd/error.h"
+#include "util/expect_message.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd::problems {
 namespace {
@@ -24,19 +24,16 @@ const std::string kCyclic2 = kStarfishDir + "data_horizontal_cyclic2.csv";
 const std::string kHeader = "Time (ms),Tendon (mm),M1 X,M1 Y,M2 X,M2 Y,M3 X,M3 Y,M4 X,M4 Y\n";
 const std::string kRow0 = "0,0,1,2,3,4,5,6,7,8\n";
 
-std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = (std::filesystem::temp_directory_path() / name).string();
-  std::ofstream(path) << text;
-  return path;
+// This program's own temporary directory (removed at exit).
+const testing::TemporaryDirectory& Scratch() {
+  static const testing::TemporaryDirectory directory("diffpd-starfish-recordings");
+  return directory;
 }
 
+std::string WriteTemp(const std::string& name, const std::string& text) { return Scratch().WriteFile(name, text); }
+
 std::string ReadError(const std::string& path) {
-  try {
-    ReadStarfishRecording(path);
-  } catch (const InvalidInputError& e) {
-    return e.what();
-  }
-  return "(no error)";
+  return testing::MessageOf<InvalidInputError>([&] { ReadStarfishRecording(path); });
 }
 
 TEST(CalibrateStarfishTest, ReadsTheRealRecordingsInSiUnits) {
@@ -59,8 +56,7 @@ TEST(CalibrateStarfishTest, ReadsTheRealRecordingsInSiUnits) {
 }
 
 TEST(CalibrateStarfishTest, RejectsMalformedFilesNamingFileAndLine) {
-  const std::string missing = (std::filesystem::temp_directory_path() / "starfish_missing.csv").string();
-  std::filesystem::remove(missing);
+  const std::string missing = Scratch().File("starfish_missing.csv");
   EXPECT_EQ(ReadError(missing), "cannot open '" + missing + "'");
   std::string p = WriteTemp("starfish_empty.csv", "");
   EXPECT_EQ(ReadError(p), p + ": empty file (expected a header row and data rows)");
@@ -89,13 +85,9 @@ TEST(CalibrateStarfishTest, RejectsMalformedFilesNamingFileAndLine) {
   EXPECT_EQ(
       w.note,
       p + ":4: tendon contraction is NaN from t = 0.033 s; the window stops before it (0.0165 s instead of 10 s)");
-  try {
-    MakeStarfishWindow(r, 0.03, 1);
-    ADD_FAILURE() << "no error";
-  } catch (const InvalidInputError& e) {
-    EXPECT_EQ(std::string(e.what()),
-              p + ":4: tendon contraction is NaN at the window's first row (t = 0.033 s): nothing to simulate");
-  }
+  EXPECT_THROW_MESSAGE(
+      MakeStarfishWindow(r, 0.03, 1), InvalidInputError,
+      p + ":4: tendon contraction is NaN at the window's first row (t = 0.033 s): nothing to simulate");
 }
 
 TEST(CalibrateStarfishTest, WindowsOfTheRealRecordingStopBeforeTheMissingTendon) {
@@ -210,18 +202,10 @@ TEST(StarfishActivationsTest, SlackLagAndLengthShapeTheActivation) {
   EXPECT_GT(largest[0], 1);    // 1/m
   EXPECT_GT(largest[1], 0.1);  // 1/s
   EXPECT_GT(largest[2], 1);    // 1/m
-  try {
-    StarfishActivations(c, h, StarfishActuation{0, -1, 0.065}, nullptr);
-    ADD_FAILURE() << "no error";
-  } catch (const InvalidInputError& err) {
-    EXPECT_EQ(std::string(err.what()), "tendon lag = -1 is invalid: must be finite and >= 0 (s)");
-  }
-  try {
-    StarfishActivations({0.0, 0.0105}, h, StarfishActuation{0, 0, 0.005}, nullptr);
-    ADD_FAILURE() << "no error";
-  } catch (const InvalidInputError& err) {
-    EXPECT_EQ(std::string(err.what()), "tendon: activation -1 < 0 at step 1 (slack 0 m, length 0.005 m)");
-  }
+  EXPECT_THROW_MESSAGE(StarfishActivations(c, h, StarfishActuation{0, -1, 0.065}, nullptr), InvalidInputError,
+                       "tendon lag = -1 is invalid: must be finite and >= 0 (s)");
+  EXPECT_THROW_MESSAGE(StarfishActivations({0.0, 0.0105}, h, StarfishActuation{0, 0, 0.005}, nullptr),
+                       InvalidInputError, "tendon: activation -1 < 0 at step 1 (slack 0 m, length 0.005 m)");
 }
 
 // The window of the gradient and fit tests: 0.15 s from 1.15 s of cyclic1
@@ -270,12 +254,8 @@ TEST_F(StarfishFitTest, LossGradientMatchesCentralDifferences) {
 
 TEST_F(StarfishFitTest, BodyArmsRegionsGiveTheArmsTheirOwnYoungsModulus) {
   EXPECT_EQ(ParseStarfishRegions("body-arms"), StarfishRegions::kBodyArms);
-  try {
-    ParseStarfishRegions("legs");
-    ADD_FAILURE() << "no error";
-  } catch (const InvalidInputError& e) {
-    EXPECT_EQ(std::string(e.what()), "--regions = 'legs' is invalid: calibrate-starfish knows 'body-arms'");
-  }
+  EXPECT_THROW_MESSAGE(ParseStarfishRegions("legs"), InvalidInputError,
+                       "--regions = 'legs' is invalid: calibrate-starfish knows 'body-arms'");
   starfish_.set_regions(StarfishRegions::kBodyArms);
   const Scene scene = starfish_.MakeScene();
   ASSERT_EQ(scene.material_regions.size(), 1u);
@@ -347,12 +327,8 @@ TEST_F(StarfishFitTest, CoordinatesMapIntoTheBoundsAndBack) {
   EXPECT_NEAR(edge_a.slack, 0, 1e-15);
   EXPECT_NEAR(edge_a.lag, 0.5, 1e-12);
   EXPECT_NEAR(edge_a.length, 0.03, 1e-12);
-  try {
-    StarfishCalibration::ActuationToCoordinates(StarfishActuation{0.02, 0.05, 0.065}, v);
-    ADD_FAILURE() << "no error";
-  } catch (const InvalidInputError& e) {
-    EXPECT_EQ(std::string(e.what()), "tendon slack = 0.02 is outside the fit's interval (0, 0.015) m");
-  }
+  EXPECT_THROW_MESSAGE(StarfishCalibration::ActuationToCoordinates(StarfishActuation{0.02, 0.05, 0.065}, v),
+                       InvalidInputError, "tendon slack = 0.02 is outside the fit's interval (0, 0.015) m");
 }
 
 TEST_F(StarfishFitTest, ShortFitLowersTheLoss) {

@@ -5,12 +5,11 @@
 
 #include <gtest/gtest.h>
 
-#include <filesystem>
-
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
 #include "diffpd/simulator.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd::problems {
 namespace {
@@ -70,8 +69,8 @@ TEST(IpoptBunnyTest, UnreachableWallIsReportedInfeasibleByTheProgram) {
   args.compare_newton = false;
   args.threads = 1;
   args.json = true;
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "diffpd_ipopt_bunny_infeasible";
-  args.out_dir = dir.string();
+  const testing::TemporaryDirectory dir("diffpd-ipopt-bunny-infeasible");
+  args.out_dir = dir.path().string();
   ::testing::internal::CaptureStdout();
   ::testing::internal::CaptureStderr();
   const int code = bunny.Run(args);
@@ -87,7 +86,6 @@ TEST(IpoptBunnyTest, UnreachableWallIsReportedInfeasibleByTheProgram) {
                      "(Infeasible_Problem_Detected)"),
             std::string::npos)
       << err;
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -16,6 +16,8 @@
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
 #include "solvers/ipopt_test_problems.h"
+#include "util/temporary_directory.h"
+#include "util/expect_message.h"
 
 namespace diffpd::problems {
 namespace {
@@ -81,12 +83,6 @@ class CubeThrow : public TrajectoryOptimizationProblem {
   double rise_;
 };
 
-fs::path FreshDirectory(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("diffpd_ipopt_driver_" + name);
-  fs::remove_all(dir);
-  return dir;
-}
-
 std::string ReadFile(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream s;
@@ -151,7 +147,8 @@ TEST(IpoptTrajectoryOptimizationTest, PdRunIsRepeatedWithNewtonAndTheTimeRatioIs
 }
 
 TEST(IpoptTrajectoryOptimizationTest, RunWritesFramesHistoriesPlotAndOneJsonObject) {
-  const fs::path dir = FreshDirectory("files");
+  const testing::TemporaryDirectory temp("diffpd-ipopt-driver-files");
+  const fs::path dir = temp.path();
   const CubeThrow problem(0.01);
   CommandArgs args;
   args.problem = problem.name();
@@ -200,11 +197,11 @@ TEST(IpoptTrajectoryOptimizationTest, RunWritesFramesHistoriesPlotAndOneJsonObje
   ASSERT_GT(png.size(), 8u) << "no PNG written (is gnuplot installed?)";
   EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
   EXPECT_EQ(nlohmann::json::parse(ReadFile(dir / "summary.json")), j);
-  fs::remove_all(dir);
 }
 
 TEST(IpoptTrajectoryOptimizationTest, UnreachableConstraintIsReportedInfeasibleWithExitCode4) {
-  const fs::path dir = FreshDirectory("infeasible");
+  const testing::TemporaryDirectory temp("diffpd-ipopt-driver-infeasible");
+  const fs::path dir = temp.path();
   const CubeThrow problem(0.5);  // a 1 m/s throw rises under 4 cm in 50 ms
   CommandArgs args;
   args.problem = problem.name();
@@ -224,21 +221,15 @@ TEST(IpoptTrajectoryOptimizationTest, UnreachableConstraintIsReportedInfeasibleW
                      "(Infeasible_Problem_Detected)"),
             std::string::npos)
       << err;
-  fs::remove_all(dir);
 }
 
 TEST(IpoptTrajectoryOptimizationTest, StepsAndTimeStepAreRefusedWithAMessage) {
   const CubeThrow problem(0.01);
   CommandArgs args;
   args.steps = 10;
-  try {
-    problem.Run(args);
-    FAIL() << "no throw";
-  } catch (const InvalidInputError& e) {
-    EXPECT_EQ(std::string(e.what()),
-              "--steps and --dt are fixed by the optimisation problem 'cube-throw'; use --small for the reduced "
-              "instance");
-  }
+  ASSERT_THROW_MESSAGE(problem.Run(args), InvalidInputError,
+                       "--steps and --dt are fixed by the optimisation problem 'cube-throw'; use --small for the "
+                       "reduced instance");
 }
 
 TEST(IpoptTrajectoryOptimizationTest, IpoptOptionsAreParsedByTheirValue) {
@@ -253,12 +244,8 @@ TEST(IpoptTrajectoryOptimizationTest, IpoptOptionsAreParsedByTheirValue) {
   ASSERT_EQ(o.string_options.size(), 1u);
   EXPECT_EQ(o.string_options[0], std::make_pair(std::string("mu_strategy"), std::string("adaptive")));
   for (const char* bad : {"max_iter", "=3", "tol="}) {
-    try {
-      AddIpoptOption(bad, &o);
-      FAIL() << bad;
-    } catch (const InvalidInputError& e) {
-      EXPECT_EQ(std::string(e.what()), std::string("Ipopt option '") + bad + "' is invalid: expected name=value");
-    }
+    ASSERT_THROW_MESSAGE(AddIpoptOption(bad, &o), InvalidInputError,
+                         std::string("Ipopt option '") + bad + "' is invalid: expected name=value");
   }
   EXPECT_EQ(DefaultOutputDirectory("bunny"), (fs::path("out") / "bunny").string());
 }

@@ -8,6 +8,7 @@
 
 #include "tools/bench.h"
 #include "diffpd/error.h"
+#include "util/expect_message.h"
 
 namespace diffpd::problems {
 namespace {
@@ -39,43 +40,21 @@ TEST(MakeRefinedProblemTest, DoublingsScaleTheCellCountCyclingAxes) {
 }
 
 TEST(MakeRefinedProblemTest, RejectsTooCoarseAndUnknownProblems) {
-  try {
-    MakeRefinedProblem("cantilever", -10);
-    FAIL() << "expected InvalidInputError";
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(), "refinement = -10 is invalid for cantilever: it must be >= -9 (4 x 1 x 1 cells)");
-  }
-  try {
-    MakeRefinedProblem("no-such-problem", 3);
-    FAIL() << "expected InvalidInputError";
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(),
-                 "problem 'no-such-problem' cannot be refined: refinement is available for cantilever and "
-                 "falling-cube");
-  }
+  ASSERT_THROW_MESSAGE(MakeRefinedProblem("cantilever", -10), InvalidInputError,
+                       "refinement = -10 is invalid for cantilever: it must be >= -9 (4 x 1 x 1 cells)");
+  ASSERT_THROW_MESSAGE(MakeRefinedProblem("no-such-problem", 3), InvalidInputError,
+                       "problem 'no-such-problem' cannot be refined: refinement is available for cantilever and "
+                       "falling-cube");
   // Unrefined, any registered problem; an unknown one lists the valid names.
   EXPECT_EQ(MakeRefinedProblem("falling-cube", 0)->name(), "falling-cube");
-  try {
-    MakeRefinedProblem("no-such-problem", 0);
-    FAIL() << "expected InvalidInputError";
-  } catch (const InvalidInputError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("unknown problem 'no-such-problem': valid problems are ", 0), 0u);
-  }
+  const std::string unknown = testing::MessageOf<InvalidInputError>([] { MakeRefinedProblem("no-such-problem", 0); });
+  EXPECT_EQ(unknown.rfind("unknown problem 'no-such-problem': valid problems are ", 0), 0u) << unknown;
 }
 
 TEST(BenchOptionsTest, ValidateNamesTheFieldValueAndRange) {
   BenchOptions o;
   o.rel_tolerance = 0;
-  EXPECT_THROW(
-      {
-        try {
-          o.Validate();
-        } catch (const InvalidInputError& e) {
-          EXPECT_STREQ(e.what(), "rtol = 0 is invalid: must be in (0, 1)");
-          throw;
-        }
-      },
-      InvalidInputError);
+  EXPECT_THROW_MESSAGE(o.Validate(), InvalidInputError, "rtol = 0 is invalid: must be in (0, 1)");
   o = BenchOptions();
   o.repeat = 0;
   EXPECT_THROW(o.Validate(), InvalidInputError);
@@ -84,12 +63,7 @@ TEST(BenchOptionsTest, ValidateNamesTheFieldValueAndRange) {
   EXPECT_THROW(o.Validate(), InvalidInputError);
   o = BenchOptions();
   o.lbfgs_weight_scale = 0;
-  try {
-    o.Validate();
-    ADD_FAILURE() << "expected InvalidInputError";
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(), "lbfgs scale = 0 is invalid: must be in (0, 1]");
-  }
+  EXPECT_THROW_MESSAGE(o.Validate(), InvalidInputError, "lbfgs scale = 0 is invalid: must be in (0, 1]");
 }
 
 TEST(RelativeErrorTest, IsTheRelativeTwoNorm) {
