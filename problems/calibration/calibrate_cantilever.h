@@ -14,7 +14,9 @@
 // corners of the free end and the two upper corners at mid-length) captured
 // at 30 Hz (frames at k/30 s, k = 1..12, not aligned with the steps), with
 // 0.1 mm of Gaussian noise in the shipped data/cantilever_motion.csv. Every
-// fit starts from E = 2e5 Pa, nu = 0.45.
+// fit starts from E = 2e5 Pa, nu = 0.45. The default run fits with pd-lbfgs
+// alone, so that the first run is quick; `--methods pd-lbfgs,newton-cholesky`
+// compares the two.
 #pragma once
 
 #include "calibration/calibrate_problem.h"
@@ -35,6 +37,7 @@ class CantileverCalibration : public CalibrationProblem {
   std::vector<Marker> Markers(const Mesh& mesh) const override;
   std::vector<double> CaptureTimes() const override;
   double noise() const override { return 1e-4; }
+  std::vector<Method> default_methods() const override { return {Method::kPdLbfgs}; }
 };
 
 }  // namespace diffpd::problems
