@@ -88,7 +88,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   fi
   say "installed (apt's log: $log)"
 else
-  say "all ${#PACKAGES[@]} Debian packages it needs are installed"
+  say "the ${#PACKAGES[@]} Debian packages DiffPD needs are installed"
 fi
 
 JOBS="${DIFFPD_BUILD_JOBS:-$(nproc)}"
