@@ -2,6 +2,7 @@
 
 #include "scenes/bouncing_ball.h"
 #include "calibration/calibrate_bouncing_ball.h"
+#include "calibration/calibrate_cantilever.h"
 #include "calibration/calibrate_plant.h"
 #include "calibration/calibrate_starfish.h"
 #include "control/bunny.h"
@@ -28,6 +29,7 @@ std::vector<std::unique_ptr<Problem>> AllProblems() {
   all.push_back(std::make_unique<Locomotion>(Locomotion::Body::kTorus));
   all.push_back(std::make_unique<Locomotion>(Locomotion::Body::kQuadruped));
   all.push_back(std::make_unique<Locomotion>(Locomotion::Body::kCow));
+  all.push_back(std::make_unique<CantileverCalibration>());
   all.push_back(std::make_unique<PlantCalibration>());
   all.push_back(std::make_unique<BouncingBallCalibration>());
   all.push_back(std::make_unique<StarfishCalibration>());

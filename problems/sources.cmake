@@ -13,6 +13,7 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/scenes/routing_tendon.cc
   # calibration: system identification with Ceres
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_problem.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_cantilever.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_plant.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_bouncing_ball.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_starfish.cc

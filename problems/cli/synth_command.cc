@@ -20,7 +20,8 @@ Subcommand AddSynthCommand(CLI::App* parent) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = parent->add_subcommand(
       "synth", "write the synthetic captured motion of a calibration problem (noisy and clean CSV)");
-  cmd->add_option("problem", args->problem, "a calibration problem (calibrate-plant, calibrate-bouncing-ball)")
+  cmd->add_option("problem", args->problem,
+                  "a calibration problem (calibrate-cantilever, calibrate-plant, calibrate-bouncing-ball)")
       ->required();
   cmd->add_option("--dir", args->dir, "output directory")->capture_default_str();
   Subcommand sub;

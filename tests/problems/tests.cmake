@@ -1,6 +1,7 @@
 # The problems library, by kind (mirrors problems/).
 set(_dir ${CMAKE_CURRENT_LIST_DIR})
 diffpd_add_test(contact_problems_test ${_dir}/scenes/contact_problems_test.cc LIBS diffpd_problems)
+diffpd_add_test(calibrate_cantilever_test ${_dir}/calibration/calibrate_cantilever_test.cc LIBS diffpd_problems)
 diffpd_add_test(calibrate_plant_test ${_dir}/calibration/calibrate_plant_test.cc LIBS diffpd_problems)
 diffpd_add_test(calibrate_bouncing_ball_test ${_dir}/calibration/calibrate_bouncing_ball_test.cc LIBS diffpd_problems)
 diffpd_add_test(calibrate_starfish_test ${_dir}/calibration/calibrate_starfish_test.cc LIBS diffpd_problems)

@@ -33,9 +33,7 @@
 // solve comes back). The final set is checked once more at the step's
 // tolerance; the returned step meets the same tolerance and the same
 // complementarity test as without screening, at fewer iterations when the
-// set changes often (rolling-sphere, rtol 1e-5, r = 0.1: 48 instead of 54
-// PD-LBFGS iterations per step with a separate restarted pass after a loose
-// one; rtol 1e-4: 39.7 with the continuing checkpoint instead of 40.9).
+// set changes often.
 //
 // The PD matrix A is never refactorised when the active set changes: the
 // erased rows and columns are a low-rank change handled by the

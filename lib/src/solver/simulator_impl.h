@@ -161,7 +161,7 @@ class StepObjective {
   // (SolverOptions::accept_rounding_floor). Computed on first use.
   double RoundingFloor();
   // The factor: a stall with |grad g| <= kRoundingFloorStall * RoundingFloor()
-  // is the floor (measured stalls: README stress report).
+  // is the floor (the stalls measured by `diffpd stress`, docs/benchmarks.md).
   static constexpr double kRoundingFloorStall = 100;
 
   // True, with *value = g(x), if the latest Evaluate was at exactly x.

@@ -121,12 +121,13 @@ TEST(StressTest, TenThousandStepsStayFiniteAndDissipative) {
   }
 }
 
-// The case the full grid found (session 8): a nearly incompressible, very
+// A case of the full grid: a nearly incompressible, very
 // stiff cantilever at h = 0.01 s whose second step's predictor is so
-// compressed that Newton's descent from it ended at a stationary point with
-// 5.6e6 J (the body had 12 J): the total energy rose by 0.96 (relative)
-// without an error. A result with g above g(x_i), the previous total energy,
-// is now solved again from x_i (SolverOptions::bound_step_energy).
+// compressed that Newton's descent from it can end at a far stationary point
+// (5.6e6 J for a body with 12 J): without the energy bound the total energy
+// rises by 0.96 (relative) without an error. A result with g above g(x_i),
+// the previous total energy, is solved again from x_i
+// (SolverOptions::bound_step_energy).
 TEST(StressTest, StiffIncompressibleStepsDoNotClimbToAFarStationaryPoint) {
   StressOptions o = ReducedGrid();
   o.steps = 5;
@@ -159,8 +160,9 @@ TEST(StressTest, ExplicitIntegrationBeyondItsStabilityLimitFailsClearly) {
 // A very stiff cube falling freely at h = 0.1 s: after ~2.5 s it is 30 m
 // from the origin, its deformation gradients are formed from positions of
 // that size, and |grad g| cannot get below the report's automatic tolerance.
-// Until session 9 Newton's line search stopped there (steps 26-29 of 50);
-// now those steps end at the rounding floor and the case completes.
+// Without the rounding-floor acceptance Newton's line search stops there
+// (steps 26-29 of 50); those steps end at the rounding floor and the case
+// completes.
 TEST(StressTest, StiffFallingCubeFarFromTheOriginCompletesAtTheRoundingFloor) {
   StressOptions o;
   o.problems = {{"falling-cube", -6}};
