@@ -13,6 +13,7 @@
 
 #include "calibration/calibrate_cantilever.h"
 #include "cli/commands.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd::problems {
 namespace {
@@ -61,9 +62,8 @@ TEST(CalibrateCantileverTest, FitOfTheShippedMotionRecoversTheTrueMaterial) {
 
 TEST(CalibrateCantileverTest, RunWritesTheReportTrajectoryAndMarkerFiles) {
   const CantileverCalibration beam;
-  std::string pattern = (std::filesystem::temp_directory_path() / "diffpd_calibrate_cantilever_XXXXXX").string();
-  ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-  const std::filesystem::path out = pattern;
+  const testing::TemporaryDirectory dir("diffpd-calibrate-cantilever");
+  const std::filesystem::path& out = dir.path();
   CommandArgs args;
   args.problem = beam.name();
   args.methods = {"pd-lbfgs"};  // the default data: data/cantilever_motion.csv
@@ -83,7 +83,6 @@ TEST(CalibrateCantileverTest, RunWritesTheReportTrajectoryAndMarkerFiles) {
   EXPECT_TRUE(std::filesystem::exists(out / "calibrate-cantilever_fitted.pvd"));
   EXPECT_TRUE(std::filesystem::exists(out / "markers.csv"));
   EXPECT_TRUE(std::filesystem::exists(out / "calibration.json"));
-  std::filesystem::remove_all(out);
 }
 
 }  // namespace
