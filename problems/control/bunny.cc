@@ -6,7 +6,7 @@
 #include "diffpd/surface_mesh.h"
 #include "diffpd/voxelizer.h"
 #include "diffpd/solvers/control_variables.h"
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 #include "shared_data.h"
 
 namespace diffpd::problems {

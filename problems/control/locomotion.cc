@@ -4,7 +4,7 @@
 
 #include "diffpd/solvers/control_variables.h"
 #include "diffpd/solvers/linear_constraint.h"
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 #include "diffpd/state_forces.h"
 #include "diffpd/surface_mesh.h"
 #include "diffpd/voxelizer.h"

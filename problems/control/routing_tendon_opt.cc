@@ -2,7 +2,7 @@
 
 #include "diffpd/box_mesh.h"
 #include "diffpd/solvers/control_variables.h"
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 #include "scenes/routing_tendon.h"
 
 namespace diffpd::problems {
@@ -79,7 +79,7 @@ Ipopt::SmartPtr<solvers::RolloutNlp> RoutingTendonOpt::MakeNlp(Simulator* sim, I
   nlp->AddRegularization(offset, count, 1e-2, 1.0);
 
   const Mesh& mesh = sim->scene().mesh;
-  const TrackedPoint tip = Marker(mesh.num_vertices(), TipNode(mesh));
+  const TrackedPoint tip = NodePoint(mesh.num_vertices(), TipNode(mesh));
   const Vec3 rest = tip.At(setup.initial.x);
   const Vec3 target = rest + Vec3(0.02, 0.012, -0.004);
   nlp->AddObjective(std::make_unique<PointDistanceSquared>(tip, kFinalState, target, "tip_error"), 1e6);

@@ -1,9 +1,7 @@
 # Sources of the optimiser adapters (paths relative to solvers/).
 set(DIFFPD_SOLVERS_SOURCES ${CMAKE_CURRENT_LIST_DIR}/optimizer_versions.cc)
 list(APPEND DIFFPD_SOLVERS_SOURCES
-  ${CMAKE_CURRENT_LIST_DIR}/control_signal.cc
   ${CMAKE_CURRENT_LIST_DIR}/control_variables.cc
-  ${CMAKE_CURRENT_LIST_DIR}/trajectory_constraint.cc
   ${CMAKE_CURRENT_LIST_DIR}/linear_constraint.cc
   ${CMAKE_CURRENT_LIST_DIR}/rollout_nlp.cc
   ${CMAKE_CURRENT_LIST_DIR}/ipopt_solve.cc)

@@ -245,8 +245,9 @@ TEST(RolloutNlpTest, FailedRolloutMakesEveryEvaluationReturnFalseAndRecovers) {
   nlp.AddVariables(std::make_unique<solvers::ExternalForceControl>(std::move(channels)));
   const int n3 = sim.num_dofs() / 3;
   nlp.AddObjective(
-      std::make_unique<solvers::PointCoordinate>(solvers::Marker(n3, tip[0]), solvers::kFinalState, Vec3::UnitZ()));
-  nlp.AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(n3, tip[0]), 1, Vec3::UnitZ()), -1, 1);
+      std::make_unique<solvers::PointCoordinate>(solvers::NodePoint(n3, tip[0]), solvers::kFinalState, Vec3::UnitZ()));
+  nlp.AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::NodePoint(n3, tip[0]), 1, Vec3::UnitZ()), -1,
+                    1);
   const int n = nlp.num_variables(), m = nlp.num_constraints();
   Ipopt::Index nn, mm, nnz, nnz_h;
   Ipopt::TNLP::IndexStyleEnum style;
@@ -307,8 +308,8 @@ TEST(RolloutNlpTest, AutoModeChoosesForwardForFewVariablesAndManyConstraints) {
     nlp->AddVariables(std::make_unique<solvers::InitialStateVariables>(solvers::InitialStateVariables::kVelocity, tip));
     const int n = sim->scene().mesh.num_vertices();
     for (int k = 1; k <= 4; ++k)
-      nlp->AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(n, tip[0]), k, Vec3::UnitZ()), -1,
-                         1);
+      nlp->AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::NodePoint(n, tip[0]), k, Vec3::UnitZ()),
+                         -1, 1);
     return nlp;
   };
   Simulator sim_a(SmallBeamScene(), TightNewton()), sim_b(SmallBeamScene(), TightNewton());
@@ -359,7 +360,8 @@ struct MuscleBeam {
     nlp->AddObjective(std::make_unique<solvers::PointDistanceSquared>(
         solvers::MeanOf(n, tip), solvers::kFinalState,
         solvers::MeanOf(n, tip).At(sim->RestState().x) - Vec3(0.01, 0, 0.01)));
-    nlp->AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(n, tip[0]), 2, Vec3::UnitX()), -1, 1);
+    nlp->AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::NodePoint(n, tip[0]), 2, Vec3::UnitX()), -1,
+                       1);
   }
 };
 
@@ -468,14 +470,15 @@ TEST(RolloutNlpTest, BadInputIsRefusedWithAMessage) {
     EXPECT_STREQ(e.what(), "initial_velocity: node 1000 is out of range: the mesh has 45 nodes");
   }
   try {
-    nlp.AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(45, 0), 7, Vec3::UnitZ(), "late"), 0,
-                      1);
+    nlp.AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::NodePoint(45, 0), 7, Vec3::UnitZ(), "late"),
+                      0, 1);
     FAIL() << "no throw";
   } catch (const InvalidInputError& e) {
     EXPECT_STREQ(e.what(), "RolloutNlp: constraint 'late' reads state 7, outside the rollout's states [0, 4]");
   }
   try {
-    nlp.AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::Marker(45, 0), 1, Vec3::UnitZ(), "c"), 1, 0);
+    nlp.AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::NodePoint(45, 0), 1, Vec3::UnitZ(), "c"), 1,
+                      0);
     FAIL() << "no throw";
   } catch (const InvalidInputError& e) {
     EXPECT_STREQ(e.what(), "RolloutNlp: constraint 'c' bounds [1, 0] are invalid: need lower <= upper, no NaN");

@@ -45,7 +45,7 @@ class WrongGradient : public TrajectoryFunction {
 
 TEST(IpoptSolveTest, DerivativeCheckerCatchesAWrongGradient) {
   BeamNlp p(TightNewton());
-  p.nlp->AddObjective(std::make_unique<WrongGradient>(Marker(p.sim->num_dofs() / 3, p.tip[0])), 10.0);
+  p.nlp->AddObjective(std::make_unique<WrongGradient>(NodePoint(p.sim->num_dofs() / 3, p.tip[0])), 10.0);
   const IpoptSummary s = SolveWithIpopt(p.nlp, DerivativeTestOptions());
   EXPECT_GT(s.derivative_checker_errors, 0) << s.log;
 }
@@ -71,7 +71,7 @@ struct SteerBeam {
     forces->SetBounds(-0.2, 0.2);
     const int offset = nlp->AddVariables(std::move(forces));
     const int n = mesh.num_vertices();
-    const TrackedPoint marker = Marker(n, tip.back());
+    const TrackedPoint marker = NodePoint(n, tip.back());
     const Vec3 rest = marker.At(sim->RestState().x);
     nlp->AddObjective(std::make_unique<PointDistanceSquared>(marker, kFinalState, rest + Vec3(0, 0.005, 0.015)), 1e4);
     nlp->AddRegularization(offset, 8, 1e-3);
@@ -174,7 +174,7 @@ TEST(IpoptSolveTest, FailedRolloutsMakeIpoptCutItsStep) {
   std::vector<ExternalForceControl::Channel> channels(1);
   channels[0] = {tip, Vec3::UnitZ(), std::make_unique<PiecewiseLinearSignal>(4, 2)};
   nlp->AddVariables(std::make_unique<ExternalForceControl>(std::move(channels)));
-  const TrackedPoint marker = Marker(scene.mesh.num_vertices(), tip[0]);
+  const TrackedPoint marker = NodePoint(scene.mesh.num_vertices(), tip[0]);
   nlp->AddObjective(
       std::make_unique<PointDistanceSquared>(marker, kFinalState, marker.At(sim.RestState().x) + Vec3(0, 0, 0.002)),
       1e7);

@@ -5,11 +5,11 @@
 #include <vector>
 
 #include "diffpd/simulator.h"
-#include "diffpd/solvers/control_signal.h"
+#include "diffpd/solvers/core/control_signal.h"
 #include "diffpd/solvers/control_variables.h"
 #include "diffpd/solvers/linear_constraint.h"
 #include "diffpd/solvers/rollout_nlp.h"
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 #include "test_scenes.h"
 
 namespace diffpd::testing {
@@ -106,7 +106,7 @@ struct BeamNlp {
     material->SetBounds(0.5, 5.0);
     material_offset = nlp->AddVariables(std::move(material));
 
-    const TrackedPoint marker = Marker(n, tip.back());
+    const TrackedPoint marker = NodePoint(n, tip.back());
     nlp->AddObjective(std::make_unique<PointDistanceSquared>(marker, kFinalState,
                                                              marker.At(sim->RestState().x) + Vec3(0.0, 0.01, 0.02)),
                       1e3);

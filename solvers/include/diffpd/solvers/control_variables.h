@@ -15,18 +15,11 @@
 #include "diffpd/rollout.h"
 #include "diffpd/scene.h"
 #include "diffpd/tangent_rollout.h"
-#include "diffpd/solvers/control_signal.h"
+#include "diffpd/solvers/core/control_signal.h"
+#include "diffpd/solvers/core/rollout_setup.h"
 #include "diffpd/types.h"
 
 namespace diffpd::solvers {
-
-// What one rollout is made from. Blocks add to it (forces, velocities,
-// positions) or overwrite a field (material parameters).
-struct RolloutSetup {
-  State initial;                  // x_0, v_0 (3n each)
-  std::vector<StepInput> inputs;  // K steps; empty fields mean "none"
-  MaterialParameters material;
-};
 
 class ControlVariables {
  public:

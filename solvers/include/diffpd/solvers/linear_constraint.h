@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "diffpd/solvers/control_signal.h"
+#include "diffpd/solvers/core/control_signal.h"
 
 namespace diffpd::solvers {
 

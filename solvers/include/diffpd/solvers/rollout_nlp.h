@@ -52,7 +52,7 @@
 #include "diffpd/simulator.h"
 #include "diffpd/solvers/control_variables.h"
 #include "diffpd/solvers/linear_constraint.h"
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 
 namespace diffpd::solvers {
 

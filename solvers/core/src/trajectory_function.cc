@@ -1,4 +1,4 @@
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 
 #include <cmath>
 #include <sstream>
@@ -56,7 +56,7 @@ Vec3 TrackedPoint::At(const VectorXd& x) const {
   return Eigen::Map<const Eigen::Matrix3Xd>(x.data(), 3, node_weights.size()) * node_weights;
 }
 
-TrackedPoint Marker(int num_nodes, int node) {
+TrackedPoint NodePoint(int num_nodes, int node) {
   if (node < 0 || node >= num_nodes) {
     std::ostringstream msg;
     msg << "marker node " << node << " is out of range [0, " << num_nodes << ")";

@@ -1,5 +1,5 @@
-// Scalar functions of a recorded trajectory, used as objective terms and as
-// constraints of trajectory optimisation (rollout_nlp.h): marker and
+// Scalar functions of a recorded trajectory (TrajectoryFunctional with one
+// value), used as objective terms, constraints and losses: marker and
 // centre-of-mass coordinates at a step, travel between steps, squared
 // distance to a target, and the tilt of a body axis.
 //
@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "diffpd/rollout.h"
+#include "diffpd/solvers/core/trajectory_functional.h"
 #include "diffpd/types.h"
 
 namespace diffpd::solvers {
@@ -24,28 +25,32 @@ struct TrackedPoint {
   // p (3) at positions x (3n).
   Vec3 At(const VectorXd& x) const;
 };
-// The node itself (a marker).
-TrackedPoint Marker(int num_nodes, int node);
+// The node itself (e.g. a marker on a vertex).
+TrackedPoint NodePoint(int num_nodes, int node);
 // The unweighted mean of `nodes`.
 TrackedPoint MeanOf(int num_nodes, const std::vector<int>& nodes);
 // The centre of mass: weights m_i / sum m, from the lumped mass per DoF
 // (3n, e.g. Simulator::LumpedMass()).
 TrackedPoint CentreOfMass(const VectorXd& lumped_mass);
 
-class TrajectoryFunction {
+class TrajectoryFunction : public TrajectoryFunctional {
  public:
-  virtual ~TrajectoryFunction() = default;
-  virtual std::string name() const = 0;
   // The latest state index the function reads in a rollout of K steps.
   virtual int LastState(int num_steps) const = 0;
-  // True if the value is affine in the states (the constraint Jacobian
-  // still depends on the simulation).
-  virtual bool is_affine_in_states() const { return false; }
   // The value on `rollout`, which must hold at least LastState(K) + 1 states.
   virtual double Value(const Rollout& rollout) const = 0;
   // Adds weight * dF/dx_k and weight * dF/dv_k into `loss` (sized for
   // `rollout`, allocating empty entries as needed).
   virtual void AddGradient(const Rollout& rollout, double weight, LossGradient* loss) const = 0;
+
+  // TrajectoryFunctional, in terms of the three above.
+  int num_values() const final { return 1; }
+  int LastStateOf(int i, int num_steps) const final { return LastState(num_steps); }
+  void Evaluate(const Rollout& rollout, Eigen::Ref<VectorXd> values) const final { values(0) = Value(rollout); }
+  void AddWeightedGradient(const Rollout& rollout, const Eigen::Ref<const VectorXd>& weights,
+                           LossGradient* loss) const final {
+    AddGradient(rollout, weights(0), loss);
+  }
 };
 
 // direction . p(x_k): a coordinate of a marker or of the centre of mass
@@ -56,7 +61,6 @@ class PointCoordinate : public TrajectoryFunction {
   PointCoordinate(TrackedPoint point, int step, Vec3 direction, std::string name = "point_coordinate");
   std::string name() const override { return name_; }
   int LastState(int num_steps) const override;
-  bool is_affine_in_states() const override { return true; }
   double Value(const Rollout& rollout) const override;
   void AddGradient(const Rollout& rollout, double weight, LossGradient* loss) const override;
 
@@ -74,7 +78,6 @@ class PointTravel : public TrajectoryFunction {
   PointTravel(TrackedPoint point, int from_step, int to_step, Vec3 direction, std::string name = "point_travel");
   std::string name() const override { return name_; }
   int LastState(int num_steps) const override;
-  bool is_affine_in_states() const override { return true; }
   double Value(const Rollout& rollout) const override;
   void AddGradient(const Rollout& rollout, double weight, LossGradient* loss) const override;
 

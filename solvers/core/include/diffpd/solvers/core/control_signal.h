@@ -1,7 +1,7 @@
 // Control signals: maps from a few coefficients c to one value per time step,
 //   s_k = S(c)_k,  k = 0..K-1,  applied during step k (time t_k = k h),
-// with their Jacobian ds/dc. They parameterise actuation or forces for
-// trajectory optimisation (see control_variables.h).
+// with their Jacobian ds/dc. They parameterise activations and forces over
+// time (activation_block.h, external_force_block.h).
 #pragma once
 
 #include <memory>
@@ -69,7 +69,7 @@ class PiecewiseLinearSignal : public ControlSignal {
 // Truncated Fourier series of period T (s):
 //   s(t) = c_0 + sum_{j=1..H} c_{2j-1} sin(2 pi j t / T) + c_{2j} cos(2 pi j t / T),
 // p = 1 + 2 H coefficients, evaluated at t_k = k h. Linear in c: bounds on
-// s_k are linear constraints on c (see linear_constraint.h).
+// s_k are linear constraints on c (e.g. SignalRangeConstraints of the Ipopt adapter).
 class FourierSignal : public ControlSignal {
  public:
   // Throws InvalidInputError unless num_steps >= 1, time_step > 0,

@@ -1,6 +1,6 @@
-// Tests of the trajectory functions (trajectory_constraint.h) on a synthetic
+// Tests of the trajectory functions (trajectory_function.h) on a synthetic
 // rollout: values, gradients vs central differences, tracked points, errors.
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 
 #include <gtest/gtest.h>
 
@@ -60,9 +60,9 @@ TEST(TrajectoryConstraintTest, TrackedPointsAreWeightedMeans) {
   x << 0, 0, 0, 1, 0, 0, 5, 5, 5, 0, 2, 0;
   EXPECT_TRUE(com.At(x).isApprox(Vec3(3.0 / 8, 1.0, 0.0)));
   EXPECT_TRUE(MeanOf(4, {1, 3}).At(x).isApprox(Vec3(0.5, 1.0, 0.0)));
-  EXPECT_TRUE(Marker(4, 2).At(x).isApprox(Vec3(5, 5, 5)));
+  EXPECT_TRUE(NodePoint(4, 2).At(x).isApprox(Vec3(5, 5, 5)));
   try {
-    Marker(4, 4);
+    NodePoint(4, 4);
     FAIL() << "no throw";
   } catch (const InvalidInputError& e) {
     EXPECT_STREQ(e.what(), "marker node 4 is out of range [0, 4)");
@@ -79,7 +79,7 @@ TEST(TrajectoryConstraintTest, ValuesFollowTheirFormulas) {
   const Vec3 t(0.1, 0.2, 0.3);
   EXPECT_NEAR(PointDistanceSquared(p, 3, t).Value(r), (p3 - t).squaredNorm(), 1e-15);
   EXPECT_NEAR(PointDistanceSquared(p, 3, t, "d", Vec3(1, 1, 0)).Value(r), (p3 - t).head<2>().squaredNorm(), 1e-15);
-  const TrackedPoint a = Marker(4, 1), b = Marker(4, 3);
+  const TrackedPoint a = NodePoint(4, 1), b = NodePoint(4, 3);
   const Vec3 d = b.At(r.states[2].x) - a.At(r.states[2].x);
   EXPECT_NEAR(AxisAlignment(a, b, 2, Vec3(0, 0, 5)).Value(r), d.z() / d.norm(), 1e-15);
   EXPECT_EQ(PointTravel(p, 0, 2, Vec3::UnitX()).LastState(7), 2);
@@ -92,11 +92,11 @@ TEST(TrajectoryConstraintTest, GradientsMatchCentralDifferences) {
   ExpectGradientMatches(PointCoordinate(p, 2, Vec3(0.3, -1, 2)), r);
   ExpectGradientMatches(PointTravel(p, 1, kFinalState, Vec3(1, 0.5, 0)), r);
   ExpectGradientMatches(PointDistanceSquared(p, kFinalState, Vec3(0.1, 0.2, 0.3), "d", Vec3(1, 2, 0.5)), r);
-  ExpectGradientMatches(AxisAlignment(Marker(4, 1), MeanOf(4, {2, 3}), 3, Vec3(0.2, 0.1, 1)), r);
+  ExpectGradientMatches(AxisAlignment(NodePoint(4, 1), MeanOf(4, {2, 3}), 3, Vec3(0.2, 0.1, 1)), r);
 }
 
 TEST(TrajectoryConstraintTest, BadArgumentsAreRefusedWithMessages) {
-  const TrackedPoint p = Marker(4, 0);
+  const TrackedPoint p = NodePoint(4, 0);
   try {
     PointCoordinate(p, -2, Vec3::UnitX(), "c");
     FAIL() << "no throw";
@@ -104,7 +104,7 @@ TEST(TrajectoryConstraintTest, BadArgumentsAreRefusedWithMessages) {
     EXPECT_STREQ(e.what(), "c: step -2 is invalid: must be a state index >= 0 or kFinalState (-1)");
   }
   try {
-    AxisAlignment(p, Marker(4, 1), 1, Vec3::Zero(), "up");
+    AxisAlignment(p, NodePoint(4, 1), 1, Vec3::Zero(), "up");
     FAIL() << "no throw";
   } catch (const InvalidInputError& e) {
     EXPECT_STREQ(e.what(), "up: the direction must be finite and non-zero");

@@ -1,4 +1,4 @@
-#include "diffpd/solvers/control_signal.h"
+#include "diffpd/solvers/core/control_signal.h"
 
 #include <cmath>
 #include <sstream>
