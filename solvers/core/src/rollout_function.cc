@@ -173,11 +173,10 @@ int RolloutFunction::AddFunctional(std::unique_ptr<TrajectoryFunctional> functio
       throw InvalidInputError(msg.str());
     }
   }
-  const int row = num_rows_;
+  functionals_.push_back(Functional{std::move(functional), num_rows_});
   num_rows_ += m;
-  functionals_.push_back(Functional{std::move(functional), row});
   Invalidate();
-  return row;
+  return num_functionals() - 1;
 }
 
 std::vector<int> RolloutFunction::RowsOf(int i) const {

@@ -79,6 +79,43 @@ TEST(RolloutFunctionTest, AutoModeUsesForwardForFewParametersAndManyRows) {
   EXPECT_EQ(f.ResolvedMode(f.num_rows()), DerivativeMode::kReverse);
 }
 
+TEST(RolloutFunctionTest, ForwardAndReverseJacobiansAgreeForEveryMethod) {
+  // The two-region beam thrown sideways: base and region materials and the
+  // initial velocity as parameters, the probes as rows.
+  for (Method method : {Method::kNewtonCholesky, Method::kPdLbfgs, Method::kSemiImplicit}) {
+    const Scene scene = TwoRegionBeamScene();
+    SolverOptions options = TightOptions(method);
+    const bool explicit_steps = method == Method::kSemiImplicit;
+    if (!explicit_steps) options.time_step = 0.01;
+    RolloutFunction f(scene, options, explicit_steps ? 60 : 6);
+    f.AddBlock(std::make_unique<MaterialBlock>(std::vector<MaterialBlock::Entry>{MaterialField::kYoungsModulus,
+                                                                                 MaterialField::kPoissonsRatio,
+                                                                                 {MaterialField::kYoungsModulus, 0},
+                                                                                 {MaterialField::kPoissonsRatio, 0},
+                                                                                 {MaterialField::kDensity, 1}},
+                                               scene));
+    std::vector<int> all(scene.mesh.num_vertices());
+    for (int i = 0; i < scene.mesh.num_vertices(); ++i) all[i] = i;
+    f.AddBlock(std::make_unique<InitialStateBlock>(InitialStateBlock::kVelocity, all));
+    AddProbes(&f);
+    VectorXd p(8);
+    p << 1.7e5, 0.37, 6e4, 0.32, 900, 0.01, -0.02, 0.03;
+    MatrixXd forward, reverse;
+    f.SetDerivativeMode(DerivativeMode::kForward);
+    ASSERT_TRUE(f.Evaluate(p, f.AllRows(), nullptr, &forward)) << f.statistics().last_error;
+    f.SetDerivativeMode(DerivativeMode::kReverse);
+    ASSERT_TRUE(f.Evaluate(p, f.AllRows(), nullptr, &reverse)) << f.statistics().last_error;
+    for (int r = 0; r < f.num_rows(); ++r) {
+      const double scale = reverse.row(r).cwiseAbs().maxCoeff();
+      ASSERT_GT(scale, 0.0);
+      EXPECT_LE((forward.row(r) - reverse.row(r)).cwiseAbs().maxCoeff(), 1e-8 * scale)
+          << ToString(method) << " row " << r;
+    }
+    for (int j = 0; j < f.num_parameters(); ++j)
+      EXPECT_GT(reverse.col(j).cwiseAbs().maxCoeff(), 0.0) << ToString(method) << " parameter " << j;
+  }
+}
+
 TEST(RolloutFunctionTest, ForwardModeIsRefusedForStateForcesWithAMessage) {
   ParameterBlockCase c = StateForceCase();
   RolloutFunction& f = *c.function;

@@ -9,13 +9,13 @@
 //   RolloutFunction f(scene, options, num_steps);      // the base setup: rest, no input
 //   f.AddBlock(std::make_unique<MaterialBlock>(std::vector<MaterialBlock::Entry>{
 //       MaterialField::kYoungsModulus, MaterialField::kPoissonsRatio}, scene));
-//   const int row = f.AddFunctional(std::make_unique<MarkerResiduals>(motion, scene.mesh, h, num_steps));
+//   const int markers = f.AddFunctional(std::make_unique<MarkerResiduals>(motion, scene.mesh, h, num_steps));
 //   VectorXd v;  MatrixXd J;
-//   f.Evaluate(f.initial_parameters(), f.RowsOf(0), &v, &J);   // residuals and their N-column Jacobian
+//   f.Evaluate(f.initial_parameters(), f.RowsOf(markers), &v, &J);   // residuals, their N-column Jacobian
 //
 // Parameters: the blocks' values, block after block (AddBlock returns each
 // block's offset). Rows: the functionals' values, functional after
-// functional (AddFunctional returns each functional's first row).
+// functional (AddFunctional returns each functional's index; RowsOf its rows).
 //
 // The setup at p is the base setup (SetInitialState, SetInputs; materials and
 // state forces from the scene) with every block applied in order. Its
@@ -139,7 +139,7 @@ class RolloutFunction {
   int FirstAffectedState(int j) const;
 
   // ---- rows -------------------------------------------------------------
-  // Appends a functional; returns the index of its first row. Throws
+  // Appends a functional; returns its index (0, 1, ...). Throws
   // InvalidInputError if it is null, has no value, or reads a state beyond
   // the rollout ("functional 'late' reads state 7, outside the rollout's
   // states [0, 4]").
