@@ -1,4 +1,9 @@
-# The optimiser side (solvers/), mirrored: the rollout core and each adapter.
+# The optimiser side (solvers/), mirrored: the rollout core and each adapter
+# that is built.
 include(${CMAKE_CURRENT_LIST_DIR}/core/tests.cmake)
-include(${CMAKE_CURRENT_LIST_DIR}/ceres/tests.cmake)
-include(${CMAKE_CURRENT_LIST_DIR}/ipopt/tests.cmake)
+if(TARGET diffpd_ceres)
+  include(${CMAKE_CURRENT_LIST_DIR}/ceres/tests.cmake)
+endif()
+if(TARGET diffpd_ipopt)
+  include(${CMAKE_CURRENT_LIST_DIR}/ipopt/tests.cmake)
+endif()
