@@ -35,7 +35,8 @@
 //    which Simulator::Tangents refuses.
 //  - Gradients of weighted sums of rows (Gradient): one Backward pass over
 //    the rollout truncated after the last state a weighted row reads.
-// Jacobian rows and the last gradient are cached per point.
+// Jacobian rows and the last gradient are cached per point (and so are their
+// failures: a failed Jacobian is not recomputed at the same point).
 //
 // Failures: the evaluation methods never throw. A failed rollout (SolverError),
 // a rejected setup (InvalidInputError, e.g. values outside a material's
