@@ -10,6 +10,7 @@
 #include "diffpd/error.h"
 #include "forces/activation_scope.h"
 #include "solver/energy_bounded_step.h"
+#include "solver/rollout_checks.h"
 #include "solver/simulator_impl.h"
 
 namespace diffpd {
@@ -178,17 +179,13 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
   const auto start = Clock::now();
   const int n = sim.num_dofs();
   const int steps = rollout.num_steps();
-  if (static_cast<int>(rollout.states.size()) != steps + 1)
-    throw InvalidInputError("Backward: the rollout has inconsistent states and inputs");
+  internal::CheckRolloutForDerivatives(sim, rollout, "Backward");
   if (static_cast<int>(loss.dx.size()) != steps + 1 || static_cast<int>(loss.dv.size()) != steps + 1) {
     std::ostringstream msg;
     msg << "Backward: the loss gradient must have " << steps + 1 << " entries in dx and dv (got " << loss.dx.size()
         << " and " << loss.dv.size() << ")";
     throw InvalidInputError(msg.str());
   }
-  if (!internal::MadeWithCurrentSettings(sim, rollout))
-    throw InvalidInputError(
-        "Backward: the rollout was made with another material, time step or method than the simulator's current ones");
   for (int k = 0; k <= steps; ++k) {
     CheckVector(loss.dx[k], n, "loss.dx", true);
     CheckVector(loss.dv[k], n, "loss.dv", true);
@@ -196,8 +193,6 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
   const double h = sim.h();
   const VectorXd& mass = sim.Mass();
   const bool contact = !sim.scene.frictional_contacts.empty() && IsImplicit(sim.options.method);
-  if (contact && static_cast<int>(rollout.reports.size()) != steps)
-    throw InvalidInputError("Backward: a rollout with frictional contact needs its step reports (active sets)");
   RolloutGradient out;
   out.external_force.assign(steps, VectorXd());
   out.activation.assign(steps, VectorXd());
