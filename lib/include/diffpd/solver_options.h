@@ -125,14 +125,23 @@ struct SolverOptions {
   int backward_max_iterations = 1000;
 
   // Threads for the element loops and PD's triangular solves (0: OpenMP's
-  // default). Never changes the process-wide OpenMP setting. Results do not
-  // depend on it beyond rounding (the solves' sums run in another order).
+  // default), at most MaxSolverThreads(). Never changes the process-wide
+  // OpenMP setting. Results do not depend on it beyond rounding (the solves'
+  // sums run in another order).
   int num_threads = 0;
   // 0: silent; 1: one line per step on stderr; 2: one line per iteration.
   int verbosity = 0;
 
-  // Throws InvalidInputError naming the field, its value and the valid range.
+  // Throws InvalidInputError naming the field, its value and the valid range
+  // ("solver options: time_step = -1 is invalid: must be finite and > 0
+  // (s)"), also for an enum field holding no declared value (an integer cast
+  // to the enum).
   void Validate() const;
 };
+
+// The most threads SolverOptions::num_threads may ask for: 4 x the
+// processors OpenMP reports (omp_get_num_procs()). More never speeds up a
+// step, and tens of thousands make the OpenMP runtime fail.
+int MaxSolverThreads();
 
 }  // namespace diffpd
