@@ -54,6 +54,10 @@ TEST(SolverOptionsTest, InvalidFieldsAreRejectedWithTheFieldAndRange) {
        "solver options: lbfgs_weight_scale = 1.5 is invalid: must be in (0, 1]"},
       {[](SolverOptions* o) { o->abs_tolerance = o->rel_tolerance = 0; },
        "solver options: abs_tolerance and rel_tolerance are both 0; at least one must be > 0"},
+      {[](SolverOptions* o) { o->max_extent_ratio = 1; },
+       "solver options: max_extent_ratio = 1 is invalid: must be > 1 (infinity: no bound)"},
+      {[](SolverOptions* o) { o->max_extent_ratio = NAN; },
+       "solver options: max_extent_ratio = nan is invalid: must be > 1 (infinity: no bound)"},
       // Integers cast to the enums.
       {[](SolverOptions* o) { o->method = static_cast<Method>(7); },
        "solver options: method = 7 is invalid: must be a Method: semi-implicit (0), newton-cholesky (1), newton-pcg "
@@ -115,7 +119,7 @@ TEST(SolverOptionsTest, BadScenesAndInputsAreRejected) {
   EXPECT_EQ(MessageOf([&] { sim.Step(sim.RestState(), in); }), "external_force has a non-finite entry");
 }
 
-TEST(SolverOptionsTest, AnExplicitStepTooLargeIsReportedAsNonFinite) {
+TEST(SolverOptionsTest, AnExplicitStepTooLargeIsReportedAsDiverged) {
   Scene scene = testing::SmallBeamScene();
   scene.material.youngs_modulus = 1e9;
   SolverOptions o;
@@ -128,7 +132,7 @@ TEST(SolverOptionsTest, AnExplicitStepTooLargeIsReportedAsNonFinite) {
     for (int k = 0; k < 2000; ++k) s = sim.Step(s, StepInput());
     FAIL() << "expected SolverError";
   } catch (const SolverError& e) {
-    EXPECT_EQ(e.status(), SolverStatus::kNonFinite);
+    EXPECT_EQ(e.status(), SolverStatus::kDiverged) << e.what();
   }
 }
 

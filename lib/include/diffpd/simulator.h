@@ -56,7 +56,9 @@ class Simulator {
 
   // One time step with the configured method. Throws InvalidInputError on
   // mismatched sizes or non-finite input, SolverError when the step fails
-  // (non-convergence, inverted neo-Hookean element, factorisation failure).
+  // (non-convergence, inverted neo-Hookean element, factorisation failure,
+  // kNonFinite for a residual or state that overflows, kDiverged for a body
+  // stretched beyond SolverOptions::max_extent_ratio).
   State Step(const State& state, const StepInput& input, StepReport* report = nullptr);
   // K = inputs.size() steps from `initial`, recorded for Backward().
   Rollout Simulate(const State& initial, const std::vector<StepInput>& inputs);

@@ -76,6 +76,7 @@ void SolverOptions::Validate() const {
   if (!(backward_rel_tolerance > 0 && backward_rel_tolerance < 1))
     Reject("backward_rel_tolerance", backward_rel_tolerance, "in (0, 1)");
   if (backward_max_iterations < 1) Reject("backward_max_iterations", backward_max_iterations, ">= 1");
+  if (!(max_extent_ratio > 1)) Reject("max_extent_ratio", max_extent_ratio, "> 1 (infinity: no bound)");
   if (num_threads < 0 || num_threads > MaxSolverThreads()) {
     std::ostringstream range;
     range << "in [0, " << MaxSolverThreads() << "] (0: OpenMP default; at most 4 x the " << omp_get_num_procs()

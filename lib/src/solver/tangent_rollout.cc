@@ -172,8 +172,10 @@ MaterialComponents PartComponents(const InputDirection& d, int part) {
 
 }  // namespace
 
-TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<InputDirection>& directions) {
-  SimulatorImpl& sim = *impl_;
+namespace {
+
+// Tangents' pass over the steps; checks its input first.
+TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std::vector<InputDirection>& directions) {
   const auto start = std::chrono::steady_clock::now();
   const int n = sim.num_dofs();
   const int steps = rollout.num_steps();
@@ -340,8 +342,26 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
     out.dv[i + 1] = (dx1 - dx0) / h;
     out.dx[i + 1] = std::move(dx1);
   }
+  for (int k = 0; k <= steps; ++k)
+    if (!out.dx[k].allFinite() || !out.dv[k].allFinite())
+      throw SolverError(SolverStatus::kNonFinite, "the tangent of state " + std::to_string(k) + " is not finite");
   out.report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
+}
+
+}  // namespace
+
+TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<InputDirection>& directions) {
+  // The rollout and directions are checked finite: a non-finite value on the
+  // way is an overflow.
+  try {
+    return TangentPass(*impl_, rollout, directions);
+  } catch (const SolverError& e) {
+    if (e.status() != SolverStatus::kNonFinite) throw;
+    throw SolverError(SolverStatus::kNonFinite, std::string(ToString(impl_->options.method)) +
+                                                    " tangent: the tangents overflowed double precision (" + e.what() +
+                                                    ")");
+  }
 }
 
 }  // namespace diffpd
