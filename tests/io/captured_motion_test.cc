@@ -107,6 +107,7 @@ const BadFile kBadFiles[] = {
     {kHeader + "0,0,1e300,2,3\n", "F:5: x = 1e+300 is invalid: must be within +-1000000 (m)"},
     {kHeader + "0,0,1,2,-1000001\n", "F:5: z = -1000001 is invalid: must be within +-1000000 (m)"},
     {kWeightHeader + "0,0,1,2,3,1,1,-1\n", "F:5: wz = -1 is invalid: weights must be >= 0"},
+    {kWeightHeader + "0,0,1,2,3,1e300,1,1\n", "F:5: wx = 1e+300 is invalid: weights must be <= 1000000000000 (1/m)"},
     {kHeader + "0,9,1,2,3\n", "F:5: unknown marker id 9 (declared ids: 0, 1)"},
     {kHeader + "0.2,0,1,2,3\n0.1,1,1,2,3\n0.1,0,1,2,3\n",
      "F:7: time 0.1 of marker 0 is not after its previous sample at time 0.2 (line 5): times must increase "

@@ -18,7 +18,8 @@
 //   [-1, 1]^3 of the trilinear map (mesh.h's node convention).
 // - The header names the sample columns: time (s, >= 0, measured from the
 //   initial state of the simulation), marker (a declared id), position x, y,
-//   z (m, each within +-kMaxMarkerCoordinate), and optionally per-axis weights wx, wy, wz (>= 0, default 1). A
+//   z (m, each within +-kMaxMarkerCoordinate), and optionally per-axis
+//   weights wx, wy, wz (in [0, kMaxMarkerWeight], default 1). A
 //   calibration residual is weight * (simulated - captured), so a weight is
 //   the inverse standard deviation of that coordinate (1/m) up to a common
 //   factor, and 0 ignores it.
@@ -41,6 +42,10 @@ namespace diffpd {
 // values are not the motion of a simulated body (and their squares, in a
 // calibration's cost, overflow double precision near 1e154).
 inline constexpr double kMaxMarkerCoordinate = 1e6;
+// The largest per-axis weight accepted (1/m): the inverse of a picometre.
+// With coordinates bounded as above, every weighted residual and its square
+// stay far inside double precision.
+inline constexpr double kMaxMarkerWeight = 1e12;
 
 // A point fixed in the material: a mesh vertex, or a point of an element.
 struct Marker {
@@ -92,6 +97,7 @@ struct CapturedMotion {
 //   "m.csv:7: x = 1e+300 is invalid: must be within +-1000000 (m)"
 //   "m.csv:7: time = -0.1 is invalid: must be >= 0 (s)"
 //   "m.csv:7: wz = -1 is invalid: weights must be >= 0"
+//   "m.csv:7: wx = 1e+300 is invalid: weights must be <= 1000000000000 (1/m)"
 //   "m.csv:7: unknown marker id 9 (declared ids: 0, 1)"
 //   "m.csv:9: time 0.1 of marker 0 is not after its previous sample at time 0.2 (line 8): times must increase strictly
 //   per marker" "m.csv: no marker declared", "m.csv: no samples"

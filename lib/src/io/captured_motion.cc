@@ -74,6 +74,9 @@ void CheckSample(const MarkerSample& s, const std::map<int, const Marker*>& ids,
       throw InvalidInputError(at + weights[d] + " = " + Format(s.weight(d)) + " is not finite");
     if (s.weight(d) < 0)
       throw InvalidInputError(at + weights[d] + " = " + Format(s.weight(d)) + " is invalid: weights must be >= 0");
+    if (s.weight(d) > kMaxMarkerWeight)
+      throw InvalidInputError(at + weights[d] + " = " + Format(s.weight(d)) +
+                              " is invalid: weights must be <= " + Format(kMaxMarkerWeight) + " (1/m)");
   }
   if (!ids.count(s.marker)) {
     std::string list;
