@@ -13,3 +13,4 @@ diffpd_add_test(trajectory_optimization_test ${_dir}/control/trajectory_optimiza
 diffpd_add_test(bench_test ${_dir}/tools/bench_test.cc LIBS diffpd_problems)
 diffpd_add_test(tradeoff_test ${_dir}/tools/tradeoff_test.cc LIBS diffpd_problems)
 diffpd_add_test(stress_test ${_dir}/tools/stress_test.cc LIBS diffpd_problems)
+diffpd_add_test(command_line_test ${_dir}/cli/command_line_test.cc LIBS diffpd_problems)

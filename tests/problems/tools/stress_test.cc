@@ -210,6 +210,14 @@ TEST(StressOptionsTest, ValidateNamesTheFieldValueAndRange) {
   o.time_steps = {0};
   EXPECT_THROW(o.Validate(), InvalidInputError);
   o = StressOptions();
+  o.threads = 99999;
+  try {
+    o.Validate();
+    FAIL() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_EQ(e.what(), "threads = 99999 is invalid: must be " + ThreadRange());
+  }
+  o = StressOptions();
   o.problems = {{"no-such-problem", 0}};
   EXPECT_THROW(RunStress(o), InvalidInputError);
 }
