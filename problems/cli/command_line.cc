@@ -1,10 +1,14 @@
+// RunCommandLine (command_line.h): the diffpd program's subcommands, their
+// options and the mapping of exceptions to exit statuses.
 #include "cli/command_line.h"
 
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
 #include <exception>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "cli/commands.h"
 #include "cli/option_checks.h"
