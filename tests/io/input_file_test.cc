@@ -11,14 +11,14 @@
 
 #include "diffpd/error.h"
 #include "util/expect_message.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd {
 namespace {
 
-std::filesystem::path TestDirectory() {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "diffpd_input_file_test";
-  std::filesystem::create_directories(dir);
-  return dir;
+const std::filesystem::path& TestDirectory() {
+  static const testing::TemporaryDirectory directory("diffpd-input-file");
+  return directory.path();
 }
 
 TEST(InputFileTest, RefusesMissingFilesAndDirectoriesByName) {

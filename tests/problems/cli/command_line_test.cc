@@ -13,12 +13,14 @@
 
 #include "diffpd/solver_options.h"
 #include "problem_registry.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd::problems {
 namespace {
 
 std::string TempPath(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("diffpd_command_line_" + name)).string();
+  static const testing::TemporaryDirectory directory("diffpd-command-line");
+  return directory.File(name);
 }
 
 std::string WriteTemp(const std::string& name, const std::string& text) {
