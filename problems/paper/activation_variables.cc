@@ -52,7 +52,7 @@ double ActivationGradient(const RolloutGradient& grad, size_t k, int m) {
 // ---- ConstantActivationVariables ---------------------------------------------
 
 ConstantActivationVariables::ConstantActivationVariables(std::vector<int> muscles, int num_muscles)
-    : ControlVariables(static_cast<int>(muscles.size())), muscles_(std::move(muscles)), num_muscles_(num_muscles) {
+    : ReverseModeBlock(static_cast<int>(muscles.size())), muscles_(std::move(muscles)), num_muscles_(num_muscles) {
   CheckMuscles(muscles_, num_muscles_, name());
   SetInitial(VectorXd::Ones(size()));
 }
@@ -79,7 +79,7 @@ void ConstantActivationVariables::PullBack(const Eigen::Ref<const VectorXd>& val
 
 WindowedActivationVariables::WindowedActivationVariables(std::vector<int> muscles, int num_muscles, int num_steps,
                                                          int window)
-    : ControlVariables(0),
+    : ReverseModeBlock(0),
       muscles_(std::move(muscles)),
       num_muscles_(num_muscles),
       num_steps_(num_steps),
@@ -136,7 +136,7 @@ int WindowedActivationVariables::FirstAffectedState(int j) const {
 
 GaitActivationVariables::GaitActivationVariables(std::vector<GaitMuscle> muscles, int num_muscles, int num_steps,
                                                  double peak)
-    : ControlVariables(3), muscles_(std::move(muscles)), num_muscles_(num_muscles), num_steps_(num_steps), peak_(peak) {
+    : ReverseModeBlock(3), muscles_(std::move(muscles)), num_muscles_(num_muscles), num_steps_(num_steps), peak_(peak) {
   std::vector<int> indices;
   for (const GaitMuscle& m : muscles_) indices.push_back(m.muscle);
   CheckMuscles(indices, num_muscles_, name());
@@ -186,7 +186,7 @@ void GaitActivationVariables::PullBack(const Eigen::Ref<const VectorXd>& values,
 
 // ---- ConstantForceVariables ------------------------------------------------------
 
-ConstantForceVariables::ConstantForceVariables(int num_dofs) : ControlVariables(num_dofs) {
+ConstantForceVariables::ConstantForceVariables(int num_dofs) : ReverseModeBlock(num_dofs) {
   if (num_dofs <= 0 || num_dofs % 3 != 0) {
     std::ostringstream msg;
     msg << name() << ": num_dofs = " << num_dofs << " is invalid: must be a positive multiple of 3";

@@ -8,14 +8,14 @@
 #include <string>
 #include <vector>
 
-#include "diffpd/solvers/control_variables.h"
+#include "paper/reverse_mode_block.h"
 
 namespace diffpd::problems {
 
 // One activation per listed muscle, held at every step: variable j is the
 // activation of muscle muscles[j] (routing tendon's 16 groups, the
 // cantilever's 32 one-element muscles). dL/dx_j = sum_k dL/da_k[muscles[j]].
-class ConstantActivationVariables : public solvers::ControlVariables {
+class ConstantActivationVariables : public ReverseModeBlock {
  public:
   // Throws InvalidInputError if muscles is empty, has a negative index or
   // num_muscles <= max index.
@@ -38,7 +38,7 @@ class ConstantActivationVariables : public solvers::ControlVariables {
 // lies in window c = floor(k / window), t = (k mod window) / window, and gets
 //   a_k[g] = (1 - t) x[c G + g] + t x[c' G + g],  c' = min(c + 1, C - 1)
 // (the last window is constant).
-class WindowedActivationVariables : public solvers::ControlVariables {
+class WindowedActivationVariables : public ReverseModeBlock {
  public:
   // Throws InvalidInputError if muscles is empty or out of [0, num_muscles),
   // window < 1, or num_steps is not a positive multiple of window.
@@ -61,7 +61,7 @@ class WindowedActivationVariables : public solvers::ControlVariables {
 //   a_i[m] = peak (1 + s_m A sin(w i)) / 2,
 // s_m = +1 for a front-pulling muscle ("F"), -1 for a back one ("B"), and
 // A = A_f on front legs, A_b on rear legs.
-class GaitActivationVariables : public solvers::ControlVariables {
+class GaitActivationVariables : public ReverseModeBlock {
  public:
   struct GaitMuscle {
     int muscle = 0;
@@ -86,7 +86,7 @@ class GaitActivationVariables : public solvers::ControlVariables {
 
 // An external force held at every step, one variable per DoF (3n, N; the
 // cantilever and rolling-sphere rows' f). Added to the base setup's forces.
-class ConstantForceVariables : public solvers::ControlVariables {
+class ConstantForceVariables : public ReverseModeBlock {
  public:
   // Throws InvalidInputError unless num_dofs > 0 and a multiple of 3.
   explicit ConstantForceVariables(int num_dofs);

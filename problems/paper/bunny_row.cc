@@ -1,7 +1,7 @@
 // Row 5, Bunny (initial-state optimisation): PROBLEMS.md section 5.
 #include <cmath>
 
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 #include "paper/paper_meshes.h"
 #include "paper/paper_rows.h"
 #include "paper/rigid_placement_variables.h"

@@ -2,7 +2,7 @@
 #include <cmath>
 
 #include "diffpd/box_mesh.h"
-#include "diffpd/solvers/control_variables.h"
+#include "diffpd/solvers/core/initial_state_block.h"
 #include "paper/activation_variables.h"
 #include "paper/paper_meshes.h"
 #include "paper/paper_rows.h"
@@ -76,12 +76,10 @@ PaperRow MakeCantileverRow(RowSize size) {
   row.base.material = scene.material;
   std::vector<int> all(n);
   for (int i = 0; i < n; ++i) all[i] = i;
-  using solvers::InitialStateVariables;
-  auto x0 =
-      std::make_shared<InitialStateVariables>(InitialStateVariables::kPosition, all, InitialStateVariables::kPerNode);
+  using solvers::InitialStateBlock;
+  auto x0 = std::make_shared<InitialStateBlock>(InitialStateBlock::kPosition, all, InitialStateBlock::kPerNode);
   x0->SetInitial(q0);
-  auto v0 =
-      std::make_shared<InitialStateVariables>(InitialStateVariables::kVelocity, all, InitialStateVariables::kPerNode);
+  auto v0 = std::make_shared<InitialStateBlock>(InitialStateBlock::kVelocity, all, InitialStateBlock::kPerNode);
   auto activation = std::make_shared<ConstantActivationVariables>(muscles, nx);
   activation->SetInitial(a);
   auto force = std::make_shared<ConstantForceVariables>(3 * n);

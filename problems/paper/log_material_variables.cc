@@ -7,7 +7,7 @@
 namespace diffpd::problems {
 namespace {
 
-using Field = solvers::MaterialVariables::Field;
+using Field = solvers::MaterialField;
 
 double& Parameter(MaterialParameters* m, Field f) {
   return f == Field::kYoungsModulus ? m->youngs_modulus : f == Field::kPoissonsRatio ? m->poissons_ratio : m->density;
@@ -20,7 +20,7 @@ double Derivative(const RolloutGradient& g, Field f) {
 }  // namespace
 
 LogMaterialVariables::LogMaterialVariables(std::vector<Field> fields, const MaterialParameters& start)
-    : ControlVariables(static_cast<int>(fields.size())), fields_(std::move(fields)) {
+    : ReverseModeBlock(static_cast<int>(fields.size())), fields_(std::move(fields)) {
   if (fields_.empty()) throw InvalidInputError("log_material: no field");
   VectorXd initial(fields_.size());
   MaterialParameters m = start;

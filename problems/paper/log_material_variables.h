@@ -6,13 +6,14 @@
 #include <string>
 #include <vector>
 
-#include "diffpd/solvers/control_variables.h"
+#include "diffpd/solvers/core/material_block.h"
+#include "paper/reverse_mode_block.h"
 
 namespace diffpd::problems {
 
-class LogMaterialVariables : public solvers::ControlVariables {
+class LogMaterialVariables : public ReverseModeBlock {
  public:
-  using Field = solvers::MaterialVariables::Field;
+  using Field = solvers::MaterialField;
   // One variable per field, in this order; starting values ln of `start`'s
   // parameters. Throws InvalidInputError if fields is empty or repeats one.
   LogMaterialVariables(std::vector<Field> fields, const MaterialParameters& start);

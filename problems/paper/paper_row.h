@@ -1,7 +1,7 @@
 // One row of the DiffPD paper's results table (PROBLEMS.md, rows 1-9) as
 // data: the scene at the paper's size (or a reduced one for tests), the
 // rollout it starts from, the optimisation variables and how they map to the
-// rollout's inputs (solvers::ControlVariables blocks), the loss as weighted
+// rollout's inputs (solvers::ParameterBlock blocks), the loss as weighted
 // functions of the rollout, the random draws that normalise the loss, the
 // optimiser's budget, the solver settings and the paper's own numbers.
 //
@@ -19,8 +19,8 @@
 #include "diffpd/scene.h"
 #include "diffpd/simulator.h"
 #include "diffpd/solver_options.h"
-#include "diffpd/solvers/control_variables.h"
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/parameter_block.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 
 namespace diffpd::problems {
 
@@ -92,7 +92,7 @@ struct PaperRow {
   solvers::RolloutSetup base;
   // The variables, block after block; a block's initial() holds x_init before
   // projection onto its bounds (the paper's L-BFGS-B projects it).
-  std::vector<std::shared_ptr<solvers::ControlVariables>> variables;
+  std::vector<std::shared_ptr<solvers::ParameterBlock>> variables;
   // L = sum of weight * function(rollout).
   std::vector<LossTerm> loss;
   InitialGuess initial_guess = InitialGuess::kGiven;

@@ -30,7 +30,7 @@ std::vector<VectorXd> UniformDraws(NumpyRandom* rng, const VectorXd& lower, cons
   return draws;
 }
 
-void SetBlockBounds(solvers::ControlVariables* block, const VectorXd& lower, const VectorXd& upper) {
+void SetBlockBounds(solvers::ParameterBlock* block, const VectorXd& lower, const VectorXd& upper) {
   for (int j = 0; j < block->size(); ++j) block->SetBounds(j, 1, lower(j), upper(j));
 }
 

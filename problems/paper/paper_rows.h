@@ -32,6 +32,6 @@ PaperRow MakePaperRow(const std::string& name, RowSize size);
 // order, as numpy.random.uniform(lower, upper)).
 std::vector<VectorXd> UniformDraws(NumpyRandom* rng, const VectorXd& lower, const VectorXd& upper, int count);
 // Sets a block's bounds variable by variable (lower, upper of its size).
-void SetBlockBounds(solvers::ControlVariables* block, const VectorXd& lower, const VectorXd& upper);
+void SetBlockBounds(solvers::ParameterBlock* block, const VectorXd& lower, const VectorXd& upper);
 
 }  // namespace diffpd::problems

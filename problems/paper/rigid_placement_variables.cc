@@ -50,7 +50,7 @@ Mat3 RigidPlacementVariables::Rotation(const Vec3& rpy, Mat3 derivatives[3]) {
   return rz * ry * rx;
 }
 
-RigidPlacementVariables::RigidPlacementVariables(const VectorXd& rest_positions) : ControlVariables(9) {
+RigidPlacementVariables::RigidPlacementVariables(const VectorXd& rest_positions) : ReverseModeBlock(9) {
   if (rest_positions.size() == 0 || rest_positions.size() % 3 != 0) {
     std::ostringstream msg;
     msg << "rigid_placement: rest_positions has " << rest_positions.size()

@@ -12,11 +12,11 @@
 
 #include <string>
 
-#include "diffpd/solvers/control_variables.h"
+#include "paper/reverse_mode_block.h"
 
 namespace diffpd::problems {
 
-class RigidPlacementVariables : public solvers::ControlVariables {
+class RigidPlacementVariables : public ReverseModeBlock {
  public:
   // Throws InvalidInputError if rest_positions is empty or not of size 3n.
   explicit RigidPlacementVariables(const VectorXd& rest_positions);

@@ -1,5 +1,5 @@
 // Row 2, Rolling sphere (timing only): PROBLEMS.md section 2.
-#include "diffpd/solvers/control_variables.h"
+#include "diffpd/solvers/core/initial_state_block.h"
 #include "paper/activation_variables.h"
 #include "paper/paper_meshes.h"
 #include "paper/paper_rows.h"
@@ -49,12 +49,10 @@ PaperRow MakeRollingSphereRow(RowSize size) {
   row.base.material = scene.material;
   std::vector<int> all(n);
   for (int i = 0; i < n; ++i) all[i] = i;
-  using solvers::InitialStateVariables;
-  auto x0 =
-      std::make_shared<InitialStateVariables>(InitialStateVariables::kPosition, all, InitialStateVariables::kPerNode);
+  using solvers::InitialStateBlock;
+  auto x0 = std::make_shared<InitialStateBlock>(InitialStateBlock::kPosition, all, InitialStateBlock::kPerNode);
   x0->SetInitial(q0);
-  auto v0_block =
-      std::make_shared<InitialStateVariables>(InitialStateVariables::kVelocity, all, InitialStateVariables::kPerNode);
+  auto v0_block = std::make_shared<InitialStateBlock>(InitialStateBlock::kVelocity, all, InitialStateBlock::kPerNode);
   v0_block->SetInitial(v0);
   row.variables = {x0, v0_block, std::make_shared<ConstantForceVariables>(3 * n)};
   row.loss = {{std::make_shared<LinearFinalStateLoss>(gq, gv), 1.0}};

@@ -1,6 +1,6 @@
 // Row 6, Routing tendon (static activation): PROBLEMS.md section 6.
 #include "diffpd/box_mesh.h"
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 #include "paper/activation_variables.h"
 #include "paper/paper_meshes.h"
 #include "paper/paper_rows.h"
@@ -53,7 +53,7 @@ PaperRow MakeRoutingTendonRow(RowSize size) {
 
   // (1/2) |p(x_K) - (0.2, 0.2, 0.45)|^2 / 0.025^2, p the last node (the tip
   // corner at (0.1, 0.1, 0.8)).
-  row.loss = {{std::make_shared<solvers::PointDistanceSquared>(solvers::Marker(n, n - 1), solvers::kFinalState,
+  row.loss = {{std::make_shared<solvers::PointDistanceSquared>(solvers::NodePoint(n, n - 1), solvers::kFinalState,
                                                                Vec3(0.2, 0.2, 0.45), "tip_to_target"),
                0.5 / (0.025 * 0.025)}};
 

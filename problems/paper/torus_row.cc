@@ -1,7 +1,7 @@
 // Row 7, Torus (open-loop rolling): PROBLEMS.md section 7.
 #include <cmath>
 
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 #include "paper/activation_variables.h"
 #include "paper/paper_meshes.h"
 #include "paper/paper_rows.h"

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 
 namespace diffpd::problems {
 
@@ -18,7 +18,6 @@ class LinearFinalStateLoss : public solvers::TrajectoryFunction {
   LinearFinalStateLoss(VectorXd position_weights, VectorXd velocity_weights);
   std::string name() const override { return "linear_final_state"; }
   int LastState(int num_steps) const override { return num_steps; }
-  bool is_affine_in_states() const override { return true; }
   double Value(const Rollout& rollout) const override;
   void AddGradient(const Rollout& rollout, double weight, LossGradient* loss) const override;
 

@@ -22,6 +22,7 @@
 #include "fem/fem_model.h"
 #include "material/density_kernels.h"
 #include "test_scenes.h"
+#include "util/central_difference.h"
 
 namespace diffpd {
 namespace {
@@ -124,14 +125,14 @@ TEST(ElasticForcesTest, GradientMatchesCentralDifferencesOfTheEnergy) {
     const VectorXd x = DeformedPositions(body.scene.mesh, c.noise, 4);
     VectorXd grad;
     forces.EnergyAndGradient(x, LameField::Uniform(mu, lambda), &grad, 1);
+    const auto energy = [&](const VectorXd& y) {
+      return forces.EnergyAndGradient(y, LameField::Uniform(mu, lambda), nullptr, 1);
+    };
     std::mt19937 rng(5);
     for (int trial = 0; trial < 3; ++trial) {
       const VectorXd dir = NormalVector(static_cast<int>(x.size()), &rng);
-      const double eps = 1e-7;
-      const double plus = forces.EnergyAndGradient(x + eps * dir, LameField::Uniform(mu, lambda), nullptr, 1);
-      const double minus = forces.EnergyAndGradient(x - eps * dir, LameField::Uniform(mu, lambda), nullptr, 1);
-      const double fd = (plus - minus) / (2 * eps);
-      EXPECT_NEAR(grad.dot(dir), fd, 1e-6 * grad.norm() * dir.norm()) << "tets " << c.tets << " noise " << c.noise;
+      EXPECT_TRUE(testing::Passes(testing::CheckDirectionalDerivative(energy, x, dir, grad.dot(dir))))
+          << "tets " << c.tets << " noise " << c.noise;
     }
   }
 }
@@ -205,17 +206,21 @@ TEST(ElasticForcesTest, ElementHessiansAreTheGradientsDerivativeAndMatchTheSampl
     forces.StressDifferentials(x, lame, &dstress, 1);
     std::mt19937 rng(11);
     const VectorXd dir = NormalVector(static_cast<int>(x.size()), &rng);
-    VectorXd h_blocks, h_samples, g_plus, g_minus;
+    VectorXd h_blocks, h_samples;
     std::vector<double> packed;
     forces.PackElementMatrices(blocks, &packed);
     forces.ApplyElementMatrices(packed, dir, &h_blocks, 1);
     forces.ApplyHessian(dstress, dir, &h_samples, 1);
     EXPECT_LE((h_blocks - h_samples).norm(), 1e-12 * h_samples.norm()) << "tets " << c.tets << " noise " << c.noise;
-    const double eps = 1e-7;
-    forces.EnergyAndGradient(x + eps * dir, lame, &g_plus, 1);
-    forces.EnergyAndGradient(x - eps * dir, lame, &g_minus, 1);
-    const VectorXd fd = (g_plus - g_minus) / (2 * eps);
-    EXPECT_LE((h_blocks - fd).norm(), 1e-5 * fd.norm()) << "tets " << c.tets << " noise " << c.noise;
+    const auto gradient = [&](const VectorXd& y) {
+      VectorXd g;
+      forces.EnergyAndGradient(y, lame, &g, 1);
+      return g;
+    };
+    testing::DifferenceOptions options;
+    options.rtol = 1e-5;
+    EXPECT_TRUE(testing::Passes(testing::CheckDirectionalDerivative(gradient, x, dir, h_blocks, options)))
+        << "tets " << c.tets << " noise " << c.noise;
   }
 }
 

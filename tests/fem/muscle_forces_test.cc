@@ -15,6 +15,8 @@
 #include "fem/muscle_forces.h"
 #include "tools/gradcheck.h"
 #include "test_scenes.h"
+#include "util/expect_message.h"
+#include "util/central_difference.h"
 
 namespace diffpd {
 namespace {
@@ -79,29 +81,25 @@ TEST_P(MuscleForcesTest, GradientHessianAndActivationDerivativeMatchFiniteDiffer
     const VectorXd x = f.Rest() + Random(n, &rng, 0.01);
     const Eigen::Vector2d a(0.8 + 0.1 * trial, 1.05);
     const VectorXd d = Random(n, &rng);
-    VectorXd grad = VectorXd::Zero(n);
-    f.forces->AddEnergyAndGradient(x, a, &grad);
-    const double eps = 1e-7;
-    const double fd = (f.forces->AddEnergyAndGradient(x + eps * d, a, nullptr) -
-                       f.forces->AddEnergyAndGradient(x - eps * d, a, nullptr)) /
-                      (2 * eps);
-    EXPECT_NEAR(fd, grad.dot(d), 1e-6 * std::abs(fd) + 1e-12);
-    VectorXd gp = VectorXd::Zero(n), gm = VectorXd::Zero(n), hd = VectorXd::Zero(n);
-    f.forces->AddEnergyAndGradient(x + eps * d, a, &gp);
-    f.forces->AddEnergyAndGradient(x - eps * d, a, &gm);
+    // E(x), grad E(x) at activation a, and -d . grad E(x) at activations b.
+    const auto gradient_at = [&](const VectorXd& y, const VectorXd& b) {
+      VectorXd g = VectorXd::Zero(n);
+      f.forces->AddEnergyAndGradient(y, b, &g);
+      return g;
+    };
+    const auto energy = [&](const VectorXd& y) { return f.forces->AddEnergyAndGradient(y, a, nullptr); };
+    const auto gradient = [&](const VectorXd& y) { return gradient_at(y, a); };
+    const auto minus_d_dot_gradient = [&](const VectorXd& b) { return -d.dot(gradient_at(x, b)); };
+    VectorXd hd = VectorXd::Zero(n);
     f.forces->AddHessianProduct(x, a, d, &hd);
-    EXPECT_LT(((gp - gm) / (2 * eps) - hd).norm(), 1e-6 * hd.norm());
+    EXPECT_TRUE(testing::Passes(testing::CheckDirectionalDerivative(energy, x, d, gradient(x).dot(d))));
+    EXPECT_TRUE(testing::Passes(testing::CheckDirectionalDerivative(gradient, x, d, hd)));
     // dL/da_j = -z . d(grad)/da_j with z = d.
     const VectorXd ga = f.forces->ActivationGradient(x, a, d);
     for (int j = 0; j < 2; ++j) {
-      Eigen::Vector2d ap = a, am = a;
-      ap(j) += eps;
-      am(j) -= eps;
-      VectorXd g1 = VectorXd::Zero(n), g2 = VectorXd::Zero(n);
-      f.forces->AddEnergyAndGradient(x, ap, &g1);
-      f.forces->AddEnergyAndGradient(x, am, &g2);
-      const double fd_a = -d.dot(g1 - g2) / (2 * eps);
-      EXPECT_NEAR(fd_a, ga(j), 1e-6 * std::abs(fd_a) + 1e-9);
+      EXPECT_TRUE(testing::Passes(
+          testing::CheckDirectionalDerivative(minus_d_dot_gradient, a, Eigen::Vector2d::Unit(j), ga(j))))
+          << "activation " << j;
     }
   }
 }
@@ -232,12 +230,8 @@ TEST(MuscleRolloutTest, BadActivationIsRejectedWithAClearMessage) {
   Simulator sim(MuscleBeam(), SolverOptions());
   StepInput wrong_size;
   wrong_size.activation = Eigen::Vector3d(1, 1, 1);
-  try {
-    sim.Step(sim.RestState(), wrong_size);
-    FAIL();
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(), "activation has 3 entries, expected 2 (one per muscle)");
-  }
+  ASSERT_THROW_MESSAGE(sim.Step(sim.RestState(), wrong_size), InvalidInputError,
+                       "activation has 3 entries, expected 2 (one per muscle)");
   StepInput nan;
   nan.activation = Eigen::Vector2d(1, std::nan(""));
   try {

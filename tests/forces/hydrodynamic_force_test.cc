@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include "forces/hydrodynamic_force.h"
+#include "util/central_difference.h"
 
 namespace diffpd {
 namespace {
@@ -75,28 +76,27 @@ TEST(HydrodynamicForceTest, VectorJacobianProductsMatchFiniteDifferences) {
     Vec3 ga, gu;
     StateForceGradient grad;
     internal::HydrodynamicForceVjp(p, n, u, w, &ga, &gu, &grad);
-    const double eps = 1e-7;
-    for (int d = 0; d < 3; ++d) {
-      const Vec3 e = Vec3::Unit(d);
-      const double fd_u =
-          w.dot(internal::HydrodynamicForce(p, n, u + eps * e) - internal::HydrodynamicForce(p, n, u - eps * e)) /
-          (2 * eps);
-      EXPECT_NEAR(fd_u, gu(d), 1e-6 * gu.norm());
-      const double en = 1e-9;
-      const double fd_n =
-          w.dot(internal::HydrodynamicForce(p, n + en * e, u) - internal::HydrodynamicForce(p, n - en * e, u)) /
-          (2 * en);
-      EXPECT_NEAR(fd_n, ga(d), 1e-6 * ga.norm());
-    }
+    const auto wf_u = [&](const VectorXd& uu) { return w.dot(internal::HydrodynamicForce(p, n, uu)); };
+    const auto wf_n = [&](const VectorXd& nn) { return w.dot(internal::HydrodynamicForce(p, nn, u)); };
+    EXPECT_TRUE(testing::Passes(testing::CheckGradient(wf_u, u, gu))) << "u";
+    EXPECT_TRUE(testing::Passes(testing::CheckGradient(wf_n, n, ga))) << "area vector";
     auto check_param = [&](double* field, double analytic) {
-      // F is linear in every parameter: a large step has no truncation error.
-      const double saved = *field, step = 1e-3 * std::max(1.0, std::abs(saved));
-      *field = saved + step;
-      const double fp = w.dot(internal::HydrodynamicForce(p, n, u));
-      *field = saved - step;
-      const double fm = w.dot(internal::HydrodynamicForce(p, n, u));
-      *field = saved;
-      EXPECT_NEAR((fp - fm) / (2 * step), analytic, 1e-9 * std::abs(analytic) + 1e-14);
+      // F is linear in every parameter: a large step has no truncation error
+      // and keeps rounding at 1e-12 relative, so the test's own step and
+      // tolerance stay (1e-9 relative, 1e-14 absolute).
+      const double saved = *field;
+      const auto wf_param = [&](const VectorXd& value) {
+        *field = value(0);
+        const double result = w.dot(internal::HydrodynamicForce(p, n, u));
+        *field = saved;
+        return result;
+      };
+      testing::DifferenceOptions options;
+      options.step = 1e-3 * std::max(1.0, std::abs(saved));
+      options.rtol = 1e-9;
+      options.floor = 1e-14;
+      EXPECT_TRUE(testing::Passes(testing::CheckDirectionalDerivative(wf_param, VectorXd::Constant(1, saved),
+                                                                      VectorXd::Ones(1), analytic, options)));
     };
     check_param(&p.fluid_density, grad.fluid_density);
     check_param(&p.drag_tangential, grad.drag_tangential);

@@ -12,6 +12,7 @@
 #include "forces/state_forces.h"
 #include "tools/gradcheck.h"
 #include "test_scenes.h"
+#include "util/central_difference.h"
 
 namespace diffpd {
 namespace {
@@ -95,31 +96,39 @@ TEST(StateForcesTest, VectorJacobianProductsMatchFiniteDifferences) {
       return w.dot(f);
     };
     const VectorXd dx = Random(n, &rng), dv = Random(n, &rng);
-    const double eps = 1e-7;
-    const double fd_x = (wf(x + eps * dx, v, rho) - wf(x - eps * dx, v, rho)) / (2 * eps);
-    const double fd_v = (wf(x, v + eps * dv, rho) - wf(x, v - eps * dv, rho)) / (2 * eps);
-    const double fd_r = (wf(x, v, rho + 1e-3) - wf(x, v, rho - 1e-3)) / 2e-3;
-    EXPECT_NEAR(fd_x, gx.dot(dx), 1e-6 * std::abs(fd_x) + 1e-10);
-    EXPECT_NEAR(fd_v, gv.dot(dv), 1e-6 * std::abs(fd_v) + 1e-10);
-    EXPECT_NEAR(fd_r, drho, 1e-6 * std::abs(fd_r) + 1e-12);
-    // Parameters: perturb the scene.
-    auto param_fd = [&](const std::function<void(Scene*, double)>& perturb) {
-      Scene p = scene, m = scene;
-      perturb(&p, 1e-6);
-      perturb(&m, -1e-6);
-      VectorXd fp = VectorXd::Zero(n), fm = VectorXd::Zero(n);
-      internal::StateForces(p).Add(x, v, mass, &fp);
-      internal::StateForces(m).Add(x, v, mass, &fm);
-      return w.dot(fp - fm) / 2e-6;
+    const auto wf_x = [&](const VectorXd& xx) { return wf(xx, v, rho); };
+    const auto wf_v = [&](const VectorXd& vv) { return wf(x, vv, rho); };
+    const auto wf_rho = [&](const VectorXd& r) { return wf(x, v, r(0)); };
+    const VectorXd one = VectorXd::Ones(1);
+    EXPECT_TRUE(testing::Passes(testing::CheckDirectionalDerivative(wf_x, x, dx, gx.dot(dx)))) << "x";
+    EXPECT_TRUE(testing::Passes(testing::CheckDirectionalDerivative(wf_v, v, dv, gv.dot(dv)))) << "v";
+    EXPECT_TRUE(testing::Passes(testing::CheckDirectionalDerivative(wf_rho, VectorXd::Constant(1, rho), one, drho)))
+        << "density";
+    // Parameters: w . F as a function of one scene field.
+    auto check_param = [&](const std::function<double&(Scene&)>& field, double analytic, const char* name) {
+      Scene base = scene;
+      const auto wf_param = [&](const VectorXd& p) {
+        Scene s = scene;
+        field(s) = p(0);
+        VectorXd f = VectorXd::Zero(n);
+        internal::StateForces(s).Add(x, v, mass, &f);
+        return w.dot(f);
+      };
+      EXPECT_TRUE(testing::Passes(
+          testing::CheckDirectionalDerivative(wf_param, VectorXd::Constant(1, field(base)), one, analytic)))
+          << name;
     };
-    auto near = [](double fd, double an) { EXPECT_NEAR(fd, an, 1e-6 * std::abs(an) + 1e-10); };
-    near(param_fd([](Scene* s, double e) { *s->linear_damping += e; }), grad.linear_damping);
-    near(param_fd([](Scene* s, double e) { s->hydrodynamics->fluid_density += e; }), grad.fluid_density);
-    near(param_fd([](Scene* s, double e) { s->hydrodynamics->drag_normal += e; }), grad.drag_normal);
-    near(param_fd([](Scene* s, double e) { s->hydrodynamics->drag_tangential += e; }), grad.drag_tangential);
-    near(param_fd([](Scene* s, double e) { s->hydrodynamics->thrust += e; }), grad.thrust);
-    near(param_fd([](Scene* s, double e) { s->hydrodynamics->flow_velocity(1) += e; }), grad.flow_velocity(1));
-    near(param_fd([](Scene* s, double e) { s->penalty_contacts[0].friction += e; }), grad.penalty_friction[0]);
+    check_param([](Scene& s) -> double& { return *s.linear_damping; }, grad.linear_damping, "linear_damping");
+    check_param([](Scene& s) -> double& { return s.hydrodynamics->fluid_density; }, grad.fluid_density,
+                "fluid_density");
+    check_param([](Scene& s) -> double& { return s.hydrodynamics->drag_normal; }, grad.drag_normal, "drag_normal");
+    check_param([](Scene& s) -> double& { return s.hydrodynamics->drag_tangential; }, grad.drag_tangential,
+                "drag_tangential");
+    check_param([](Scene& s) -> double& { return s.hydrodynamics->thrust; }, grad.thrust, "thrust");
+    check_param([](Scene& s) -> double& { return s.hydrodynamics->flow_velocity(1); }, grad.flow_velocity(1),
+                "flow_velocity(1)");
+    check_param([](Scene& s) -> double& { return s.penalty_contacts[0].friction; }, grad.penalty_friction[0],
+                "penalty_contacts[0].friction");
   }
 }
 

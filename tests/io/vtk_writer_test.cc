@@ -1,7 +1,5 @@
 #include "diffpd/vtk_writer.h"
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -11,6 +9,8 @@
 
 #include "diffpd/box_mesh.h"
 #include "diffpd/error.h"
+#include "util/temporary_directory.h"
+#include "util/expect_message.h"
 
 namespace diffpd {
 namespace {
@@ -30,14 +30,9 @@ int Count(const std::string& text, const std::string& pattern) {
 
 class VtkWriterTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    directory_ = std::filesystem::path(::testing::TempDir()) / ("diffpd_vtk_writer_test_" + std::to_string(getpid()));
-    std::filesystem::create_directories(directory_);
-  }
-  void TearDown() override { std::filesystem::remove_all(directory_); }
-  std::string Path(const std::string& name) const { return (directory_ / name).string(); }
+  std::string Path(const std::string& name) const { return directory_.File(name); }
 
-  std::filesystem::path directory_;
+  const testing::TemporaryDirectory directory_{"diffpd-vtk-writer"};
 };
 
 Mesh TwoTets() {
@@ -85,12 +80,7 @@ TEST_F(VtkWriterTest, TetMesh) {
 TEST_F(VtkWriterTest, Errors) {
   const Mesh mesh = TwoTets();
   auto message = [&](const std::string& path, const Eigen::Matrix3Xd& x, const VtkPointData& data) {
-    try {
-      WriteVtu(path, mesh, x, data);
-    } catch (const InvalidInputError& error) {
-      return std::string(error.what());
-    }
-    return std::string("no exception");
+    return testing::MessageOf<InvalidInputError>([&] { WriteVtu(path, mesh, x, data); });
   };
   const std::string path = Path("e.vtu");
   EXPECT_EQ(message("/nonexistent-diffpd-dir/a.vtu", mesh.vertices, {}),
@@ -127,24 +117,14 @@ TEST_F(VtkWriterTest, PvdSeries) {
 TEST_F(VtkWriterTest, PvdErrors) {
   std::ofstream(Path("file")) << "x";
   const std::string blocked = Path("file") + "/sub";
-  try {
-    PvdWriter writer(blocked, "a");
-    ADD_FAILURE() << "no exception";
-  } catch (const InvalidInputError& error) {
-    EXPECT_EQ(std::string(error.what()).rfind("PvdWriter: cannot create directory '" + blocked + "'", 0), 0u)
-        << error.what();
-  }
+  const std::string blocked_message = testing::MessageOf<InvalidInputError>([&] { PvdWriter writer(blocked, "a"); });
+  EXPECT_EQ(blocked_message.rfind("PvdWriter: cannot create directory '" + blocked + "'", 0), 0u) << blocked_message;
   EXPECT_THROW(PvdWriter(Path("d"), "a/b"), InvalidInputError);
   PvdWriter writer(Path("d"), "a");
   const Mesh mesh = TwoTets();
   writer.AddFrame(1.0, mesh, mesh.vertices);
-  try {
-    writer.AddFrame(1.0, mesh, mesh.vertices);
-    ADD_FAILURE() << "no exception";
-  } catch (const InvalidInputError& error) {
-    EXPECT_EQ(std::string(error.what()),
-              "PvdWriter::AddFrame: time = 1 s, must be finite and > the previous frame's time 1 s");
-  }
+  EXPECT_THROW_MESSAGE(writer.AddFrame(1.0, mesh, mesh.vertices), InvalidInputError,
+                       "PvdWriter::AddFrame: time = 1 s, must be finite and > the previous frame's time 1 s");
 }
 
 }  // namespace

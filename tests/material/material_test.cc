@@ -14,6 +14,9 @@
 #include <vector>
 
 #include "diffpd/error.h"
+#include "util/expect_message.h"
+#include "util/central_difference.h"
+#include "util/deformation.h"
 
 namespace diffpd {
 namespace {
@@ -46,15 +49,10 @@ std::vector<Mat3> RandomDeformations(std::mt19937& rng, int count) {
 }
 
 std::string ValidationMessage(const MaterialParameters& parameters) {
-  try {
-    parameters.Validate();
-  } catch (const InvalidInputError& error) {
-    return error.what();
-  }
-  return "no error";
+  return testing::MessageOf<InvalidInputError>([&] { parameters.Validate(); });
 }
 
-TEST(MaterialParametersTest, DefaultsAreValid) { EXPECT_EQ(ValidationMessage(MaterialParameters()), "no error"); }
+TEST(MaterialParametersTest, DefaultsAreValid) { EXPECT_NO_THROW(MaterialParameters().Validate()); }
 
 TEST(MaterialParametersTest, ValidationMessagesAreExact) {
   MaterialParameters p;
@@ -86,21 +84,26 @@ TEST(MaterialParametersTest, LameParametersAndDerivatives) {
   p.poissons_ratio = 0.45;
   EXPECT_NEAR(p.mu(), 1e6 / 2.9, 1e-9);
   EXPECT_NEAR(p.lambda(), 1e6 * 0.45 / (1.45 * 0.1), 1e-7);
+  // (mu, lambda) as functions of (E, nu); Jacobian rows mu, lambda.
+  const auto lame = [](const VectorXd& e_nu) {
+    const MaterialParameters q{e_nu(0), e_nu(1), 1e3};
+    return Eigen::Vector2d(q.mu(), q.lambda()).eval();
+  };
   for (double nu : {-0.9, -0.3, 0.0, 0.25, 0.45, 0.49}) {
     p.poissons_ratio = nu;
     double dmu_dE, dmu_dnu, dlambda_dE, dlambda_dnu;
     p.LameDerivatives(&dmu_dE, &dmu_dnu, &dlambda_dE, &dlambda_dnu);
-    const double hE = 1.0, hnu = 1e-7;
-    MaterialParameters plus = p, minus = p;
-    plus.youngs_modulus += hE;
-    minus.youngs_modulus -= hE;
-    EXPECT_NEAR(dmu_dE, (plus.mu() - minus.mu()) / (2 * hE), 1e-6 * std::abs(dmu_dE));
-    EXPECT_NEAR(dlambda_dE, (plus.lambda() - minus.lambda()) / (2 * hE), 1e-6 * std::abs(dlambda_dE) + 1e-12);
-    plus = minus = p;
-    plus.poissons_ratio += hnu;
-    minus.poissons_ratio -= hnu;
-    EXPECT_NEAR(dmu_dnu, (plus.mu() - minus.mu()) / (2 * hnu), 1e-6 * std::abs(dmu_dnu));
-    EXPECT_NEAR(dlambda_dnu, (plus.lambda() - minus.lambda()) / (2 * hnu), 1e-6 * std::abs(dlambda_dnu));
+    const VectorXd e_nu = Eigen::Vector2d(p.youngs_modulus, nu);
+    testing::DifferenceOptions along_e;
+    EXPECT_TRUE(testing::Passes(testing::CheckDirectionalDerivative(lame, e_nu, Eigen::Vector2d(1, 0),
+                                                                    Eigen::Vector2d(dmu_dE, dlambda_dE), along_e)))
+        << "nu = " << nu;
+    // nu's scale is its distance to the poles of lambda at -1 and 0.5.
+    testing::DifferenceOptions along_nu;
+    along_nu.input_scale = std::min(1 + nu, 0.5 - nu);
+    EXPECT_TRUE(testing::Passes(testing::CheckDirectionalDerivative(lame, e_nu, Eigen::Vector2d(0, 1),
+                                                                    Eigen::Vector2d(dmu_dnu, dlambda_dnu), along_nu)))
+        << "nu = " << nu;
   }
   double only_mu = 0.0;
   p.LameDerivatives(&only_mu, nullptr, nullptr, nullptr);  // unwanted outputs may be null
@@ -129,40 +132,32 @@ TEST(ElasticEnergyTest, ZeroEnergyAndStressAtRest) {
 
 TEST(ElasticEnergyTest, StressIsTheEnergyGradient) {
   std::mt19937 rng(41);
-  const double h = 1e-6;
   for (ElasticEnergy energy : kEnergies) {
+    const auto psi = [&](const VectorXd& f) { return EnergyDensity(energy, testing::Unflatten(f), kMu, kLambda); };
     for (const Mat3& F : RandomDeformations(rng, 40)) {
-      Mat3 numeric;
-      for (int n = 0; n < 9; ++n) {
-        Mat3 plus = F, minus = F;
-        plus(n) += h;
-        minus(n) -= h;
-        numeric(n) = (EnergyDensity(energy, plus, kMu, kLambda) - EnergyDensity(energy, minus, kMu, kLambda)) / (2 * h);
-      }
-      const Mat3 stress = FirstPiolaStress(energy, F, kMu, kLambda);
-      EXPECT_LE((stress - numeric).norm(), 1e-6 * std::max(1.0, numeric.norm())) << ToString(energy) << " at F =\n"
-                                                                                 << F;
+      const Vec9 stress = testing::Flatten(FirstPiolaStress(energy, F, kMu, kLambda));
+      testing::DifferenceOptions options;
+      options.input_scale = testing::DeformationScale(F);
+      EXPECT_TRUE(testing::Passes(testing::CheckGradient(psi, testing::Flatten(F), stress, options)))
+          << ToString(energy) << " at F =\n"
+          << F;
     }
   }
 }
 
 TEST(ElasticEnergyTest, StressDifferentialIsTheStressJacobian) {
   std::mt19937 rng(42);
-  const double h = 1e-6;
   for (ElasticEnergy energy : kEnergies) {
+    const auto stress = [&](const VectorXd& f) -> VectorXd {
+      return testing::Flatten(FirstPiolaStress(energy, testing::Unflatten(f), kMu, kLambda));
+    };
     for (const Mat3& F : RandomDeformations(rng, 40)) {
-      Mat9 numeric;
-      for (int n = 0; n < 9; ++n) {
-        Mat3 plus = F, minus = F;
-        plus(n) += h;
-        minus(n) -= h;
-        const Mat3 column =
-            (FirstPiolaStress(energy, plus, kMu, kLambda) - FirstPiolaStress(energy, minus, kMu, kLambda)) / (2 * h);
-        numeric.col(n) = Eigen::Map<const Vec9>(column.data());
-      }
       const Mat9 analytic = StressDifferential(energy, F, kMu, kLambda);
-      EXPECT_LE((analytic - numeric).norm(), 1e-6 * std::max(1.0, numeric.norm())) << ToString(energy) << " at F =\n"
-                                                                                   << F;
+      testing::DifferenceOptions options;
+      options.input_scale = testing::DeformationScale(F);
+      EXPECT_TRUE(testing::Passes(testing::CheckJacobian(stress, testing::Flatten(F), analytic, options)))
+          << ToString(energy) << " at F =\n"
+          << F;
     }
   }
 }

@@ -15,6 +15,8 @@
 #include <vector>
 
 #include "material/svd3.h"
+#include "util/central_difference.h"
+#include "util/deformation.h"
 
 namespace diffpd::internal {
 namespace {
@@ -36,21 +38,12 @@ Mat3 RandomDeformation(std::mt19937& rng, double lo, double hi) {
 Mat3 Rotation(const Mat3& F) { return ProjectToRotation(ComputeSvd3(F)); }
 Mat3 Volume(const Mat3& F) { return ProjectToUnitDeterminant(ComputeSvd3(F)); }
 
-// Central differences of vec(proj(F)) w.r.t. vec(F), step h.
-Mat9 FiniteDifference(const Projector& proj, const Mat3& F, double h = 1e-6) {
-  Mat9 D;
-  for (int n = 0; n < 9; ++n) {
-    Mat3 plus = F, minus = F;
-    plus(n) += h;
-    minus(n) -= h;
-    const Mat3 column = (proj(plus) - proj(minus)) / (2.0 * h);
-    D.col(n) = Eigen::Map<const Vec9>(column.data());
-  }
-  return D;
-}
-
-void ExpectDifferentialMatches(const Mat9& analytic, const Mat9& numeric, const Mat3& F) {
-  EXPECT_LE((analytic - numeric).norm(), 1e-6 * std::max(1.0, numeric.norm()))
+// dvec(proj(F)) / dvec(F) = `analytic` by central differences.
+void ExpectDifferentialMatches(const Projector& proj, const Mat9& analytic, const Mat3& F) {
+  const auto flat = [&](const VectorXd& f) -> VectorXd { return testing::Flatten(proj(testing::Unflatten(f))); };
+  testing::DifferenceOptions options;
+  options.input_scale = testing::DeformationScale(F);
+  EXPECT_TRUE(testing::Passes(testing::CheckJacobian(flat, testing::Flatten(F), analytic, options)))
       << "F =\n"
       << F << "\nsigma = " << ComputeSvd3(F).sigma.transpose();
 }
@@ -95,11 +88,10 @@ TEST(RotationProjectionTest, DifferentialMatchesFiniteDifferences) {
     if (n % 4 == 2) {                                           // near-repeated singular values
       F = RandomRotation(rng) * Vec3(1.3, 1.3 + 1e-9, 0.7).asDiagonal() * RandomRotation(rng);
     }
-    ExpectDifferentialMatches(RotationProjectionDifferential(ComputeSvd3(F)), FiniteDifference(Rotation, F), F);
+    ExpectDifferentialMatches(Rotation, RotationProjectionDifferential(ComputeSvd3(F)), F);
   }
   // Identity and a repeated spectrum.
-  ExpectDifferentialMatches(RotationProjectionDifferential(ComputeSvd3(Mat3::Identity())),
-                            FiniteDifference(Rotation, Mat3::Identity()), Mat3::Identity());
+  ExpectDifferentialMatches(Rotation, RotationProjectionDifferential(ComputeSvd3(Mat3::Identity())), Mat3::Identity());
 }
 
 TEST(RotationProjectionTest, DenominatorIsClampedWhereRotationIsDiscontinuous) {
@@ -254,7 +246,7 @@ TEST(VolumeProjectionTest, DifferentialMatchesFiniteDifferences) {
       F = RandomRotation(rng) * Vec3(s + 1e-9, s, 0.8).asDiagonal() * RandomRotation(rng);
     }
     if (n % 4 == 3) F = Mat3::Identity() + 0.1 * RandomDeformation(rng, -1.0, 1.0);
-    ExpectDifferentialMatches(UnitDeterminantProjectionDifferential(ComputeSvd3(F)), FiniteDifference(Volume, F), F);
+    ExpectDifferentialMatches(Volume, UnitDeterminantProjectionDifferential(ComputeSvd3(F)), F);
   }
 }
 
@@ -263,17 +255,20 @@ TEST(VolumeProjectionTest, SingularValueJacobianMatchesFiniteDifferences) {
   // projection jumps.)
   const std::vector<Vec3> spectra = {{2, 1, 0.5}, {1.9, 1.9, 1.9}, {3, 2, -1},    {10, 9, 8},
                                      {1, 1, 1},   {1e3, 1, 1e-3},  {4, 0.3, -0.2}};
+  const auto project = [](const VectorXd& s) -> VectorXd { return ProjectSingularValuesToUnitDeterminant(s).d; };
   for (const Vec3& sigma : spectra) {
     const Mat3 J = UnitDeterminantProjectionJacobian(sigma, ProjectSingularValuesToUnitDeterminant(sigma));
     for (int j = 0; j < 3; ++j) {
-      const double h = 1e-5 * std::abs(sigma(j));
-      Vec3 plus = sigma, minus = sigma;
-      plus(j) += h;
-      minus(j) -= h;
-      const Vec3 column =
-          (ProjectSingularValuesToUnitDeterminant(plus).d - ProjectSingularValuesToUnitDeterminant(minus).d) /
-          (2.0 * h);
-      EXPECT_LE((J.col(j) - column).norm(), 1e-6 * std::max(1.0, column.norm()))
+      // Column by column: each singular value is its own input scale
+      // (sigma spans 1e-3 .. 1e3 here).
+      // The test's own floor 1e-6 (an absolute error of 1e-6 accepted for
+      // columns below 1, e.g. d d / d sigma_2 = 1e-3 at sigma_2 = 1e-3, whose
+      // noise floor would be 1e-4).
+      testing::DifferenceOptions options;
+      options.input_scale = std::abs(sigma(j));
+      options.floor = 1e-6;
+      const VectorXd column = J.col(j);
+      EXPECT_TRUE(testing::Passes(testing::CheckDirectionalDerivative(project, sigma, Vec3::Unit(j), column, options)))
           << sigma.transpose() << " column " << j;
     }
   }
@@ -291,15 +286,9 @@ TEST(SphereProjectionTest, ProjectionAndDifferential) {
     EXPECT_NEAR(p.norm(), radius, 1e-14);
     EXPECT_LE((ProjectToSphere(p, radius) - p).norm(), 1e-14);
     EXPECT_LE((p - f.normalized() * radius).norm(), 1e-14);
-    Mat3 numeric;
-    const double h = 1e-6;
-    for (int j = 0; j < 3; ++j) {
-      Vec3 plus = f, minus = f;
-      plus(j) += h;
-      minus(j) -= h;
-      numeric.col(j) = (ProjectToSphere(plus, radius) - ProjectToSphere(minus, radius)) / (2 * h);
-    }
-    EXPECT_LE((SphereProjectionDifferential(f, radius) - numeric).norm(), 1e-6 * numeric.norm());
+    const auto sphere = [&](const VectorXd& g) -> VectorXd { return ProjectToSphere(g, radius); };
+    EXPECT_TRUE(testing::Passes(testing::CheckJacobian(sphere, f, SphereProjectionDifferential(f, radius))))
+        << "f = " << f.transpose();
   }
   EXPECT_EQ(ProjectToSphere(Vec3::Zero(), radius), Vec3(radius, 0.0, 0.0));
   EXPECT_EQ(SphereProjectionDifferential(Vec3::Zero(), radius), Mat3::Zero());

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "diffpd/error.h"
+#include "util/expect_message.h"
 
 namespace diffpd {
 namespace {
@@ -52,16 +53,13 @@ TEST(MakeBoxHexMeshTest, DefaultOriginIsZero) {
 
 TEST(MakeBoxHexMeshTest, RejectsBadInput) {
   auto message = [](const Eigen::Vector3i& cells, const Vec3& size) {
-    try {
-      MakeBoxHexMesh(cells, size);
-    } catch (const InvalidInputError& error) {
-      return std::string(error.what());
-    }
-    return std::string("no exception");
+    return testing::MessageOf<InvalidInputError>([&] { MakeBoxHexMesh(cells, size); });
   };
   EXPECT_EQ(message(Eigen::Vector3i(1, 0, 1), Vec3::Ones()), "MakeBoxHexMesh: cells(1) = 0, must be >= 1");
   EXPECT_EQ(message(Eigen::Vector3i(1, 1, 1), Vec3(1.0, 1.0, -1.0)),
             "MakeBoxHexMesh: size(2) = -1 m, must be finite and > 0");
+  EXPECT_EQ(message(Eigen::Vector3i(2000, 2000, 2000), Vec3::Ones()),
+            "MakeBoxHexMesh: cells = (2000, 2000, 2000) is 8e+09 cells, more than the limit of 1e+08");
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 
 #include "diffpd/error.h"
 #include "diffpd/types.h"
+#include "util/expect_message.h"
 
 namespace diffpd {
 namespace {
@@ -39,12 +40,7 @@ Mesh UnitCube() {
 }
 
 void ExpectMessage(const Mesh& mesh, const std::string& what, const std::string& expected) {
-  try {
-    ValidateMesh(mesh, what);
-    ADD_FAILURE() << "no exception, expected: " << expected;
-  } catch (const InvalidInputError& error) {
-    EXPECT_EQ(std::string(error.what()), expected);
-  }
+  EXPECT_THROW_MESSAGE(ValidateMesh(mesh, what), InvalidInputError, expected);
 }
 
 TEST(ElementTypeTest, NodesAndNames) {
@@ -87,6 +83,14 @@ TEST(SignedElementVolumeTest, FrustumHexIsExact) {
 TEST(SignedElementVolumeTest, UsesGivenPositions) {
   const Mesh tet = UnitTet();
   EXPECT_DOUBLE_EQ(SignedElementVolume(tet, 2.0 * tet.vertices, 0), 8.0 / 6.0);
+}
+
+// An integer cast to ElementType is refused before anything uses the type
+// (NodesPerElement would abort).
+TEST(ValidateMeshTest, UndeclaredElementType) {
+  Mesh mesh = UnitCube();
+  mesh.type = static_cast<ElementType>(7);
+  ExpectMessage(mesh, "m", "m: type = 7 is invalid: must be ElementType::kTet4 (0) or kHex8 (1)");
 }
 
 TEST(ValidateMeshTest, NoElements) { ExpectMessage(Mesh{}, "mesh", "mesh: the mesh has no elements"); }
@@ -165,13 +169,9 @@ TEST(ValidateMeshTest, HexWithNegativeJacobianAtAGaussPoint) {
   mesh.vertices.col(7) = Vec3(0.05, 0.05, 0.05);
   const double volume = SignedElementVolume(mesh, mesh.vertices, 0);
   ASSERT_GT(volume, 0.0);
-  try {
-    ValidateMesh(mesh, "m");
-    ADD_FAILURE() << "no exception";
-  } catch (const InvalidInputError& error) {
-    EXPECT_EQ(std::string(error.what()),
-              "m: element 0 is inverted or degenerate (signed volume 0.2875 m^3; det J = -0.0965905 at Gauss point 7)");
-  }
+  EXPECT_THROW_MESSAGE(
+      ValidateMesh(mesh, "m"), InvalidInputError,
+      "m: element 0 is inverted or degenerate (signed volume 0.2875 m^3; det J = -0.0965905 at Gauss point 7)");
 }
 
 TEST(ValidateMeshTest, UnreferencedVertex) {
@@ -186,11 +186,7 @@ TEST(ValidateMeshTest, DefaultWhatIsMesh) {
   Mesh mesh = UnitTet();
   mesh.elements(0, 0) = 7;
   ExpectMessage(mesh, "mesh", "mesh: element 0 references vertex 7, but the mesh has 4 vertices");
-  try {
-    ValidateMesh(mesh);
-  } catch (const InvalidInputError& error) {
-    EXPECT_EQ(std::string(error.what()).rfind("mesh: ", 0), 0u);
-  }
+  EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { ValidateMesh(mesh); }).rfind("mesh: ", 0), 0u);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "diffpd/error.h"
+#include "util/expect_message.h"
 
 namespace diffpd {
 namespace {
@@ -23,12 +24,7 @@ SurfaceMesh UnitCube() {
 }
 
 std::string WatertightError(const SurfaceMesh& surface) {
-  try {
-    ValidateWatertight(surface, "cube");
-  } catch (const InvalidInputError& error) {
-    return error.what();
-  }
-  return "no exception";
+  return testing::MessageOf<InvalidInputError>([&] { ValidateWatertight(surface, "cube"); });
 }
 
 TEST(SurfaceMeshTest, CubeVolumeAndWindingNumber) {

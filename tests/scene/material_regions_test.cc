@@ -7,17 +7,13 @@
 #include "diffpd/error.h"
 #include "scene/material_regions.h"
 #include "test_scenes.h"
+#include "util/expect_message.h"
 
 namespace diffpd {
 namespace {
 
 std::string ValidationMessage(const Scene& scene) {
-  try {
-    scene.Validate();
-  } catch (const InvalidInputError& e) {
-    return e.what();
-  }
-  return "";
+  return testing::MessageOf<InvalidInputError>([&] { scene.Validate(); });
 }
 
 Scene WithRegions(std::vector<MaterialRegion> regions) {
@@ -27,9 +23,9 @@ Scene WithRegions(std::vector<MaterialRegion> regions) {
 }
 
 TEST(MaterialRegionsTest, ValidScenesPass) {
-  EXPECT_EQ(ValidationMessage(testing::TwoRegionBeamScene()), "");
-  EXPECT_EQ(ValidationMessage(testing::TwoRegionBeamScene(/*tets=*/true)), "");
-  EXPECT_EQ(ValidationMessage(WithRegions({{{15, 0, 7}, MaterialParameters()}})), "");
+  EXPECT_NO_THROW(testing::TwoRegionBeamScene().Validate());
+  EXPECT_NO_THROW(testing::TwoRegionBeamScene(/*tets=*/true).Validate());
+  EXPECT_NO_THROW(WithRegions({{{15, 0, 7}, MaterialParameters()}}).Validate());
 }
 
 TEST(MaterialRegionsTest, EveryInvalidRegionIsNamedPrecisely) {

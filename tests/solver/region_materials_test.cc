@@ -13,6 +13,8 @@
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
 #include "test_scenes.h"
+#include "util/expect_message.h"
+#include "util/central_difference.h"
 
 namespace diffpd {
 namespace {
@@ -210,32 +212,45 @@ TEST_P(RegionDerivativeTest, BackwardAndTangentsMatchCentralFiniteDifferences) {
   for (const Parameter& p : params) dirs.push_back(DirectionOf(p, 2));
   TangentRollout t;
   if (!c.damping) t = sim.Tangents(rollout, dirs);
-  const double eps = 1e-4;
+  // The step rule for rollouts solved to rel_tolerance along directions
+  // scaled to their parameters (input scale 1): eps = cbrt(1e-12) = 1e-4.
+  const double eps = testing::CentralDifferenceStep(options.rel_tolerance, 1.0);
   for (size_t j = 0; j < params.size(); ++j) {
     const Parameter& p = params[j];
     const std::string what = std::string(p.name) + " of region " + std::to_string(p.region);
     Simulator plus_sim(Moved(scene, p, eps), options), minus_sim(Moved(scene, p, -eps), options);
     const Rollout plus = plus_sim.Simulate(start, std::vector<StepInput>(steps));
     const Rollout minus = minus_sim.Simulate(start, std::vector<StepInput>(steps));
-    const double fd = (loss_of(plus) - loss_of(minus)) / (2 * eps);
     const double adjoint = GradientAlong(g, p);
     // The differences carry the forward solves' stopping points: measured
     // ~5e-11 here (two equally valid preconditioners move fd by that much),
-    // hence the absolute 2e-10; the smallest gradient (the tip's nu) is
-    // 4e-6, so a wrong one still errs far beyond it.
-    EXPECT_NEAR(adjoint, fd, 1e-5 * std::abs(fd) + 2e-10) << what;
+    // hence the test's own floor 2e-10; the smallest gradient (the tip's nu)
+    // is 4e-6, so a wrong one still errs far beyond it.
+    testing::DifferenceOptions loss_check;
+    loss_check.noise = options.rel_tolerance;
+    loss_check.rtol = 1e-5;
+    loss_check.floor = 2e-10;
+    EXPECT_TRUE(
+        testing::Passes(testing::CompareCentralDifference(loss_of(plus), loss_of(minus), eps, adjoint, loss_check)))
+        << what;
     EXPECT_NE(adjoint, 0.0) << what;
     if (c.damping) continue;
-    double scale_x = 0;
-    for (int k = 1; k <= steps; ++k) scale_x = std::max(scale_x, t.dx[k].col(j).norm());
-    ASSERT_GT(scale_x, 0.0) << what;
+    // The differences carry the forward solves' own error (~1e-14 m at
+    // these tolerances) over 2 eps: ~1e-10 m, 1e-6 of the smallest
+    // tangents (the tip's nu, ~1e-4 m); a wrong tangent errs by O(1). So
+    // relative to the direction's largest state tangent, no floor.
+    testing::DifferenceOptions x_check;
+    x_check.noise = options.rel_tolerance;
+    x_check.rtol = 3e-6;
+    x_check.floor = 0;
+    for (int k = 1; k <= steps; ++k)
+      x_check.derivative_scale = std::max(x_check.derivative_scale, t.dx[k].col(j).norm());
+    ASSERT_GT(x_check.derivative_scale, 0.0) << what;
     double forward = 0;
     for (int k = 1; k <= steps; ++k) {
-      const VectorXd fd_x = (plus.states[k].x - minus.states[k].x) / (2 * eps);
-      // The differences carry the forward solves' own error (~1e-14 m at
-      // these tolerances) over 2 eps: ~1e-10 m, 1e-6 of the smallest
-      // tangents (the tip's nu, ~1e-4 m); a wrong tangent errs by O(1).
-      EXPECT_LT((t.dx[k].col(j) - fd_x).norm(), 3e-6 * scale_x) << what << " x_" << k;
+      EXPECT_TRUE(testing::Passes(
+          testing::CompareCentralDifference(plus.states[k].x, minus.states[k].x, eps, t.dx[k].col(j), x_check)))
+          << what << " x_" << k;
       forward += loss.dx[k].dot(t.dx[k].col(j)) + loss.dv[k].dot(t.dv[k].col(j));
     }
     EXPECT_NEAR(forward, adjoint, 1e-8 * std::abs(adjoint)) << what;
@@ -290,13 +305,8 @@ TEST(RegionMaterialsTest, SetRegionMaterialValidatesAndRolloutsRecordTheRegions)
   SolverOptions options;
   options.method = Method::kNewtonCholesky;
   Simulator sim(scene, options);
-  auto message = [&](int region, const MaterialParameters& m) -> std::string {
-    try {
-      sim.SetRegionMaterial(region, m);
-    } catch (const InvalidInputError& e) {
-      return e.what();
-    }
-    return "";
+  auto message = [&](int region, const MaterialParameters& m) {
+    return testing::MessageOf<InvalidInputError>([&] { sim.SetRegionMaterial(region, m); });
   };
   EXPECT_EQ(message(2, MaterialParameters()), "SetRegionMaterial: region 2 is out of range [0, 2)");
   EXPECT_EQ(message(-1, MaterialParameters()), "SetRegionMaterial: region -1 is out of range [0, 2)");
@@ -310,7 +320,7 @@ TEST(RegionMaterialsTest, SetRegionMaterialValidatesAndRolloutsRecordTheRegions)
   EXPECT_EQ(r.region_materials[1].density, scene.material_regions[1].material.density);
   MaterialParameters other = scene.material_regions[1].material;
   other.poissons_ratio = 0.25;
-  EXPECT_EQ(message(1, other), "");
+  EXPECT_NO_THROW(sim.SetRegionMaterial(1, other));
   LossGradient loss(2);
   EXPECT_THROW(sim.Backward(r, loss), InvalidInputError);
   EXPECT_THROW(sim.Tangents(r, {InputDirection::YoungsModulus()}), InvalidInputError);
@@ -319,19 +329,11 @@ TEST(RegionMaterialsTest, SetRegionMaterialValidatesAndRolloutsRecordTheRegions)
   // Directions must have no or one entry per region.
   InputDirection wrong;
   wrong.region_materials.resize(3);
-  try {
-    sim.Tangents(r, {wrong});
-    ADD_FAILURE() << "no exception";
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(),
-                 "Tangents: direction 0 has region_materials for 3 regions, expected 0 or 2 (one per material region)");
-  }
-  try {
-    InputDirection::RegionDensity(2, 2);
-    ADD_FAILURE() << "no exception";
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(), "InputDirection: region 2 is out of range [0, 2)");
-  }
+  EXPECT_THROW_MESSAGE(
+      sim.Tangents(r, {wrong}), InvalidInputError,
+      "Tangents: direction 0 has region_materials for 3 regions, expected 0 or 2 (one per material region)");
+  EXPECT_THROW_MESSAGE(InputDirection::RegionDensity(2, 2), InvalidInputError,
+                       "InputDirection: region 2 is out of range [0, 2)");
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
 #include "test_scenes.h"
+#include "util/expect_message.h"
 
 namespace diffpd {
 namespace {
@@ -87,13 +88,8 @@ TEST(SolverAgreementTest, NonProjectiveMaterialsAgreeBetweenNewtonAndPdLbfgs) {
 TEST(SolverAgreementTest, PdRejectsNonProjectiveEnergiesWithAClearMessage) {
   const Scene scene = testing::SmallBeamScene(false, {ElasticEnergy::kNeoHookean});
   Simulator sim(scene, Tight(Method::kPd));
-  try {
-    sim.Step(sim.RestState(), StepInput());
-    FAIL() << "expected InvalidInputError";
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(),
-                 "method pd needs projective energies only (pd-corotated, pd-volume); use pd-lbfgs or newton");
-  }
+  ASSERT_THROW_MESSAGE(sim.Step(sim.RestState(), StepInput()), InvalidInputError,
+                       "method pd needs projective energies only (pd-corotated, pd-volume); use pd-lbfgs or newton");
 }
 
 TEST(SolverAgreementTest, NonConvergenceIsReportedNotReturned) {

@@ -10,6 +10,8 @@
 #include "diffpd/state_forces.h"
 #include "diffpd/simulator.h"
 #include "test_scenes.h"
+#include "util/expect_message.h"
+#include "util/central_difference.h"
 
 namespace diffpd {
 namespace {
@@ -89,26 +91,36 @@ TEST_P(TangentFiniteDifferenceTest, MatchesCentralFiniteDifferencesOfEveryState)
   const TangentRollout t = sim.Tangents(rollout, dirs);
   ASSERT_EQ(t.num_steps(), steps);
   ASSERT_EQ(t.num_directions(), static_cast<int>(dirs.size()));
-  const double eps = 1e-4;
   for (size_t p = 0; p < dirs.size(); ++p) {
+    // The step rule for states solved to rel_tolerance: eps = cbrt(1e-12)
+    // times the input scale, 1 for the directions scaled to their inputs,
+    // and for Poisson's ratio the distance 0.5 - nu to the pole of lambda
+    // over its share of the direction.
+    const double nu_scale = (0.5 - scene.material.poissons_ratio) / std::abs(dirs[p].poissons_ratio);
+    const double eps = testing::CentralDifferenceStep(options.rel_tolerance, std::min(1.0, nu_scale));
     const Rollout plus = Perturbed(scene, options, start, steps, dirs[p], eps);
     const Rollout minus = Perturbed(scene, options, start, steps, dirs[p], -eps);
     // Relative to the largest state tangent of the direction (early steps
-    // can be tiny, e.g. x_1 under a force with a small time step).
-    double scale_x = 0, scale_v = 0;
+    // can be tiny, e.g. x_1 under a force with a small time step), with no
+    // absolute floor: the solves converge far below their tolerance here.
+    testing::DifferenceOptions x_options, v_options;
+    x_options.noise = v_options.noise = options.rel_tolerance;
+    x_options.floor = v_options.floor = 0;
+    x_options.rtol = 1e-6;
+    // v = (x_{k} - x_{k-1}) / h amplifies the forward solves' residual by
+    // 1/h, so the velocity differences carry about 3x the noise of x.
+    v_options.rtol = 3e-6;
     for (int k = 1; k <= steps; ++k) {
-      scale_x = std::max(scale_x, t.dx[k].col(p).norm());
-      scale_v = std::max(scale_v, t.dv[k].col(p).norm());
+      x_options.derivative_scale = std::max(x_options.derivative_scale, t.dx[k].col(p).norm());
+      v_options.derivative_scale = std::max(v_options.derivative_scale, t.dv[k].col(p).norm());
     }
-    ASSERT_GT(scale_x, 0.0);
+    ASSERT_GT(x_options.derivative_scale, 0.0);
     for (int k = 1; k <= steps; ++k) {
-      const VectorXd fd_x = (plus.states[k].x - minus.states[k].x) / (2 * eps);
-      const VectorXd fd_v = (plus.states[k].v - minus.states[k].v) / (2 * eps);
-      EXPECT_LT((t.dx[k].col(p) - fd_x).norm(), 1e-6 * scale_x)
+      EXPECT_TRUE(testing::Passes(
+          testing::CompareCentralDifference(plus.states[k].x, minus.states[k].x, eps, t.dx[k].col(p), x_options)))
           << ToString(c.method) << " direction " << p << " x_" << k;
-      // v = (x_{k} - x_{k-1}) / h amplifies the forward solves' residual by
-      // 1/h, so the velocity differences carry about 3x the noise of x.
-      EXPECT_LT((t.dv[k].col(p) - fd_v).norm(), 3e-6 * scale_v)
+      EXPECT_TRUE(testing::Passes(
+          testing::CompareCentralDifference(plus.states[k].v, minus.states[k].v, eps, t.dv[k].col(p), v_options)))
           << ToString(c.method) << " direction " << p << " v_" << k;
     }
   }
@@ -218,12 +230,7 @@ TEST(TangentRolloutTest, RejectsBadDirectionsWithMessages) {
   Simulator sim(testing::SmallBeamScene(), TightOptions(Method::kPd));
   const Rollout rollout = sim.Simulate(sim.RestState(), std::vector<StepInput>(2));
   auto message = [&](const std::vector<InputDirection>& dirs) {
-    try {
-      sim.Tangents(rollout, dirs);
-    } catch (const InvalidInputError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no exception");
+    return testing::MessageOf<InvalidInputError>([&] { sim.Tangents(rollout, dirs); });
   };
   EXPECT_EQ(message({}), "Tangents: no direction given (need at least one)");
   InputDirection bad;
@@ -291,15 +298,22 @@ TEST(TangentRolloutTest, FrictionalContactTangentsMatchReverseModeAndFiniteDiffe
     for (int p = 0; p < 3; ++p) {
       const double forward = loss.dx[steps].dot(t.dx[steps].col(p)) + loss.dv[steps - 2].dot(t.dv[steps - 2].col(p));
       EXPECT_NEAR(forward, reverse[p], 1e-8 * std::abs(reverse[p])) << ToString(method) << " direction " << p;
+      // A step of 1e-6 (not the rule's 1e-4) keeps the perturbed rollouts on
+      // the same active sets.
       const double eps = 1e-6;
       const Rollout plus = Perturbed(scene, options, start, steps, dirs[p], eps);
       const Rollout minus = Perturbed(scene, options, start, steps, dirs[p], -eps);
       for (int k = 0; k < steps; ++k) ASSERT_EQ(plus.reports[k].contact_nodes, rollout.reports[k].contact_nodes);
-      const VectorXd fd = (plus.states[steps].x - minus.states[steps].x) / (2 * eps);
       // Central differences carry the forward solves' rounding / eps, about
       // 1e-15 m / 1e-6 = 1e-9 m per unit, which matters where the pinned
-      // contact nodes make the final state almost insensitive to v0.
-      EXPECT_LT((t.dx[steps].col(p) - fd).norm(), 1e-6 * fd.norm() + 5e-9) << ToString(method) << " direction " << p;
+      // contact nodes make the final state almost insensitive to v0: the
+      // test's own floor 5e-9.
+      testing::DifferenceOptions check;
+      check.noise = options.rel_tolerance;
+      check.floor = 5e-9;
+      EXPECT_TRUE(testing::Passes(testing::CompareCentralDifference(plus.states[steps].x, minus.states[steps].x, eps,
+                                                                    t.dx[steps].col(p), check)))
+          << ToString(method) << " direction " << p;
     }
   }
 }
@@ -331,22 +345,21 @@ TEST(TangentRolloutTest, ActivationTangentsMatchFiniteDifferences) {
         plus[k].activation += eps * d.activation[k];
         minus[k].activation -= eps * d.activation[k];
       }
-    const VectorXd fd =
-        (sim.Simulate(MovingStart(sim), plus).states.back().x - sim.Simulate(MovingStart(sim), minus).states.back().x) /
-        (2 * eps);
-    EXPECT_GT(fd.norm(), 0.0);
-    EXPECT_LT((t.dx.back().col(0) - fd).norm(), 1e-6 * fd.norm()) << ToString(method);
+    const VectorXd x_plus = sim.Simulate(MovingStart(sim), plus).states.back().x;
+    const VectorXd x_minus = sim.Simulate(MovingStart(sim), minus).states.back().x;
+    EXPECT_GT((x_plus - x_minus).norm(), 0.0);
+    testing::DifferenceOptions check;
+    check.noise = options.rel_tolerance;
+    check.floor = 0;  // the test's own: relative to the tangent only
+    EXPECT_TRUE(testing::Passes(testing::CompareCentralDifference(x_plus, x_minus, eps, t.dx.back().col(0), check)))
+        << ToString(method);
   }
   Simulator sim(scene, TightOptions(Method::kPd));
   const Rollout rollout = sim.Simulate(sim.RestState(), std::vector<StepInput>(2));
   InputDirection bad;
   bad.activation = {VectorXd::Ones(2), VectorXd()};
-  try {
-    sim.Tangents(rollout, {bad});
-    FAIL();
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(), "Tangents: direction 0 has an activation with 2 entries, expected 1 (one per muscle)");
-  }
+  ASSERT_THROW_MESSAGE(sim.Tangents(rollout, {bad}), InvalidInputError,
+                       "Tangents: direction 0 has an activation with 2 entries, expected 1 (one per muscle)");
 }
 
 TEST(TangentRolloutTest, StateForcesAreRejectedUntilSupported) {
@@ -354,14 +367,9 @@ TEST(TangentRolloutTest, StateForcesAreRejectedUntilSupported) {
   scene.linear_damping = 0.5;
   Simulator sim(scene, TightOptions(Method::kNewtonCholesky));
   const Rollout rollout = sim.Simulate(sim.RestState(), std::vector<StepInput>(2));
-  try {
-    sim.Tangents(rollout, {InputDirection::Density()});
-    FAIL();
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(),
-                 "Tangents: explicit state forces (linear damping, hydrodynamics, penalty friction) are not "
-                 "differentiated in forward mode yet; use Backward");
-  }
+  ASSERT_THROW_MESSAGE(sim.Tangents(rollout, {InputDirection::Density()}), InvalidInputError,
+                       "Tangents: explicit state forces (linear damping, hydrodynamics, penalty friction) are not "
+                       "differentiated in forward mode yet; use Backward");
 }
 
 }  // namespace

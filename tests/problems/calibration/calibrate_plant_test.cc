@@ -10,6 +10,8 @@
 #include "calibration/calibrate_plant.h"
 #include "cli/commands.h"
 #include "diffpd/error.h"
+#include "util/expect_message.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd::problems {
 namespace {
@@ -69,12 +71,7 @@ TEST(CalibratePlantTest, FitOfNoiseFreeMotionRecoversTheTrueMaterial) {
 
 // Runs the problem with `args` and expects InvalidInputError with `message`.
 void ExpectRefused(const PlantCalibration& problem, const CommandArgs& args, const std::string& message) {
-  try {
-    problem.Run(args);
-    ADD_FAILURE() << "no exception, expected: " << message;
-  } catch (const InvalidInputError& e) {
-    EXPECT_EQ(std::string(e.what()), message);
-  }
+  EXPECT_THROW_MESSAGE(problem.Run(args), InvalidInputError, message);
 }
 
 // The simulator-tuning and verbosity flags of `run` are refused, not silently ignored.
@@ -96,8 +93,8 @@ TEST(CalibratePlantTest, SimulatorTuningFlagsAreRefusedWithAMessage) {
 
 TEST(CalibratePlantTest, RunWritesTheJsonReportAndItsFiles) {
   const NearbyPlant plant;
-  const auto out = std::filesystem::temp_directory_path() / "diffpd_calibrate_plant_test";
-  std::filesystem::remove_all(out);
+  const testing::TemporaryDirectory temp("diffpd-calibrate-plant");
+  const std::filesystem::path out = temp.path();
   CommandArgs args;
   args.problem = plant.name();
   args.methods = {"newton-cholesky"};  // the default data: data/plant_motion.csv

@@ -5,12 +5,11 @@
 
 #include <gtest/gtest.h>
 
-#include <filesystem>
-
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
 #include "diffpd/simulator.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd::problems {
 namespace {
@@ -29,8 +28,7 @@ SolverOptions Options(const Bunny& bunny, Method method, double rel_tolerance) {
 
 TEST(IpoptBunnyTest, DerivativeCheckerReportsNoError) {
   const Bunny bunny;
-  Simulator sim(bunny.MakeScene(InstanceSize::kSmall), Options(bunny, Method::kNewtonCholesky, 1e-11));
-  auto nlp = bunny.MakeNlp(&sim, InstanceSize::kSmall);
+  auto nlp = bunny.MakeNlp(Options(bunny, Method::kNewtonCholesky, 1e-11), InstanceSize::kSmall);
   IpoptOptions o;
   o.string_options = {{"derivative_test", "first-order"}};
   o.int_options = {{"max_iter", 0}};
@@ -41,8 +39,7 @@ TEST(IpoptBunnyTest, DerivativeCheckerReportsNoError) {
 
 TEST(IpoptBunnyTest, SmallInstanceLandsOnTargetAfterClearingTheWall) {
   const Bunny bunny;
-  Simulator sim(bunny.MakeScene(InstanceSize::kSmall), Options(bunny, Method::kNewtonCholesky, 1e-6));
-  auto nlp = bunny.MakeNlp(&sim, InstanceSize::kSmall);
+  auto nlp = bunny.MakeNlp(Options(bunny, Method::kNewtonCholesky, 1e-6), InstanceSize::kSmall);
   const IpoptSummary s = SolveWithIpopt(nlp, bunny.DefaultIpoptOptions(InstanceSize::kSmall));
   ASSERT_TRUE(s.succeeded()) << s.BriefReport() << "\n" << s.log;
   EXPECT_LE(s.constraint_violation, 1e-6);
@@ -70,8 +67,8 @@ TEST(IpoptBunnyTest, UnreachableWallIsReportedInfeasibleByTheProgram) {
   args.compare_newton = false;
   args.threads = 1;
   args.json = true;
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "diffpd_ipopt_bunny_infeasible";
-  args.out_dir = dir.string();
+  const testing::TemporaryDirectory dir("diffpd-ipopt-bunny-infeasible");
+  args.out_dir = dir.path().string();
   ::testing::internal::CaptureStdout();
   ::testing::internal::CaptureStderr();
   const int code = bunny.Run(args);
@@ -87,7 +84,6 @@ TEST(IpoptBunnyTest, UnreachableWallIsReportedInfeasibleByTheProgram) {
                      "(Infeasible_Problem_Detected)"),
             std::string::npos)
       << err;
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

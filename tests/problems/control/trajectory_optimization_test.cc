@@ -15,7 +15,11 @@
 #include "cli/commands.h"
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
-#include "solvers/ipopt_test_problems.h"
+#include "diffpd/solvers/core/initial_state_block.h"
+#include "diffpd/solvers/core/trajectory_function.h"
+#include "test_scenes.h"
+#include "util/temporary_directory.h"
+#include "util/expect_message.h"
 
 namespace diffpd::problems {
 namespace {
@@ -58,18 +62,19 @@ class CubeThrow : public TrajectoryOptimizationProblem {
   }
   int steps(InstanceSize size) const override { return 5; }
   double time_step(InstanceSize size) const override { return 0.01; }
-  Ipopt::SmartPtr<solvers::RolloutNlp> MakeNlp(Simulator* sim, InstanceSize size) const override {
+  Ipopt::SmartPtr<solvers::RolloutNlp> MakeNlp(const SolverOptions& options, InstanceSize size) const override {
     using namespace solvers;
-    const int n = sim->scene().mesh.num_vertices();
+    Ipopt::SmartPtr<RolloutNlp> nlp =
+        new RolloutNlp(std::make_unique<RolloutFunction>(MakeScene(size), options, steps(size)));
+    const int n = nlp->function().scene().mesh.num_vertices();
     std::vector<int> all(n);
     for (int i = 0; i < n; ++i) all[i] = i;
-    Ipopt::SmartPtr<RolloutNlp> nlp = new RolloutNlp(sim, diffpd::testing::RestSetup(*sim, steps(size)));
-    auto v0 = std::make_unique<InitialStateVariables>(InitialStateVariables::kVelocity, all);
+    auto v0 = std::make_unique<InitialStateBlock>(InitialStateBlock::kVelocity, all);
     v0->SetBounds(-1.0, 1.0);
     v0->SetInitial(Vec3(0.0, 0.0, 0.2));
     nlp->AddVariables(std::move(v0));
-    const TrackedPoint com = CentreOfMass(sim->LumpedMass());
-    const Vec3 c0 = com.At(sim->RestState().x);
+    const TrackedPoint com = CentreOfMass(nlp->function().simulator().LumpedMass());
+    const Vec3 c0 = com.At(nlp->function().base().initial.x);
     nlp->AddObjective(
         std::make_unique<PointDistanceSquared>(com, kFinalState, c0 + Vec3(0.02, 0, 0), "travel", Vec3(1, 1, 0)), 1e4);
     nlp->AddConstraint(std::make_unique<PointCoordinate>(com, kFinalState, Vec3::UnitZ(), "rise"), c0.z() + rise_,
@@ -80,12 +85,6 @@ class CubeThrow : public TrajectoryOptimizationProblem {
  private:
   double rise_;
 };
-
-fs::path FreshDirectory(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("diffpd_ipopt_driver_" + name);
-  fs::remove_all(dir);
-  return dir;
-}
 
 std::string ReadFile(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -151,7 +150,8 @@ TEST(IpoptTrajectoryOptimizationTest, PdRunIsRepeatedWithNewtonAndTheTimeRatioIs
 }
 
 TEST(IpoptTrajectoryOptimizationTest, RunWritesFramesHistoriesPlotAndOneJsonObject) {
-  const fs::path dir = FreshDirectory("files");
+  const testing::TemporaryDirectory temp("diffpd-ipopt-driver-files");
+  const fs::path dir = temp.path();
   const CubeThrow problem(0.01);
   CommandArgs args;
   args.problem = problem.name();
@@ -200,11 +200,11 @@ TEST(IpoptTrajectoryOptimizationTest, RunWritesFramesHistoriesPlotAndOneJsonObje
   ASSERT_GT(png.size(), 8u) << "no PNG written (is gnuplot installed?)";
   EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
   EXPECT_EQ(nlohmann::json::parse(ReadFile(dir / "summary.json")), j);
-  fs::remove_all(dir);
 }
 
 TEST(IpoptTrajectoryOptimizationTest, UnreachableConstraintIsReportedInfeasibleWithExitCode4) {
-  const fs::path dir = FreshDirectory("infeasible");
+  const testing::TemporaryDirectory temp("diffpd-ipopt-driver-infeasible");
+  const fs::path dir = temp.path();
   const CubeThrow problem(0.5);  // a 1 m/s throw rises under 4 cm in 50 ms
   CommandArgs args;
   args.problem = problem.name();
@@ -224,21 +224,15 @@ TEST(IpoptTrajectoryOptimizationTest, UnreachableConstraintIsReportedInfeasibleW
                      "(Infeasible_Problem_Detected)"),
             std::string::npos)
       << err;
-  fs::remove_all(dir);
 }
 
 TEST(IpoptTrajectoryOptimizationTest, StepsAndTimeStepAreRefusedWithAMessage) {
   const CubeThrow problem(0.01);
   CommandArgs args;
   args.steps = 10;
-  try {
-    problem.Run(args);
-    FAIL() << "no throw";
-  } catch (const InvalidInputError& e) {
-    EXPECT_EQ(std::string(e.what()),
-              "--steps and --dt are fixed by the optimisation problem 'cube-throw'; use --small for the reduced "
-              "instance");
-  }
+  ASSERT_THROW_MESSAGE(problem.Run(args), InvalidInputError,
+                       "--steps and --dt are fixed by the optimisation problem 'cube-throw'; use --small for the "
+                       "reduced instance");
 }
 
 TEST(IpoptTrajectoryOptimizationTest, IpoptOptionsAreParsedByTheirValue) {
@@ -253,12 +247,8 @@ TEST(IpoptTrajectoryOptimizationTest, IpoptOptionsAreParsedByTheirValue) {
   ASSERT_EQ(o.string_options.size(), 1u);
   EXPECT_EQ(o.string_options[0], std::make_pair(std::string("mu_strategy"), std::string("adaptive")));
   for (const char* bad : {"max_iter", "=3", "tol="}) {
-    try {
-      AddIpoptOption(bad, &o);
-      FAIL() << bad;
-    } catch (const InvalidInputError& e) {
-      EXPECT_EQ(std::string(e.what()), std::string("Ipopt option '") + bad + "' is invalid: expected name=value");
-    }
+    ASSERT_THROW_MESSAGE(AddIpoptOption(bad, &o), InvalidInputError,
+                         std::string("Ipopt option '") + bad + "' is invalid: expected name=value");
   }
   EXPECT_EQ(DefaultOutputDirectory("bunny"), (fs::path("out") / "bunny").string());
 }

@@ -6,8 +6,10 @@
 
 #include <algorithm>
 
+#include "problem_registry.h"
 #include "tools/bench.h"
 #include "diffpd/error.h"
+#include "util/expect_message.h"
 
 namespace diffpd::problems {
 namespace {
@@ -38,44 +40,38 @@ TEST(MakeRefinedProblemTest, DoublingsScaleTheCellCountCyclingAxes) {
   EXPECT_EQ(MakeRefinedProblem("falling-cube", 3)->MakeScene().mesh.num_elements(), 16 * 16 * 16);
 }
 
-TEST(MakeRefinedProblemTest, RejectsTooCoarseAndUnknownProblems) {
-  try {
-    MakeRefinedProblem("cantilever", -10);
-    FAIL() << "expected InvalidInputError";
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(), "refinement = -10 is invalid for cantilever: it must be >= -9 (4 x 1 x 1 cells)");
+TEST(MakeRefinedProblemTest, RejectsRefinementsOutOfRangeAndUnknownProblems) {
+  std::string problems;
+  for (const auto& p : AllProblems()) problems += (problems.empty() ? "" : ", ") + p->name();
+  struct Case {
+    std::string name;
+    int doublings;
+    std::string message;
+  };
+  const Case cases[] = {
+      {"cantilever", -10,
+       "refinement = -10 is invalid for cantilever: it must be in [-9, 12] (12: 4096 times the cells)"},
+      {"cantilever", 100,
+       "refinement = 100 is invalid for cantilever: it must be in [-9, 12] (12: 4096 times the cells)"},
+      {"falling-cube", 13,
+       "refinement = 13 is invalid for falling-cube: it must be in [-9, 12] (12: 4096 times the cells)"},
+      {"no-such-problem", 3, "unknown problem 'no-such-problem': valid problems are " + problems},
+      {"no-such-problem", 0, "unknown problem 'no-such-problem': valid problems are " + problems},
+      {"bouncing-ball", -6,
+       "problem 'bouncing-ball' cannot be refined: refinement is available for cantilever and falling-cube"},
+  };
+  for (const Case& c : cases) {
+    EXPECT_THROW_MESSAGE(MakeRefinedProblem(c.name, c.doublings), InvalidInputError, c.message);
   }
-  try {
-    MakeRefinedProblem("no-such-problem", 3);
-    FAIL() << "expected InvalidInputError";
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(),
-                 "problem 'no-such-problem' cannot be refined: refinement is available for cantilever and "
-                 "falling-cube");
-  }
-  // Unrefined, any registered problem; an unknown one lists the valid names.
+  // Unrefined, any registered problem.
   EXPECT_EQ(MakeRefinedProblem("falling-cube", 0)->name(), "falling-cube");
-  try {
-    MakeRefinedProblem("no-such-problem", 0);
-    FAIL() << "expected InvalidInputError";
-  } catch (const InvalidInputError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("unknown problem 'no-such-problem': valid problems are ", 0), 0u);
-  }
+  EXPECT_EQ(MakeRefinedProblem("bouncing-ball", 0)->name(), "bouncing-ball");
 }
 
 TEST(BenchOptionsTest, ValidateNamesTheFieldValueAndRange) {
   BenchOptions o;
   o.rel_tolerance = 0;
-  EXPECT_THROW(
-      {
-        try {
-          o.Validate();
-        } catch (const InvalidInputError& e) {
-          EXPECT_STREQ(e.what(), "rtol = 0 is invalid: must be in (0, 1)");
-          throw;
-        }
-      },
-      InvalidInputError);
+  EXPECT_THROW_MESSAGE(o.Validate(), InvalidInputError, "rtol = 0 is invalid: must be in (0, 1)");
   o = BenchOptions();
   o.repeat = 0;
   EXPECT_THROW(o.Validate(), InvalidInputError);
@@ -84,12 +80,12 @@ TEST(BenchOptionsTest, ValidateNamesTheFieldValueAndRange) {
   EXPECT_THROW(o.Validate(), InvalidInputError);
   o = BenchOptions();
   o.lbfgs_weight_scale = 0;
-  try {
-    o.Validate();
-    ADD_FAILURE() << "expected InvalidInputError";
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(), "lbfgs scale = 0 is invalid: must be in (0, 1]");
-  }
+  EXPECT_THROW_MESSAGE(o.Validate(), InvalidInputError, "lbfgs scale = 0 is invalid: must be in (0, 1]");
+  o = BenchOptions();
+  o.threads = 99999;
+  EXPECT_THROW_MESSAGE(o.Validate(), InvalidInputError,
+                       "threads = 99999 is invalid: must be in [0, " + std::to_string(MaxSolverThreads()) +
+                           "] (0: OpenMP default; SolverOptions::num_threads)");
 }
 
 TEST(RelativeErrorTest, IsTheRelativeTwoNorm) {

@@ -11,6 +11,8 @@
 
 #include "diffpd/error.h"
 #include "tools/tradeoff.h"
+#include "util/expect_message.h"
+#include "util/temporary_directory.h"
 
 namespace diffpd::problems {
 namespace {
@@ -113,12 +115,7 @@ TEST(TradeoffTest, JsonRowsHaveTheDocumentedFields) {
 TEST(TradeoffOptionsTest, ValidateNamesTheFieldValueAndRange) {
   TradeoffOptions o;
   o.tolerances = {1e-3, 2};
-  try {
-    o.Validate();
-    FAIL() << "expected InvalidInputError";
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(), "tolerance = 2 is invalid: must be in (0, 1)");
-  }
+  ASSERT_THROW_MESSAGE(o.Validate(), InvalidInputError, "tolerance = 2 is invalid: must be in (0, 1)");
   o = TradeoffOptions();
   o.time_step_levels = 0;
   EXPECT_THROW(o.Validate(), InvalidInputError);
@@ -142,29 +139,26 @@ std::vector<TradeoffRow> SyntheticRows() {
 
 TEST(TradeoffPlotTest, WritesAPngWithGnuplot) {
   if (!GnuplotAvailable()) GTEST_SKIP() << "gnuplot is not installed";
-  const auto path = std::filesystem::temp_directory_path() / "diffpd_tradeoff_test.png";
-  std::filesystem::remove(path);
-  WriteTradeoffPlot(SyntheticRows(), path.string(), "test");
+  const testing::TemporaryDirectory dir("diffpd-tradeoff-plot");
+  const std::string path = dir.File("tradeoff.png");
+  WriteTradeoffPlot(SyntheticRows(), path, "test");
   std::ifstream in(path, std::ios::binary);
   char magic[8] = {};
   in.read(magic, 8);
   EXPECT_EQ(std::string(magic + 1, 3), "PNG");
   EXPECT_GT(std::filesystem::file_size(path), 1000u);
-  std::filesystem::remove(path);
 }
 
 TEST(TradeoffPlotTest, MissingGnuplotIsAClearError) {
   const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
   setenv("PATH", "/nonexistent-diffpd-test-dir", 1);
   EXPECT_FALSE(GnuplotAvailable());
-  try {
-    WriteTradeoffPlot(SyntheticRows(), "/tmp/unused.png", "test");
-    ADD_FAILURE() << "expected std::runtime_error";
-  } catch (const std::runtime_error& e) {
-    EXPECT_STREQ(e.what(),
-                 "--plot needs the gnuplot program, which is not on PATH (Debian: apt-get install gnuplot-nox), or "
-                 "leave out --plot");
-  }
+  const testing::TemporaryDirectory dir("diffpd-tradeoff-plot");
+  EXPECT_THROW_MESSAGE(
+      WriteTradeoffPlot(SyntheticRows(), dir.File("unused.png"), "test"), std::runtime_error,
+      "--plot needs the gnuplot program, which is not on PATH (Debian: apt-get install gnuplot-nox), or "
+      "leave out --plot");
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
   setenv("PATH", path.c_str(), 1);
 }
 

@@ -1,0 +1,1 @@
+diffpd_add_test(energy_terms_conformance_test ${CMAKE_CURRENT_LIST_DIR}/energy_terms_conformance_test.cc)

@@ -1,0 +1,169 @@
+#include "util/central_difference.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <stdexcept>
+
+namespace diffpd::testing {
+namespace {
+
+double InfNorm(const VectorXd& v) { return v.size() == 0 ? 0.0 : v.cwiseAbs().maxCoeff(); }
+
+double InputScale(const DifferenceOptions& options, const VectorXd& x) {
+  if (options.input_scale > 0) return options.input_scale;
+  const double s = InfNorm(x);
+  return s > 0 ? s : 1.0;
+}
+
+double StepAlong(const DifferenceOptions& options, const VectorXd& x, const VectorXd& d) {
+  if (options.step > 0) return options.step;
+  return CentralDifferenceStep(options.noise, InputScale(options, x), InfNorm(d));
+}
+
+// The verdict from the compared quantities. `measured_values`: the largest
+// |f| seen (the default value scale); `columns`: how many differences the
+// noise enters (1 along a direction, n for a Jacobian).
+DifferenceCheck Verdict(double error, double analytic, double numeric, double h, double measured_values, int columns,
+                        double truncation, const DifferenceOptions& options) {
+  DifferenceCheck c;
+  c.step = h;
+  c.error = error;
+  c.analytic = analytic;
+  c.numeric = numeric;
+  c.rtol = options.rtol;
+  c.scale = options.derivative_scale > 0 ? options.derivative_scale : analytic;
+  const double value_scale = options.value_scale > 0 ? options.value_scale : measured_values;
+  c.noise_floor = options.noise * value_scale / h * std::sqrt(static_cast<double>(columns));
+  c.floor_given = options.floor >= 0;
+  c.floor = c.floor_given ? options.floor : c.noise_floor;
+  c.tolerance = std::max(options.rtol * c.scale, c.floor);
+  c.truncation = truncation;
+  return c;
+}
+
+std::string Format(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.3g", v);
+  return buffer;
+}
+
+}  // namespace
+
+double DifferenceCheck::margin() const {
+  if (error == 0) return std::numeric_limits<double>::infinity();
+  return tolerance / error;
+}
+
+bool DifferenceCheck::marginal() const {
+  return passed() && error > 0 && (margin() < 2 || (!floor_given && noise_floor > rtol * scale));
+}
+
+std::string DifferenceCheck::Describe() const {
+  std::string s = "central difference ";
+  if (!passed()) {
+    s += "FAILS";
+  } else if (marginal()) {
+    s += "passes marginally";
+  } else {
+    s += "passes";
+  }
+  s += " (margin " + Format(margin()) + "): |fd - an| = " + Format(error) + " vs tolerance " + Format(tolerance) +
+       " = max(rtol " + Format(rtol) + " x scale " + Format(scale) + ", floor " + Format(floor) + ")";
+  s += "; |an| = " + Format(analytic) + ", |fd| = " + Format(numeric) + ", h = " + Format(step) + ", noise floor " +
+       Format(noise_floor);
+  s += std::isnan(truncation) ? std::string(", truncation not measured") : ", truncation ~" + Format(truncation);
+  if (floor > rtol * scale) {
+    s += floor_given ? "; the given floor sets the tolerance (" + Format(floor / scale) + " relative)"
+                     : "; the noise floor sets the tolerance: the differences resolve the derivative only to " +
+                           Format(floor / scale) + " relative";
+  }
+  if (!std::isnan(truncation) && truncation > tolerance) {
+    s += "; the truncation estimate exceeds the tolerance: f is not smooth within 2h, or h is too large";
+  }
+  return s;
+}
+
+double CentralDifferenceStep(double noise, double input_scale, double direction_inf_norm) {
+  if (!(noise > 0) || !(input_scale > 0) || !(direction_inf_norm > 0)) {
+    throw std::invalid_argument("CentralDifferenceStep: noise = " + Format(noise) + ", input_scale = " +
+                                Format(input_scale) + ", |d|_inf = " + Format(direction_inf_norm) + " must all be > 0");
+  }
+  return std::cbrt(noise) * input_scale / direction_inf_norm;
+}
+
+DifferenceCheck CheckDirectionalDerivative(const std::function<VectorXd(const VectorXd&)>& f, const VectorXd& x,
+                                           const VectorXd& d, const VectorXd& analytic,
+                                           const DifferenceOptions& options) {
+  const double h = StepAlong(options, x, d);
+  const VectorXd plus = f(x + h * d), minus = f(x - h * d);
+  const VectorXd fd = (plus - minus) / (2 * h);
+  double truncation = std::numeric_limits<double>::quiet_NaN();
+  if (options.estimate_truncation) {
+    const VectorXd fd2 = (f(x + 2 * h * d) - f(x - 2 * h * d)) / (4 * h);
+    truncation = (fd2 - fd).norm() / 3;
+  }
+  return Verdict((fd - analytic).norm(), analytic.norm(), fd.norm(), h, std::max(plus.norm(), minus.norm()), 1,
+                 truncation, options);
+}
+
+DifferenceCheck CheckDirectionalDerivative(const std::function<double(const VectorXd&)>& f, const VectorXd& x,
+                                           const VectorXd& d, double analytic, const DifferenceOptions& options) {
+  return CheckDirectionalDerivative([&](const VectorXd& y) { return VectorXd::Constant(1, f(y)); }, x, d,
+                                    VectorXd::Constant(1, analytic), options);
+}
+
+DifferenceCheck CheckJacobian(const std::function<VectorXd(const VectorXd&)>& f, const VectorXd& x,
+                              const MatrixXd& analytic, const DifferenceOptions& options) {
+  const int n = static_cast<int>(x.size());
+  if (analytic.cols() != n) throw std::invalid_argument("CheckJacobian: the Jacobian's columns must match x");
+  const double h = options.step > 0 ? options.step : CentralDifferenceStep(options.noise, InputScale(options, x));
+  MatrixXd fd(analytic.rows(), n), fd2(analytic.rows(), n);
+  double values = 0;
+  for (int j = 0; j < n; ++j) {
+    VectorXd plus = x, minus = x;
+    plus(j) += h;
+    minus(j) -= h;
+    const VectorXd fp = f(plus), fm = f(minus);
+    values = std::max({values, fp.norm(), fm.norm()});
+    fd.col(j) = (fp - fm) / (2 * h);
+    if (options.estimate_truncation) {
+      plus(j) += h;
+      minus(j) -= h;
+      fd2.col(j) = (f(plus) - f(minus)) / (4 * h);
+    }
+  }
+  const double truncation =
+      options.estimate_truncation ? (fd2 - fd).norm() / 3 : std::numeric_limits<double>::quiet_NaN();
+  return Verdict((fd - analytic).norm(), analytic.norm(), fd.norm(), h, values, n, truncation, options);
+}
+
+DifferenceCheck CheckGradient(const std::function<double(const VectorXd&)>& f, const VectorXd& x,
+                              const VectorXd& analytic, const DifferenceOptions& options) {
+  return CheckJacobian([&](const VectorXd& y) { return VectorXd::Constant(1, f(y)); }, x, analytic.transpose(),
+                       options);
+}
+
+DifferenceCheck CompareCentralDifference(const VectorXd& f_plus, const VectorXd& f_minus, double h,
+                                         const VectorXd& analytic, const DifferenceOptions& options) {
+  const VectorXd fd = (f_plus - f_minus) / (2 * h);
+  return Verdict((fd - analytic).norm(), analytic.norm(), fd.norm(), h, std::max(f_plus.norm(), f_minus.norm()), 1,
+                 std::numeric_limits<double>::quiet_NaN(), options);
+}
+
+DifferenceCheck CompareCentralDifference(double f_plus, double f_minus, double h, double analytic,
+                                         const DifferenceOptions& options) {
+  return CompareCentralDifference(VectorXd::Constant(1, f_plus), VectorXd::Constant(1, f_minus), h,
+                                  VectorXd::Constant(1, analytic), options);
+}
+
+::testing::AssertionResult Passes(const DifferenceCheck& check) {
+  if (std::getenv("DIFFPD_PRINT_DIFFERENCE_CHECKS")) std::cout << "[ CHECK ] " << check.Describe() << std::endl;
+  if (!check.passed()) return ::testing::AssertionFailure() << check.Describe();
+  if (check.marginal()) std::cout << "[ MARGINAL ] " << check.Describe() << std::endl;
+  return ::testing::AssertionSuccess() << check.Describe();
+}
+
+}  // namespace diffpd::testing

@@ -1,0 +1,4 @@
+diffpd_add_test(temporary_directory_test ${CMAKE_CURRENT_LIST_DIR}/temporary_directory_test.cc)
+diffpd_add_test(expect_message_test ${CMAKE_CURRENT_LIST_DIR}/expect_message_test.cc)
+diffpd_add_test(central_difference_test ${CMAKE_CURRENT_LIST_DIR}/central_difference_test.cc)
+diffpd_add_test(energy_conformance_test ${CMAKE_CURRENT_LIST_DIR}/energy_conformance_test.cc)
