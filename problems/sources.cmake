@@ -31,6 +31,7 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/paper/quadruped_row.cc
   ${CMAKE_CURRENT_LIST_DIR}/paper/cow_row.cc
   ${CMAKE_CURRENT_LIST_DIR}/paper/row_evaluation.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/row_rollout_function.cc
   # tools
   ${CMAKE_CURRENT_LIST_DIR}/tools/gradcheck.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/bench.cc
@@ -62,7 +63,8 @@ set(DIFFPD_PROBLEMS_CONTROL_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/control/trajectory_optimization.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/bunny.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/routing_tendon_opt.cc
-  ${CMAKE_CURRENT_LIST_DIR}/control/locomotion.cc)
+  ${CMAKE_CURRENT_LIST_DIR}/control/locomotion.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/row_optimisation.cc)
 get_filename_component(DIFFPD_DEFAULT_SHARED_DATA_DIR "${CMAKE_CURRENT_LIST_DIR}/../../shared/data" ABSOLUTE)
 set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/shared_data.cc PROPERTIES
   COMPILE_DEFINITIONS "DIFFPD_SHARED_DATA_DIR=\"${DIFFPD_DEFAULT_SHARED_DATA_DIR}\"")

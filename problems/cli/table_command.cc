@@ -68,6 +68,9 @@ std::string CommandLine(const TableArgs& a) {
     << a.options.threads << " --evaluations " << a.options.evaluations << " --newton-evaluations "
     << a.options.newton_evaluations << " --draws " << a.options.random_draws;
   if (a.small) s << " --small";
+  if (a.options.optimise) s << " --optimise";
+  if (a.options.optimiser_evaluations > 0) s << " --optimiser-evaluations " << a.options.optimiser_evaluations;
+  if (a.options.optimiser_minutes > 0) s << " --optimiser-minutes " << a.options.optimiser_minutes;
   if (a.options.budget_minutes > 0) s << " --budget-minutes " << a.options.budget_minutes;
   if (!a.json_file.empty()) s << " --json " << a.json_file;
   if (a.resume) s << " --resume";
@@ -138,6 +141,17 @@ Subcommand AddTableCommand(CLI::App* parent) {
       ->capture_default_str();
   cmd->add_option("--newton-evaluations", args->options.newton_evaluations, "evaluations per Newton method (mean)")
       ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_flag("--optimise", args->options.optimise,
+                "then optimise every optimised row with each PD method (Ipopt, limited-memory Hessian, the row's "
+                "bounds and evaluation budget); Newton methods stay timed at x_init");
+  cmd->add_option("--optimiser-evaluations", args->options.optimiser_evaluations,
+                  "loss evaluations per optimisation (0: the row's budget)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--optimiser-minutes", args->options.optimiser_minutes,
+                  "wall-clock minutes per optimisation; it stops at its next iteration (0: none)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--json", args->json_file, "JSON file of the result, rewritten after every draw and method");
   cmd->add_flag("--resume", args->resume, "read --json FILE back and skip the rows and methods it has finished");

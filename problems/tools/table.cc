@@ -15,6 +15,9 @@
 #include "diffpd/error.h"
 #include "paper/paper_rows.h"
 #include "paper/row_evaluation.h"
+#if DIFFPD_WITH_IPOPT
+#include "paper/row_optimisation.h"
+#endif
 
 #ifndef DIFFPD_SOURCE_DIR
 #define DIFFPD_SOURCE_DIR "."
@@ -117,6 +120,8 @@ void Summarise(const PaperRow& row, TableRowResult* r) {
   const bool pd_ok = pd && pd->failure.empty() && pd->evaluations > 0;
   if (row.baseline == LossBaseline::kZero)
     r->baseline = 0.0;
+  else if (pd_ok && pd->optimisation && std::isfinite(pd->optimisation->final_loss))
+    r->baseline = pd->optimisation->final_loss;  // DiffPD's final loss, as the paper
   else if (pd_ok)
     r->baseline = pd->loss;
   for (TableMethodResult& m : r->methods) {
@@ -124,6 +129,13 @@ void Summarise(const PaperRow& row, TableRowResult* r) {
     if (m.failure.empty() && m.evaluations > 0 && r->random_loss_mean && r->baseline &&
         *r->random_loss_mean != *r->baseline)
       m.normalised_loss = NormalisedLoss(m.loss, *r->random_loss_mean, *r->baseline);
+    if (m.optimisation) {
+      m.optimisation->normalised_loss.reset();
+      if (r->random_loss_mean && r->baseline && *r->random_loss_mean != *r->baseline &&
+          std::isfinite(m.optimisation->final_loss))
+        m.optimisation->normalised_loss =
+            NormalisedLoss(m.optimisation->final_loss, *r->random_loss_mean, *r->baseline);
+    }
   }
   if (pd_ok) {
     std::optional<double> best;
@@ -182,6 +194,10 @@ void TableOptions::Validate() const {
   if (random_draws < 0) ThrowInvalidOption("random draws", random_draws, ">= 0");
   if (evaluations < 1) ThrowInvalidOption("evaluations", evaluations, ">= 1");
   if (newton_evaluations < 1) ThrowInvalidOption("newton evaluations", newton_evaluations, ">= 1");
+  if (!std::isfinite(optimiser_minutes))
+    ThrowInvalidOption("optimiser minutes", optimiser_minutes, "finite (<= 0: none)");
+  if (optimise && !DIFFPD_WITH_IPOPT)
+    throw InvalidInputError("optimise: this build has no Ipopt adapter (configure with DIFFPD_WITH_IPOPT=ON)");
 }
 
 TableResult RunTable(const TableOptions& options, const TableResult* previous,
@@ -246,9 +262,11 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
       for (const TableMethodResult& m : before->methods)
         if (m.complete) out.methods.push_back(m);
     }
+    // Whether `m` optimises this row in this run (PD methods of optimised rows).
+    const auto optimises = [&](Method m) { return options.optimise && row.budget.optimised && !IsNewton(m); };
     const auto method_done = [&](Method m) {
       const TableMethodResult* r = out.method(ToString(m));
-      return r && r->complete;
+      return r && r->complete && (!optimises(m) || r->optimisation || !r->failure.empty());
     };
     bool all_done = static_cast<int>(out.random_losses.size()) == out.random_draws;
     for (Method m : options.methods) all_done = all_done && method_done(m);
@@ -322,11 +340,14 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
       if (method_done(method) || budget.spent()) continue;
       TableMethodResult m;
       m.method = ToString(method);
+      const TableMethodResult* measured = out.method(m.method);
+      const bool at_x_init_done = measured && measured->complete;
+      if (at_x_init_done) m = *measured;
       const int count = IsNewton(method) ? options.newton_evaluations : options.evaluations;
       try {
         Simulator sim(row.scene, row.Options(method, options.threads));
         double forward = 0, backward = 0;
-        for (int k = 0; k < count; ++k) {
+        for (int k = 0; k < count && !at_x_init_done; ++k) {
           if (budget.spent()) break;
           const RowEvaluation e = EvaluateRow(row, &sim, x, true);
           forward += e.forward_s;
@@ -349,6 +370,39 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
           Progress(progress, line.str());
         }
         m.complete = m.evaluations == count;
+#if DIFFPD_WITH_IPOPT
+        if (m.complete && optimises(method) && !m.optimisation && !budget.spent()) {
+          RowOptimisationOptions o;
+          o.max_evaluations = options.optimiser_evaluations;
+          o.budget_seconds = 60 * options.optimiser_minutes;
+          o.on_evaluation = [&](long k, double loss, double forward_s) {
+            std::ostringstream line;
+            line << "[table] " << name << " " << m.method << " optimiser evaluation " << k << ": loss " << loss
+                 << ", forward " << Seconds(forward_s);
+            Progress(progress, line.str());
+          };
+          const RowOptimisationResult r = OptimiseRow(row, row.Options(method, options.threads), o);
+          TableOptimisation t;
+          t.status = r.status;
+          t.stopped_by = r.stopped_by;
+          t.iterations = r.iterations;
+          t.evaluations = r.evaluations;
+          t.gradients = r.gradients;
+          t.failed_evaluations = r.failed_evaluations;
+          t.forward_s = r.forward_s;
+          t.backward_s = r.backward_s;
+          t.total_s = r.total_s;
+          t.initial_loss = r.initial_loss;
+          t.final_loss = r.final_loss;
+          t.loss_history = r.loss_history;
+          m.optimisation = t;
+          std::ostringstream line;
+          line << "[table] " << name << " " << m.method << " optimiser: " << r.status << " (stopped by " << r.stopped_by
+               << "), " << r.iterations << " iterations, " << r.evaluations << " evaluations, " << r.gradients
+               << " gradients, loss " << r.initial_loss << " -> " << r.final_loss << ", " << Seconds(r.total_s);
+          Progress(progress, line.str());
+        }
+#endif
       } catch (const SolverError& e) {
         m.failure = std::string(ToString(e.status())) + ": " + e.what();
         m.complete = true;
@@ -407,6 +461,46 @@ T Field(const json& j, const std::string& key, const std::string& where) {
   }
 }
 
+json OptimisationJson(const TableOptimisation& t) {
+  json history = json::array();
+  for (double l : t.loss_history) history.push_back(Number(l));
+  return {{"status", t.status},
+          {"stopped_by", t.stopped_by},
+          {"iterations", t.iterations},
+          {"evaluations", t.evaluations},
+          {"gradients", t.gradients},
+          {"failed_evaluations", t.failed_evaluations},
+          {"forward_s", t.forward_s},
+          {"backward_s", t.backward_s},
+          {"total_s", t.total_s},
+          {"initial_loss", Number(t.initial_loss)},
+          {"final_loss", Number(t.final_loss)},
+          {"normalised_loss", Optional(t.normalised_loss)},
+          {"loss_history", history}};
+}
+
+double NumberOrNan(const json& j, const std::string& key) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : std::nan("");
+}
+
+TableOptimisation OptimisationFromJson(const json& j, const std::string& where) {
+  TableOptimisation t;
+  t.status = Field<std::string>(j, "status", where);
+  t.stopped_by = Field<std::string>(j, "stopped_by", where);
+  t.iterations = Field<int>(j, "iterations", where);
+  t.evaluations = Field<long>(j, "evaluations", where);
+  t.gradients = Field<long>(j, "gradients", where);
+  t.failed_evaluations = Field<long>(j, "failed_evaluations", where);
+  t.forward_s = Field<double>(j, "forward_s", where);
+  t.backward_s = Field<double>(j, "backward_s", where);
+  t.total_s = Field<double>(j, "total_s", where);
+  t.initial_loss = NumberOrNan(j, "initial_loss");
+  t.final_loss = NumberOrNan(j, "final_loss");
+  for (const json& l : Field<json>(j, "loss_history", where))
+    t.loss_history.push_back(l.is_number() ? l.get<double>() : std::nan(""));
+  return t;
+}
+
 }  // namespace
 
 json TableToJson(const TableResult& result) {
@@ -428,7 +522,8 @@ json TableToJson(const TableResult& result) {
                          {"newton_fallback_steps", m.newton_fallback_steps},
                          {"backward_iterations_per_step", m.backward_iterations_per_step},
                          {"backward_fallbacks", m.backward_fallbacks},
-                         {"complete", m.complete}});
+                         {"complete", m.complete},
+                         {"optimisation", m.optimisation ? OptimisationJson(*m.optimisation) : json(nullptr)}});
     json random = json::array();
     for (double l : r.random_losses) random.push_back(Number(l));
     rows.push_back({{"row", r.row},
@@ -515,6 +610,8 @@ TableResult TableFromJson(const json& j) {
         m.backward_iterations_per_step = Field<double>(mj, "backward_iterations_per_step", mwhere);
       if (mj.contains("backward_fallbacks")) m.backward_fallbacks = Field<int>(mj, "backward_fallbacks", mwhere);
       m.complete = Field<bool>(mj, "complete", mwhere);
+      if (mj.contains("optimisation") && !mj["optimisation"].is_null())
+        m.optimisation = OptimisationFromJson(mj["optimisation"], mwhere + ".optimisation");
       r.methods.push_back(m);
     }
     result.rows.push_back(r);

@@ -52,11 +52,33 @@ struct TableOptions {
   int newton_evaluations = 1;  // per Newton method, >= 1
   // false: measure nothing; only rebuild the report of `previous` (RunTable).
   bool measure = true;
+  // After the evaluations at x_init, optimise every optimised row with each
+  // PD method (pd-lbfgs, pd) through row_optimisation.h (Ipopt, limited-memory
+  // Hessian, the row's bounds); the Newton methods are timed at x_init only.
+  // Needs the Ipopt adapter (InvalidInputError otherwise).
+  bool optimise = false;
+  // Loss evaluations per optimisation; <= 0: the row's budget (maxfun).
+  int optimiser_evaluations = 0;
+  // Wall-clock minutes per optimisation (it stops at its next iteration); <= 0: none.
+  double optimiser_minutes = 0;
 
   TableOptions();  // rows = every row
   // Throws InvalidInputError naming the field, its value and the valid range
   // (an unknown row lists the valid names; semi-implicit is refused).
   void Validate() const;
+};
+
+// One optimisation of a row with one method (row_optimisation.h).
+struct TableOptimisation {
+  std::string status;      // Ipopt's return status
+  std::string stopped_by;  // "optimiser", "evaluation budget" or "time budget"
+  int iterations = 0;
+  long evaluations = 0, gradients = 0, failed_evaluations = 0;
+  double forward_s = 0, backward_s = 0;  // means per rollout and per adjoint pass
+  double total_s = 0;
+  double initial_loss = 0, final_loss = 0;
+  std::optional<double> normalised_loss;  // of final_loss
+  std::vector<double> loss_history;       // per Ipopt iteration
 };
 
 struct TableMethodResult {
@@ -69,11 +91,12 @@ struct TableMethodResult {
   std::vector<double> forward_samples, backward_samples;
   double loss = 0;  // L at the last evaluation
   std::optional<double> normalised_loss;
-  double iterations_per_step = 0;           // forward solver iterations per step, last evaluation
-  int newton_fallback_steps = 0;            // pd-lbfgs steps finished by Newton, last evaluation
-  double backward_iterations_per_step = 0;  // adjoint solver iterations per step, last evaluation
-  int backward_fallbacks = 0;               // adjoint solves that fell back to a direct one, last evaluation
-  bool complete = false;                    // all its evaluations done (or it failed)
+  double iterations_per_step = 0;                 // forward solver iterations per step, last evaluation
+  int newton_fallback_steps = 0;                  // pd-lbfgs steps finished by Newton, last evaluation
+  double backward_iterations_per_step = 0;        // adjoint solver iterations per step, last evaluation
+  int backward_fallbacks = 0;                     // adjoint solves that fell back to a direct one, last evaluation
+  bool complete = false;                          // all its evaluations at x_init done (or it failed)
+  std::optional<TableOptimisation> optimisation;  // when the row was optimised with this method
 };
 
 struct TableRowResult {

@@ -65,8 +65,13 @@ std::vector<Cells> TableCells(const TableResult& result) {
       const bool ok = m && m->failure.empty() && m->evaluations > 0;
       c.forward = ok ? Seconds(m->forward_s) : m && !m->failure.empty() ? "failed" : "-";
       c.backward = ok ? Seconds(m->backward_s) : "-";
-      c.evals = ok ? std::to_string(m->evaluations) : "-";
-      c.loss = ok ? Sci(m->normalised_loss) : "-";
+      // An optimised method: the optimiser's evaluations and final loss;
+      // else the evaluations at x_init in parentheses and the loss there.
+      const bool optimised = ok && m->optimisation;
+      c.evals = optimised ? std::to_string(m->optimisation->evaluations)
+                : ok      ? "(" + std::to_string(m->evaluations) + ")"
+                          : "-";
+      c.loss = optimised ? Sci(m->optimisation->normalised_loss) : ok ? "(" + Sci(m->normalised_loss) + ")" : "-";
       c.paper_forward = p ? Fixed(p->forward_s) : "-";
       c.paper_backward = p ? Fixed(p->backward_s) : "-";
       c.paper_evals = p && p->evaluations ? std::to_string(*p->evaluations) : "-";
@@ -110,9 +115,22 @@ std::string Explanation(const TableResult& result) {
   std::ostringstream s;
   s << "Seconds are wall-clock means per evaluation of the loss and its gradient at x_init (" << result.evaluations
     << " evaluations per PD method, " << result.newton_evaluations
-    << " per Newton method); the paper's are means over its whole optimisation, on 8 threads. loss (norm) is (L - "
-       "l) / (L_random - l) at x_init, L_random the mean pd-lbfgs loss of the row's 16 random draws (the paper's "
-       "value is the optimiser's final loss). speed-up: best Newton (forward + backward) over pd-lbfgs.";
+    << " per Newton method); the paper's are means over its whole optimisation, on 8 threads. evals and loss "
+       "(norm): for a method that optimised the row (Ipopt, limited-memory Hessian, the row's bounds and "
+       "evaluation budget), its loss evaluations and final loss; in parentheses, a method timed at x_init only: "
+       "its evaluations there and the loss at x_init. loss (norm) is (L - l) / (L_random - l), L_random the mean "
+       "pd-lbfgs loss of the row's 16 random draws, l = 0 or pd-lbfgs's final loss as the paper's row says. "
+       "speed-up: best Newton (forward + backward at x_init) over pd-lbfgs (at x_init).";
+  return s.str();
+}
+
+// "<status>, stopped by <what>, 12 iterations, 15 evaluations, ..." of one optimisation.
+std::string OptimisationLine(const TableOptimisation& t) {
+  std::ostringstream s;
+  s << t.status << " (stopped by " << t.stopped_by << "), " << t.iterations << " iterations, " << t.evaluations
+    << " evaluations (" << t.failed_evaluations << " failed), " << t.gradients << " gradients, forward "
+    << Seconds(t.forward_s) << " s and backward " << Seconds(t.backward_s) << " s per evaluation, "
+    << Seconds(t.total_s) << " s in all, loss " << Sci(t.initial_loss) << " -> " << Sci(t.final_loss);
   return s.str();
 }
 
@@ -140,6 +158,11 @@ void PrintTable(const TableResult& result, std::FILE* out) {
     for (const TableMethodResult& m : r.methods)
       if (!m.failure.empty())
         std::fprintf(out, "# %s %s failed: %s\n", r.row.c_str(), m.method.c_str(), m.failure.c_str());
+  for (const TableRowResult& r : result.rows)
+    for (const TableMethodResult& m : r.methods)
+      if (m.optimisation)
+        std::fprintf(out, "# %s %s optimiser: %s\n", r.row.c_str(), m.method.c_str(),
+                     OptimisationLine(*m.optimisation).c_str());
   if (result.budget_exhausted) std::fprintf(out, "# the time budget ran out: rows marked '-' were not measured\n");
   std::fprintf(out, "# %s\n", Explanation(result).c_str());
   std::vector<std::string> shared;
@@ -168,6 +191,10 @@ std::string TableMarkdown(const TableResult& result, const std::string& command)
   for (const TableRowResult& r : result.rows)
     for (const TableMethodResult& m : r.methods)
       if (!m.failure.empty()) s << "\n- " << r.row << ", " << m.method << " failed: " << m.failure;
+  for (const TableRowResult& r : result.rows)
+    for (const TableMethodResult& m : r.methods)
+      if (m.optimisation)
+        s << "\n- " << r.row << ", " << m.method << " optimiser: " << OptimisationLine(*m.optimisation);
   if (result.budget_exhausted) s << "\n\nThe time budget ran out; cells marked '-' were not measured.";
   std::vector<std::string> shared;
   std::vector<std::pair<std::string, std::vector<std::string>>> own;
