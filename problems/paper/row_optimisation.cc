@@ -53,8 +53,8 @@ class BudgetedRowNlp : public solvers::RolloutNlp {
                              Ipopt::Number regularization_size, Ipopt::Number alpha_du, Ipopt::Number alpha_pr,
                              Ipopt::Index ls_trials, const Ipopt::IpoptData* ip_data,
                              Ipopt::IpoptCalculatedQuantities* ip_cq) override {
-    RolloutNlp::intermediate_callback(mode, iter, obj_value, inf_pr, inf_du, mu, d_norm, regularization_size,
-                                      alpha_du, alpha_pr, ls_trials, ip_data, ip_cq);
+    RolloutNlp::intermediate_callback(mode, iter, obj_value, inf_pr, inf_du, mu, d_norm, regularization_size, alpha_du,
+                                      alpha_pr, ls_trials, ip_data, ip_cq);
     if (statistics().rollouts >= max_evaluations_) {
       stopped_by_ = "evaluation budget";
       return false;
@@ -97,9 +97,8 @@ RowOptimisationResult OptimiseRow(const PaperRow& row, const SolverOptions& opti
   nlp->ReportNewRollout(row.initial());
 
   solvers::IpoptOptions ipopt;
-  ipopt.int_options = {{"print_level", 0},
-                       {"max_iter", row.budget.max_iterations},
-                       {"limited_memory_max_history", row.budget.history}};
+  ipopt.int_options = {
+      {"print_level", 0}, {"max_iter", row.budget.max_iterations}, {"limited_memory_max_history", row.budget.history}};
   ipopt.num_options = {{"tol", row.budget.gtol}};
   const auto start = Clock::now();
   const solvers::IpoptSummary summary = solvers::SolveWithIpopt(nlp, ipopt);

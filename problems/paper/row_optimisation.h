@@ -34,20 +34,20 @@ struct RowOptimisationOptions {
 };
 
 struct RowOptimisationResult {
-  std::string status;         // Ipopt's return status ("Solve_Succeeded", "User_Requested_Stop", ...)
-  std::string stopped_by;     // "optimiser", "evaluation budget" or "time budget"
-  int iterations = 0;         // Ipopt iterations
-  long evaluations = 0;       // rollouts (loss evaluations)
-  long gradients = 0;         // adjoint passes
+  std::string status;      // Ipopt's return status ("Solve_Succeeded", "User_Requested_Stop", ...)
+  std::string stopped_by;  // "optimiser", "evaluation budget" or "time budget"
+  int iterations = 0;      // Ipopt iterations
+  long evaluations = 0;    // rollouts (loss evaluations)
+  long gradients = 0;      // adjoint passes
   long failed_evaluations = 0;
-  double forward_s = 0;       // mean wall seconds per rollout
-  double backward_s = 0;      // mean wall seconds per adjoint pass (with the pull-back)
-  double total_s = 0;         // wall seconds of the whole optimisation
-  double initial_loss = 0;    // L at x_init (NaN if its rollout failed)
-  double final_loss = 0;      // L at the returned point (NaN if its rollout failed)
-  VectorXd x;                 // the returned point
+  double forward_s = 0;              // mean wall seconds per rollout
+  double backward_s = 0;             // mean wall seconds per adjoint pass (with the pull-back)
+  double total_s = 0;                // wall seconds of the whole optimisation
+  double initial_loss = 0;           // L at x_init (NaN if its rollout failed)
+  double final_loss = 0;             // L at the returned point (NaN if its rollout failed)
+  VectorXd x;                        // the returned point
   std::vector<double> loss_history;  // L per Ipopt iteration (0 = start)
-  std::string last_error;     // the latest failed evaluation's message, if any
+  std::string last_error;            // the latest failed evaluation's message, if any
 };
 
 // Throws InvalidInputError if the row still needs PaperRow::Prepare; never

@@ -44,9 +44,7 @@ class SharedFunctional : public solvers::TrajectoryFunctional {
   std::string name() const override { return f_->name(); }
   int num_values() const override { return 1; }
   int LastStateOf(int i, int num_steps) const override { return f_->LastState(num_steps); }
-  void Evaluate(const Rollout& rollout, Eigen::Ref<VectorXd> values) const override {
-    values(0) = f_->Value(rollout);
-  }
+  void Evaluate(const Rollout& rollout, Eigen::Ref<VectorXd> values) const override { values(0) = f_->Value(rollout); }
   void AddWeightedGradient(const Rollout& rollout, const Eigen::Ref<const VectorXd>& weights,
                            LossGradient* loss) const override {
     f_->AddGradient(rollout, weights(0), loss);
