@@ -41,6 +41,22 @@ TEST(SolverOptionsTest, InvalidFieldsAreRejectedWithTheFieldAndRange) {
   o.lbfgs_weight_scale = 1.5;
   EXPECT_EQ(MessageOf([&] { o.Validate(); }), "solver options: lbfgs_weight_scale = 1.5 is invalid: must be in (0, 1]");
   o = SolverOptions();
+  o.backward_rel_tolerance = -1e-6;
+  EXPECT_EQ(MessageOf([&] { o.Validate(); }),
+            "solver options: backward_rel_tolerance = -1e-06 is invalid: must be in [0, 1) (0: derived from the "
+            "forward's accuracy)");
+  o = SolverOptions();
+  o.backward_tolerance_factor = 0;
+  EXPECT_EQ(MessageOf([&] { o.Validate(); }),
+            "solver options: backward_tolerance_factor = 0 is invalid: must be in (0, 1]");
+  o = SolverOptions();
+  o.adjoint_guess_solutions = -1;
+  EXPECT_EQ(MessageOf([&] { o.Validate(); }), "solver options: adjoint_guess_solutions = -1 is invalid: must be >= 0");
+  o = SolverOptions();
+  o.adjoint_solver = static_cast<AdjointSolver>(7);
+  EXPECT_EQ(MessageOf([&] { o.Validate(); }),
+            "solver options: adjoint_solver = 7 is invalid: must be auto, iterative or direct (AdjointSolver)");
+  o = SolverOptions();
   o.abs_tolerance = 0;
   o.rel_tolerance = 0;
   EXPECT_EQ(MessageOf([&] { o.Validate(); }),
@@ -48,11 +64,17 @@ TEST(SolverOptionsTest, InvalidFieldsAreRejectedWithTheFieldAndRange) {
 }
 
 TEST(SolverOptionsTest, MethodNamesRoundTripAndUnknownNamesAreListed) {
-  for (const Method m :
-       {Method::kSemiImplicit, Method::kNewtonCholesky, Method::kNewtonPcg, Method::kPd, Method::kPdLbfgs})
+  for (const Method m : {Method::kSemiImplicit, Method::kNewtonCholesky, Method::kNewtonPcg, Method::kPd,
+                         Method::kPdLbfgs, Method::kNewtonLdlt})
     EXPECT_EQ(ParseMethod(ToString(m)), m);
+  EXPECT_EQ(ToString(Method::kNewtonLdlt), std::string("newton-ldlt"));
   EXPECT_EQ(MessageOf([] { ParseMethod("newton"); }),
-            "unknown method 'newton': valid methods are semi-implicit, newton-cholesky, newton-pcg, pd, pd-lbfgs");
+            "unknown method 'newton': valid methods are semi-implicit, newton-cholesky, newton-pcg, pd, pd-lbfgs, "
+            "newton-ldlt");
+  for (const AdjointSolver a : {AdjointSolver::kAuto, AdjointSolver::kIterative, AdjointSolver::kDirect})
+    EXPECT_EQ(ParseAdjointSolver(ToString(a)), a);
+  EXPECT_EQ(MessageOf([] { ParseAdjointSolver("cg"); }),
+            "unknown adjoint solver 'cg': valid adjoint solvers are auto, iterative, direct");
 }
 
 TEST(SolverOptionsTest, BadScenesAndInputsAreRejected) {

@@ -14,3 +14,7 @@ diffpd_add_test(parallel_triangular_solve_test ${CMAKE_CURRENT_LIST_DIR}/paralle
 diffpd_add_test(lbfgs_pairs_test ${CMAKE_CURRENT_LIST_DIR}/lbfgs_pairs_test.cc)
 diffpd_add_test(thread_count_test ${CMAKE_CURRENT_LIST_DIR}/thread_count_test.cc)
 diffpd_add_test(rigid_mode_correction_test ${CMAKE_CURRENT_LIST_DIR}/rigid_mode_correction_test.cc)
+diffpd_add_test(adjoint_solver_test ${CMAKE_CURRENT_LIST_DIR}/adjoint_solver_test.cc)
+diffpd_add_test(adjoint_cost_model_test ${CMAKE_CURRENT_LIST_DIR}/adjoint_cost_model_test.cc)
+diffpd_add_test(hessian_assembly_test ${CMAKE_CURRENT_LIST_DIR}/hessian_assembly_test.cc)
+diffpd_add_test(adjoint_tolerance_test ${CMAKE_CURRENT_LIST_DIR}/adjoint_tolerance_test.cc)

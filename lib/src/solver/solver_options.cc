@@ -7,8 +7,9 @@
 
 namespace diffpd {
 namespace {
-constexpr Method kMethods[] = {Method::kSemiImplicit, Method::kNewtonCholesky, Method::kNewtonPcg, Method::kPd,
-                               Method::kPdLbfgs};
+constexpr Method kMethods[] = {Method::kSemiImplicit, Method::kNewtonCholesky, Method::kNewtonPcg,
+                               Method::kPd,           Method::kPdLbfgs,        Method::kNewtonLdlt};
+constexpr AdjointSolver kAdjointSolvers[] = {AdjointSolver::kAuto, AdjointSolver::kIterative, AdjointSolver::kDirect};
 
 template <class T>
 [[noreturn]] void Reject(const char* field, T value, const char* range) {
@@ -30,8 +31,32 @@ const char* ToString(Method method) {
       return "pd";
     case Method::kPdLbfgs:
       return "pd-lbfgs";
+    case Method::kNewtonLdlt:
+      return "newton-ldlt";
   }
   return "unknown";
+}
+
+const char* ToString(AdjointSolver solver) {
+  switch (solver) {
+    case AdjointSolver::kAuto:
+      return "auto";
+    case AdjointSolver::kIterative:
+      return "iterative";
+    case AdjointSolver::kDirect:
+      return "direct";
+  }
+  return "unknown";
+}
+
+AdjointSolver ParseAdjointSolver(const std::string& name) {
+  std::string valid;
+  for (const AdjointSolver a : kAdjointSolvers) {
+    if (name == ToString(a)) return a;
+    valid += valid.empty() ? "" : ", ";
+    valid += ToString(a);
+  }
+  throw InvalidInputError("unknown adjoint solver '" + name + "': valid adjoint solvers are " + valid);
 }
 
 Method ParseMethod(const std::string& name) {
@@ -59,9 +84,16 @@ void SolverOptions::Validate() const {
   if (lbfgs_history < 1) Reject("lbfgs_history", lbfgs_history, ">= 1");
   if (!(lbfgs_weight_scale > 0 && lbfgs_weight_scale <= 1))
     Reject("lbfgs_weight_scale", lbfgs_weight_scale, "in (0, 1]");
-  if (!(backward_rel_tolerance > 0 && backward_rel_tolerance < 1))
-    Reject("backward_rel_tolerance", backward_rel_tolerance, "in (0, 1)");
+  if (!(backward_rel_tolerance >= 0 && backward_rel_tolerance < 1))
+    Reject("backward_rel_tolerance", backward_rel_tolerance, "in [0, 1) (0: derived from the forward's accuracy)");
+  if (!(backward_tolerance_factor > 0 && backward_tolerance_factor <= 1))
+    Reject("backward_tolerance_factor", backward_tolerance_factor, "in (0, 1]");
+  bool known_adjoint_solver = false;
+  for (const AdjointSolver a : kAdjointSolvers) known_adjoint_solver = known_adjoint_solver || a == adjoint_solver;
+  if (!known_adjoint_solver)
+    Reject("adjoint_solver", static_cast<int>(adjoint_solver), "auto, iterative or direct (AdjointSolver)");
   if (backward_max_iterations < 1) Reject("backward_max_iterations", backward_max_iterations, ">= 1");
+  if (adjoint_guess_solutions < 0) Reject("adjoint_guess_solutions", adjoint_guess_solutions, ">= 0");
   if (num_threads < 0) Reject("num_threads", num_threads, ">= 0 (0: OpenMP default)");
 }
 
