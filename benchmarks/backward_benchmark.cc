@@ -22,10 +22,18 @@
 // repetition run one after another (so that a change of machine load hits
 // all rows alike), for each thread count of --threads (default 1,2).
 //
+// --sweep: the adjoint's accuracy against its cost instead. Per scene and
+// forward rel_tolerance (1e-3 ... 1e-6), one pd-lbfgs rollout and its
+// gradient by the iterative adjoint at fixed tolerances (1e-2 ... 1e-10), by
+// the rule backward_rel_tolerance = 0 at several factors, and by the direct
+// adjoint (exact: the error the forward alone leaves); seconds, iterations
+// per step and the gradient's relative error against the reference.
+//
 // Usage: backward_benchmark [--scenes tendon,cantilever,rolling-sphere]
-//   [--threads 1,2] [--repeat 3] [--rtol 1e-4] [--steps K] [--newton]
-//   [--no-newton] [--json]
+//   [--threads 1,2] [--repeat 3] [--rtol 1e-4] [--steps K] [--no-newton]
+//   [--sweep] [--json]
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -223,6 +231,93 @@ std::vector<Row> MeasureWorkload(const Workload& w, const std::vector<int>& thre
   return rows;
 }
 
+// One backward variant of the sweep on one forward rollout.
+struct SweepRow {
+  std::string scene, adjoint;
+  double forward_rel_tolerance = 0;
+  double forward_s = 0, forward_iters_per_step = 0;
+  double backward_s = 0, backward_iters_per_step = 0;
+  double grad_rel_error = 0;
+  double part_max = 0;
+};
+
+std::vector<SweepRow> Sweep(const Workload& w, int threads) {
+  const int n = w.scene.mesh.num_dofs(), steps = static_cast<int>(w.inputs.size());
+  const LinearLoss loss = LinearLoss::Random(n, 20211);
+  SolverOptions ref;
+  ref.method = Method::kNewtonCholesky;
+  ref.time_step = w.time_step;
+  ref.rel_tolerance = problems::kReferenceRelTolerance;
+  ref.num_threads = threads;
+  std::cerr << "[sweep] " << w.name << ": reference" << std::endl;
+  const RolloutMeasurement reference = MeasureRollout(w.scene, ref, w.initial, w.inputs, loss, 1);
+  if (!reference.ok()) throw SolverError(reference.status, "the reference failed: " + reference.failure);
+  LossGradient dl(steps);
+  dl.dx[steps] = loss.cx;
+  dl.dv[steps] = loss.cv;
+  std::vector<SweepRow> rows;
+  for (const double forward_tol : {1e-3, 1e-4, 1e-5, 1e-6}) {
+    SolverOptions o;
+    o.method = Method::kPdLbfgs;
+    o.time_step = w.time_step;
+    o.rel_tolerance = forward_tol;
+    o.num_threads = threads;
+    Simulator sim(w.scene, o);
+    auto start = std::chrono::steady_clock::now();
+    const Rollout rollout = sim.Simulate(w.initial, w.inputs);
+    const double forward_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    long forward_iterations = 0;
+    for (const StepReport& r : rollout.reports) forward_iterations += r.iterations;
+    struct Variant {
+      std::string name;
+      AdjointSolver solver;
+      double tolerance, factor;
+    };
+    std::vector<Variant> variants;
+    for (const double t : {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-10}) {
+      std::ostringstream name;
+      name << "fixed " << t;
+      variants.push_back({name.str(), AdjointSolver::kIterative, t, 0.01});
+    }
+    for (const double f : {0.1, 0.03, 0.01, 0.001}) {
+      std::ostringstream name;
+      name << "rule x" << f;
+      variants.push_back({name.str(), AdjointSolver::kIterative, 0.0, f});
+    }
+    variants.push_back({"direct", AdjointSolver::kDirect, 0.0, 0.01});
+    for (const Variant& v : variants) {
+      SolverOptions b = o;
+      b.adjoint_solver = v.solver;
+      b.backward_rel_tolerance = v.tolerance;
+      b.backward_tolerance_factor = v.factor;
+      sim.SetOptions(b);
+      start = std::chrono::steady_clock::now();
+      const RolloutGradient g = sim.Backward(rollout, dl);
+      SweepRow row;
+      row.backward_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      row.scene = w.name;
+      row.adjoint = v.name;
+      row.forward_rel_tolerance = forward_tol;
+      row.forward_s = forward_s;
+      row.forward_iters_per_step = double(forward_iterations) / steps;
+      row.backward_iters_per_step = double(g.report.linear_iterations) / steps;
+      VectorXd stacked(reference.gradient.size());
+      stacked.head(2 * n + 3) << g.x0, g.v0, g.youngs_modulus, g.poissons_ratio, g.density;
+      Eigen::Index at = 2 * n + 3;
+      for (const VectorXd& a : g.activation) {
+        stacked.segment(at, a.size()) = a;
+        at += a.size();
+      }
+      row.grad_rel_error = RelativeError(stacked, reference.gradient);
+      for (const auto& p : PartErrors(stacked, reference.gradient, n)) row.part_max = std::max(row.part_max, p.second);
+      std::cerr << "[sweep] " << w.name << " rtol " << forward_tol << " " << v.name << ": " << row.grad_rel_error
+                << std::endl;
+      rows.push_back(row);
+    }
+  }
+  return rows;
+}
+
 const Row* Find(const std::vector<Row>& rows, const Row& like, const std::string& config) {
   for (const Row& r : rows)
     if (r.scene == like.scene && r.threads == like.threads && r.config == config && r.failure.empty()) return &r;
@@ -243,8 +338,7 @@ void Ratios(const std::vector<Row>& rows, const Row& row, double* vs_best_newton
 
 void PrintTable(const std::vector<Row>& rows) {
   std::printf("%-15s %3s %-26s %9s %9s %7s %8s %8s %9s %10s %10s %9s %9s\n", "scene", "thr", "config", "forward_s",
-              "backward_s", "bwd/fwd", "fwd_it", "bwd_it", "iter/dir", "grad_err", "part_max", "xNewton",
-              "xLDLT");
+              "backward_s", "bwd/fwd", "fwd_it", "bwd_it", "iter/dir", "grad_err", "part_max", "xNewton", "xLDLT");
   for (const Row& r : rows) {
     if (!r.failure.empty()) {
       std::printf("%-15s %3d %-26s failed: %s\n", r.scene.c_str(), r.threads, r.config.c_str(), r.failure.c_str());
@@ -266,14 +360,11 @@ void PrintTable(const std::vector<Row>& rows) {
 nlohmann::json ToJson(const std::vector<Row>& rows, double rtol, int repeat) {
   nlohmann::json out = nlohmann::json::array();
   for (const Row& r : rows) {
-    nlohmann::json j = {{"scene", r.scene},
-                        {"config", r.config},
-                        {"threads", r.threads},
-                        {"steps", r.steps},
-                        {"dofs", r.dofs},
-                        {"rel_tolerance", rtol},
-                        {"repeat", repeat},
-                        {"status", r.failure.empty() ? std::string("ok") : "failed: " + r.failure}};
+    nlohmann::json j = {
+        {"scene", r.scene},     {"config", r.config},
+        {"threads", r.threads}, {"steps", r.steps},
+        {"dofs", r.dofs},       {"rel_tolerance", rtol},
+        {"repeat", repeat},     {"status", r.failure.empty() ? std::string("ok") : "failed: " + r.failure}};
     if (r.failure.empty()) {
       double vs_newton = 0, vs_ldlt = 0;
       Ratios(rows, r, &vs_newton, &vs_ldlt);
@@ -305,12 +396,36 @@ std::vector<std::string> Split(const std::string& s) {
   return out;
 }
 
+void PrintSweep(const std::vector<SweepRow>& rows) {
+  std::printf("%-15s %9s %-12s %9s %8s %10s %8s %10s %10s\n", "scene", "fwd_rtol", "adjoint", "forward_s", "fwd_it",
+              "backward_s", "bwd_it", "grad_err", "part_max");
+  for (const SweepRow& r : rows)
+    std::printf("%-15s %9.0e %-12s %9.3f %8.1f %10.3f %8.1f %10.2e %10.2e\n", r.scene.c_str(), r.forward_rel_tolerance,
+                r.adjoint.c_str(), r.forward_s, r.forward_iters_per_step, r.backward_s, r.backward_iters_per_step,
+                r.grad_rel_error, r.part_max);
+}
+
+nlohmann::json SweepToJson(const std::vector<SweepRow>& rows) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const SweepRow& r : rows)
+    out.push_back({{"scene", r.scene},
+                   {"forward_rel_tolerance", r.forward_rel_tolerance},
+                   {"adjoint", r.adjoint},
+                   {"forward_s", r.forward_s},
+                   {"forward_iters_per_step", r.forward_iters_per_step},
+                   {"backward_s", r.backward_s},
+                   {"backward_iters_per_step", r.backward_iters_per_step},
+                   {"grad_rel_error", r.grad_rel_error},
+                   {"grad_rel_error_part_max", r.part_max}});
+  return out;
+}
+
 int Main(int argc, char** argv) {
   std::vector<std::string> scenes = {"tendon", "cantilever", "rolling-sphere"};
   std::vector<int> threads = {1, 2};
   int repeat = 3, steps = -1;
   double rtol = 1e-4;
-  bool json = false, newton = true;
+  bool json = false, newton = true, sweep = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const bool has_value = i + 1 < argc;
@@ -318,6 +433,8 @@ int Main(int argc, char** argv) {
       json = true;
     } else if (a == "--no-newton") {
       newton = false;
+    } else if (a == "--sweep") {
+      sweep = true;
     } else if (a == "--scenes" && has_value) {
       scenes = Split(argv[++i]);
     } else if (a == "--threads" && has_value) {
@@ -334,6 +451,25 @@ int Main(int argc, char** argv) {
       return 2;
     }
   }
+  if (sweep) {
+    std::vector<SweepRow> rows;
+    for (const std::string& name : scenes) {
+      const std::vector<SweepRow> scene_rows =
+          Sweep(name == "tendon" ? PaperTendon(steps) : Registered(name, steps), threads.front());
+      rows.insert(rows.end(), scene_rows.begin(), scene_rows.end());
+    }
+    if (json) {
+      std::printf("%s\n", SweepToJson(rows).dump(2).c_str());
+    } else {
+      std::printf(
+          "# pd-lbfgs gradient error against newton-cholesky at rel_tolerance 1e-10, per forward tolerance and "
+          "adjoint: the iterative adjoint at a fixed tolerance, by the rule (backward_rel_tolerance 0) with "
+          "the factor given, and the direct (exact) adjoint; %d thread(s)\n",
+          threads.front());
+      PrintSweep(rows);
+    }
+    return 0;
+  }
   std::vector<Row> rows;
   for (const std::string& name : scenes) {
     const Workload w = name == "tendon" ? PaperTendon(steps) : Registered(name, steps);
@@ -343,12 +479,13 @@ int Main(int argc, char** argv) {
   if (json) {
     std::printf("%s\n", ToJson(rows, rtol, repeat).dump(2).c_str());
   } else {
-    std::printf("# rel_tolerance %g, medians of %d runs; bwd/fwd = backward_s / forward_s; fwd_it, bwd_it: iterations "
-                "per step; iter/dir: backward steps solved iteratively / directly; grad_err: relative error of the "
-                "whole gradient, part_max: the largest over its parts (x0, v0, material, activation); xNewton, "
-                "xLDLT: (forward + backward) of the faster of newton-cholesky and newton-pcg, and of newton-ldlt, "
-                "over the row's\n",
-                rtol, repeat);
+    std::printf(
+        "# rel_tolerance %g, medians of %d runs; bwd/fwd = backward_s / forward_s; fwd_it, bwd_it: iterations "
+        "per step; iter/dir: backward steps solved iteratively / directly; grad_err: relative error of the "
+        "whole gradient, part_max: the largest over its parts (x0, v0, material, activation); xNewton, "
+        "xLDLT: (forward + backward) of the faster of newton-cholesky and newton-pcg, and of newton-ldlt, "
+        "over the row's\n",
+        rtol, repeat);
     PrintTable(rows);
   }
   return 0;
