@@ -29,7 +29,7 @@ SolverOptions TightPdLbfgs(bool fallback) {
 // first PD-LBFGS directions far too long in the stiff modes; with two
 // halvings allowed the line search stalls on the first iteration, far above
 // g's rounding floor. A stand-in for the stalls of stiff, nearly
-// incompressible material at large h (README stress report), which depend
+// incompressible material at large h (`diffpd stress`), which depend
 // on rounding paths.
 SolverOptions StallingOptions(bool fallback) {
   SolverOptions o = TightPdLbfgs(fallback);

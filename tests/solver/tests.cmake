@@ -18,3 +18,6 @@ diffpd_add_test(adjoint_solver_test ${CMAKE_CURRENT_LIST_DIR}/adjoint_solver_tes
 diffpd_add_test(adjoint_cost_model_test ${CMAKE_CURRENT_LIST_DIR}/adjoint_cost_model_test.cc)
 diffpd_add_test(hessian_assembly_test ${CMAKE_CURRENT_LIST_DIR}/hessian_assembly_test.cc)
 diffpd_add_test(adjoint_tolerance_test ${CMAKE_CURRENT_LIST_DIR}/adjoint_tolerance_test.cc)
+diffpd_add_test(rollout_test ${CMAKE_CURRENT_LIST_DIR}/rollout_test.cc)
+diffpd_add_test(rollout_checks_test ${CMAKE_CURRENT_LIST_DIR}/rollout_checks_test.cc)
+diffpd_add_test(simulator_test ${CMAKE_CURRENT_LIST_DIR}/simulator_test.cc)

@@ -74,9 +74,9 @@ struct SolverOptions {
   int max_iterations = 1000;  // per step (Newton or PD iterations)
   // After a step's solve from x0, compare g there with g(x_i), the previous
   // total energy (kinetic + elastic + the explicit forces' potential); if the
-  // result is above it (a far stationary point: a very stiff, nearly
-  // incompressible body at a large h was driven to one, README stress
-  // report), solve again from x_i, so that the step's potential energy never
+  // result is above it (a far stationary point, which a very stiff, nearly
+  // incompressible body at a large h can reach), solve again from x_i, so
+  // that the step's potential energy never
   // exceeds the previous total energy. Costs one evaluation of g per step;
   // other steps' results are unchanged. With frictional contact each
   // active-set pass is checked against x_i with that pass's pins (the bound
@@ -88,8 +88,8 @@ struct SolverOptions {
   int max_line_search_steps = 40;
   // A line search that finds no acceptable step while ||grad g|| is within
   // 100 times g's estimated rounding floor (eps times the magnitudes of the
-  // inertia, explicit-force and elastic-stress terms; README stress report)
-  // cannot do better in double precision: true ends the step there, as
+  // inertia, explicit-force and elastic-stress terms) cannot do better in
+  // double precision: true ends the step there, as
   // converged at the floor (StepReport::rounding_floor_stop); false throws
   // SolverError(kLineSearchFailed) as for any other stall. Only steps that
   // would otherwise fail are affected (very stiff material, tolerances below
@@ -103,8 +103,7 @@ struct SolverOptions {
   int pcg_max_iterations = 20000;
 
   // PD-LBFGS and the PD backward's L-BFGS (PdBackwardMethod::kLbfgs): number
-  // of stored pairs (20 measured
-  // best on the cantilever: 73 iterations per step vs 90 with 8 and 130 with 5).
+  // of stored curvature pairs; >= 1. Memory: 2 x lbfgs_history x 3n doubles.
   int lbfgs_history = 20;
   // PD-LBFGS (forward and backward): its initial Hessian is the PD matrix A
   // with the elastic weights w (2 mu + lambda for pd-corotated + pd-volume)
@@ -112,11 +111,9 @@ struct SolverOptions {
   // scaled. Any factor in (0, 1] gives the same converged result (A is only
   // the L-BFGS preconditioner); 1 is the DiffPD matrix. A has full stiffness
   // on rotations and volume change while the true Hessian has none on
-  // rotations, so a smaller factor preconditions bending far better: measured
-  // on the cantilever (README, "PD-LBFGS initial Hessian"), 0.3 cuts
-  // iterations per step by 30-55% over nu = 0.3..0.49; much smaller factors
-  // under-weight volume change and slow it down again (0.1: nearly as slow as 1;
-  // 0.05: no convergence in 1000 iterations at rtol 1e-12). The plain `pd`
+  // rotations, so a smaller factor preconditions bending better; much
+  // smaller factors under-weight volume change and converge slowly again.
+  // Must be in (0, 1]. The plain `pd`
   // method always uses 1 (its fixed point needs the true A). With a factor
   // < 1 the fixed-point backward (PdBackwardMethod::kFixedPoint) may not
   // converge and then falls back to a direct solve; the kLbfgs and default
@@ -128,10 +125,10 @@ struct SolverOptions {
   // on with Newton iterations (projected Hessian, CHOLMOD; at most
   // max_iterations more) from where it stopped, to the same test
   // (StepReport::newton_fallback). Stiff or nearly incompressible material
-  // at large h, where g can no longer resolve PD-LBFGS's progress, or where
-  // PD-LBFGS needs close to 1000 iterations per step (nu = 0.499, h = 0.1 s;
-  // README stress report); ordinary steps never get there. false: the stall
-  // or the iteration limit is an error.
+  // at large h, where g can no longer resolve PD-LBFGS's progress or
+  // PD-LBFGS needs close to max_iterations; ordinary steps never get there.
+  // false: the stall or the iteration limit is an error
+  // (SolverError(kLineSearchFailed) or SolverError(kMaxIterations)).
   bool pd_lbfgs_newton_fallback = true;
   // For a body without Dirichlet DoFs (free to move: on frictional or
   // penalty contact, swimming, falling), PD-LBFGS's initial inverse Hessian
@@ -141,13 +138,12 @@ struct SolverOptions {
   // Z the translations and rotations (zero at contact pins), H the step
   // Hessian at the solve's start. A charges a rigid rotation like a stretch
   // while H resists it with inertia alone, so free bodies converge slowly
-  // without it (rolling sphere: forward iterations per step 39.7 -> 20.1,
-  // backward 35.5 -> 18.9, and smaller errors at the same tolerance;
-  // README). Costs per solve the Hessians of the elements at contact pins
+  // without it. Costs per solve the Hessians of the elements at contact pins
   // (forward; grad E comes from the solve's first gradient) or 6 Hessian
-  // products (backward), and 12 vector passes per iteration. Clamped bodies never use it: their cut
-  // rigid modes are not soft (cantilever: 5% fewer iterations but 3-6x
-  // larger errors at the same tolerance, README). Dynamic steps only.
+  // products (backward), and 12 vector passes per iteration. Bodies with
+  // Dirichlet DoFs never use it (their cut rigid modes are not soft).
+  // Dynamic steps only. Only the preconditioner changes, not the test a
+  // step must meet.
   bool rigid_mode_correction = true;
 
   // PD methods' backward and tangent solves: iterative, direct or chosen
@@ -173,15 +169,35 @@ struct SolverOptions {
   // at the cost of as many Hessian products per step; >= 0, 0: from zero.
   int adjoint_guess_solutions = 8;
 
+  // A step fails with SolverError(kDiverged) when the body's extent (the
+  // diagonal of its nodes' bounding box) exceeds max_extent_ratio times its
+  // rest extent. Rigid motion keeps the extent (a rotation changes it by at
+  // most sqrt(3)), and solids do not stretch a thousandfold, while an
+  // unstable step tears the nodes apart geometrically (semi-implicit Euler
+  // at h = 1e3 s: 1e17 m within three steps; at h = 0.01 s on a stiff beam,
+  // kilometres within 0.06 s), so the error comes early instead of as a
+  // NaN, or never. Velocities need no bound of their own, v_{i+1} = (x_{i+1}
+  // - x_i) / h. > 1; infinity: only a non-finite state is an error.
+  double max_extent_ratio = 1e3;
+
   // Threads for the element loops and PD's triangular solves (0: OpenMP's
-  // default). Never changes the process-wide OpenMP setting. Results do not
-  // depend on it beyond rounding (the solves' sums run in another order).
+  // default), at most MaxSolverThreads(). Never changes the process-wide
+  // OpenMP setting. Results do not depend on it beyond rounding (the solves'
+  // sums run in another order).
   int num_threads = 0;
   // 0: silent; 1: one line per step on stderr; 2: one line per iteration.
   int verbosity = 0;
 
-  // Throws InvalidInputError naming the field, its value and the valid range.
+  // Throws InvalidInputError naming the field, its value and the valid range
+  // ("solver options: time_step = -1 is invalid: must be finite and > 0
+  // (s)"), also for an enum field holding no declared value (an integer cast
+  // to the enum).
   void Validate() const;
 };
+
+// The most threads SolverOptions::num_threads may ask for: 4 x the
+// processors OpenMP reports (omp_get_num_procs()). More never speeds up a
+// step, and tens of thousands make the OpenMP runtime fail.
+int MaxSolverThreads();
 
 }  // namespace diffpd

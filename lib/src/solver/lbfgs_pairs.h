@@ -10,7 +10,7 @@
 // of pair j -/+ 1 in one pass over slices of the vectors, on 2 threads:
 // 0.13-0.19 ms on 2 threads but 0.21-0.26 ms on one (Eigen's whole-vector
 // passes ran faster than interleaved slices); pairs stored as floats (slower
-// at this size, README).
+// at this size; docs/benchmarks.md).
 #pragma once
 
 #include <vector>

@@ -17,7 +17,8 @@
 // and CG preconditioner. E = Z^T H Z's non-positive eigenvalues (H indefinite
 // along a mode) are dropped from the pseudo-inverse. Used for bodies without
 // Dirichlet DoFs only (SimulatorImpl::UseRigidModeCorrection): a clamped
-// body's cut modes are not soft, and there it cost accuracy (README).
+// body's cut modes are not soft, and there it cost accuracy
+// (docs/benchmarks.md).
 #pragma once
 
 #include <vector>

@@ -105,7 +105,10 @@ bool StepLinearization::DirectSolve(const MatrixXd& b, MatrixXd* z) {
   }
   for (int d = 0; d < z->rows(); ++d)
     if (sim_.fixed[d]) z->row(d).setZero();
-  return z->allFinite();
+  // A finite b whose solution overflows: the derivative exceeds double
+  // precision, not a singular H.
+  if (!z->allFinite()) throw SolverError(SolverStatus::kNonFinite, "the solution of H z = b overflowed");
+  return true;
 }
 
 void StepLinearization::IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, std::vector<char>* ok, int* iterations) {
@@ -184,6 +187,9 @@ MatrixXd StepLinearization::SolveSystem(const MatrixXd& b, AdjointCostModel* mod
   analysis_seconds_ = 0;
   const Method m = sim_.options.method;
   const char* pass = tangent ? "tangent" : "backward";
+  if (!b.allFinite())
+    throw SolverError(SolverStatus::kNonFinite,
+                      tangent ? "the right-hand sides B are not finite" : "the right-hand side b is not finite");
   const int cols = static_cast<int>(b.cols());
   MatrixXd z = MatrixXd::Zero(b.rows(), cols);
   std::vector<char> ok(cols, 0);
