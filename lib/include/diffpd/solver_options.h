@@ -41,8 +41,8 @@ enum class PdBackwardMethod {
 enum class AdjointSolver {
   // Per step, whichever of the two below is cheaper on this problem, by
   // their measured times: each is timed on a step as it runs, the cheaper
-  // one serves the following steps, and the other is timed again now and
-  // then (after 8, 16, ... up to 64 steps) in case the costs crossed. The
+  // one serves the following steps, and the other is timed again after
+  // max(8, (r - 1) / 0.05) of them (r: the ratio of the times; <= 5% extra). The
   // measurements persist across Backward/Tangents calls of one simulator
   // (SetOptions resets them). Which steps used which is reported
   // (BackwardReport); the gradients agree with either to the adjoint's
