@@ -16,21 +16,29 @@ constexpr const char* kBenchFooter = R"(
 Measures one rollout (the problem's steps, or --steps) and its backward pass
 per method. The loss is L = c_x . x_K + c_v . v_K with fixed N(0,1) vectors
 (--seed); the gradient compared is the concatenation
-[dL/dx0, dL/dv0, dL/dE, dL/dnu, dL/drho]. The reference is newton-cholesky
-with rel_tolerance 1e-10 (adjoint 1e-12). state_rel_error ([x; v] stacked),
+[dL/dx0, dL/dv0, dL/dE, dL/dnu, dL/drho] (and every step's activations for a
+scene with muscles). The reference is newton-cholesky with rel_tolerance
+1e-10 and a direct adjoint. state_rel_error ([x; v] stacked),
 position_rel_error (x), velocity_rel_error (v) and grad_rel_error
 are relative 2-norms against it. forward_s / backward_s: wall-clock seconds of
 Simulate / Backward on a fresh simulator (forward includes PD's factorisation,
-factorization_s: the one-off cost per mesh, h and weights), median of --repeat runs. The adjoint tolerance is --rtol unless
---backward-rtol is given. speedup_vs_newton_cholesky = (forward+backward of
-newton-cholesky in this run) / (this method's).
+factorization_s: the one-off cost per mesh, h and weights), median of --repeat runs. The adjoint tolerance is the
+library's default (derived per step from the accuracy the forward reached)
+unless --backward-rtol is given; the PD methods' adjoint solver is
+--adjoint-solver (auto: per step by measured cost). iter/dir: backward steps
+solved iteratively / by a factorisation of the step Hessian.
+speedup_vs_newton_cholesky = (forward+backward of newton-cholesky in this
+run) / (this method's); speedup_vs_best_newton the same against the faster
+of newton-cholesky and newton-pcg, speedup_vs_newton_ldlt against
+newton-ldlt (the DiffPD paper's Newton: simplicial LDL^T under AMD).
 JSON: a list of objects {method, status, forward_s, backward_s,
 iters_per_step, state_rel_error, position_rel_error, velocity_rel_error,
 grad_rel_error, grad_rel_error_by_input, forward_per_iteration_ms,
-factorization_s, speedup_vs_newton_cholesky, backward_iters_per_step,
-backward_fallbacks, rounding_floor_steps (forward steps ended at the rounding
-floor), newton_fallback_steps (PD-LBFGS steps finished by Newton), problem,
-dofs, ...}.
+factorization_s, speedup_vs_newton_cholesky, speedup_vs_best_newton,
+speedup_vs_newton_ldlt, backward_iters_per_step, backward_fallbacks,
+backward_iterative_steps, backward_direct_steps, rounding_floor_steps (forward
+steps ended at the rounding floor), newton_fallback_steps (PD-LBFGS steps
+finished by Newton), problem, dofs, adjoint_solver, ...}.
 --scaling: the problem at --scales x the elements (default 1,2,4,8); rows
 {method, factor, elements, vertices, dofs, forward_s, iters_per_step,
 forward_per_iteration_ms, factorization_s, iteration_ms, backward_per_step_ms,
@@ -51,6 +59,7 @@ struct BenchArgs {
   std::string problem;
   std::vector<std::string> methods = {"pd", "pd-lbfgs", "newton-pcg", "newton-cholesky"};
   BenchOptions options;
+  std::string adjoint_solver = ToString(SolverOptions().adjoint_solver);
   bool json = false;
   bool scaling = false;
   bool threads_compare = false;
@@ -60,17 +69,20 @@ struct BenchArgs {
 void PrintBenchTable(const BenchResult& r) {
   std::printf("# %s: %d elements, %d DoFs, %d steps of %g s; reference newton-cholesky rtol 1e-10 (%.3f s)\n",
               r.problem.c_str(), r.elements, r.dofs, r.steps, r.time_step, r.reference_forward_s);
-  std::printf("%-16s %10s %10s %10s %10s %12s %12s %12s %10s %10s %12s %10s\n", "method", "forward_s", "backward_s",
-              "factor_s", "iters/step", "ms/iter", "bwd_it/step", "state_err", "x_err", "v_err", "grad_err", "speedup");
+  std::printf("%-16s %10s %10s %10s %10s %12s %12s %9s %12s %10s %10s %12s %10s\n", "method", "forward_s", "backward_s",
+              "factor_s", "iters/step", "ms/iter", "bwd_it/step", "iter/dir", "state_err", "x_err", "v_err", "grad_err",
+              "speedup");
   for (const auto& row : r.rows) {
     if (!row.failure.empty()) {
       std::printf("%-16s failed: %s\n", row.method.c_str(), row.failure.c_str());
       continue;
     }
-    std::printf("%-16s %10.4f %10.4f %10.4f %10.2f %12.4f %12.2f %12.3e %10.2e %10.2e %12.3e", row.method.c_str(),
+    const std::string split =
+        std::to_string(row.backward_iterative_steps) + "/" + std::to_string(row.backward_direct_steps);
+    std::printf("%-16s %10.4f %10.4f %10.4f %10.2f %12.4f %12.2f %9s %12.3e %10.2e %10.2e %12.3e", row.method.c_str(),
                 row.forward_s, row.backward_s, row.factorization_s, row.iters_per_step, row.forward_per_iteration_ms,
-                row.backward_iters_per_step, row.state_rel_error, row.position_rel_error, row.velocity_rel_error,
-                row.grad_rel_error);
+                row.backward_iters_per_step, split.c_str(), row.state_rel_error, row.position_rel_error,
+                row.velocity_rel_error, row.grad_rel_error);
     if (row.backward_fallbacks > 0) std::printf(" (%d adjoint fallbacks)", row.backward_fallbacks);
     if (row.rounding_floor_steps > 0) std::printf(" (%d steps at the rounding floor)", row.rounding_floor_steps);
     if (row.newton_fallback_steps > 0) std::printf(" (%d steps finished by Newton)", row.newton_fallback_steps);
@@ -121,6 +133,7 @@ void PrintThreadsTable(const std::vector<ThreadsRow>& rows) {
 int RunBenchArgs(const BenchArgs& args) {
   BenchOptions options = args.options;
   options.methods = ParseMethods(args.methods);
+  options.adjoint_solver = ParseAdjointSolver(args.adjoint_solver);
   if (args.scaling) {
     const ScalingResult r = RunScaling(args.problem, options, args.scales, &std::cerr);
     if (args.json)
@@ -151,8 +164,12 @@ Subcommand AddBenchCommand(CLI::App* parent) {
       "bench", "forward/backward time, iterations and error vs. a converged Newton reference, per method");
   cmd->footer(kBenchFooter);
   cmd->add_option("problem", args->problem, "problem name (see `diffpd list`)")->required();
-  cmd->add_option("--methods", args->methods, "comma-separated methods: newton-cholesky, newton-pcg, pd, pd-lbfgs")
+  cmd->add_option("--methods", args->methods,
+                  "comma-separated methods: newton-cholesky, newton-pcg, newton-ldlt, pd, pd-lbfgs")
       ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--adjoint-solver", args->adjoint_solver,
+                  "PD methods' adjoint solver: auto (per step by measured cost), iterative or direct")
       ->capture_default_str();
   cmd->add_option("--threads", args->options.threads, "threads for element loops (0: OpenMP default)")
       ->check(ThreadCount("--threads"));
@@ -163,7 +180,7 @@ Subcommand AddBenchCommand(CLI::App* parent) {
       ->check(Fraction("--rtol"))
       ->capture_default_str();
   cmd->add_option("--backward-rtol", args->options.backward_rel_tolerance,
-                  "relative tolerance of the adjoint solves (default: --rtol)")
+                  "relative tolerance of the adjoint solves (default: derived from the forward's accuracy)")
       ->check(Fraction("--backward-rtol"));
   cmd->add_option("--max-iterations", args->options.max_iterations, "iteration limit of each step's solve")
       ->check(IntegerAtLeast("--max-iterations", 1))

@@ -21,7 +21,7 @@ namespace {
 // Adds the options shared by the simulating subcommands.
 void AddCommonOptions(CLI::App* cmd, CommandArgs* args, std::string* method) {
   cmd->add_option("problem", args->problem, "problem name (see `diffpd list`)")->required();
-  cmd->add_option("--method", *method, "semi-implicit, newton-cholesky, newton-pcg, pd or pd-lbfgs")
+  cmd->add_option("--method", *method, "semi-implicit, newton-cholesky, newton-pcg, newton-ldlt, pd or pd-lbfgs")
       ->capture_default_str();
   cmd->add_option("--threads", args->threads, "threads for element loops (0: OpenMP default)")
       ->check(ThreadCount("--threads"));

@@ -40,7 +40,8 @@ SolverOptions MethodOptions(Method method, const BenchOptions& o, double time_st
   s.method = method;
   s.time_step = time_step;
   s.rel_tolerance = o.rel_tolerance;
-  s.backward_rel_tolerance = o.backward_rel_tolerance > 0 ? o.backward_rel_tolerance : o.rel_tolerance;
+  s.backward_rel_tolerance = o.backward_rel_tolerance > 0 ? o.backward_rel_tolerance : 0.0;
+  s.adjoint_solver = o.adjoint_solver;
   s.num_threads = o.threads;
   s.max_iterations = o.max_iterations;
   s.lbfgs_weight_scale = o.lbfgs_weight_scale;
@@ -164,9 +165,18 @@ RolloutMeasurement MeasureRollout(const Scene& scene, const SolverOptions& optio
       backward.push_back(SecondsSince(start));
       m.backward_iterations = g.report.linear_iterations;
       m.backward_fallbacks = g.report.fallbacks;
+      m.backward_iterative_steps = g.report.iterative_steps;
+      m.backward_direct_steps = g.report.direct_steps;
       const int n = sim.num_dofs();
-      m.gradient.resize(2 * n + 3);
-      m.gradient << g.x0, g.v0, g.youngs_modulus, g.poissons_ratio, g.density;
+      Eigen::Index activations = 0;
+      for (const VectorXd& a : g.activation) activations += a.size();
+      m.gradient.resize(2 * n + 3 + activations);
+      m.gradient.head(2 * n + 3) << g.x0, g.v0, g.youngs_modulus, g.poissons_ratio, g.density;
+      Eigen::Index at = 2 * n + 3;
+      for (const VectorXd& a : g.activation) {
+        m.gradient.segment(at, a.size()) = a;
+        at += a.size();
+      }
     } catch (const SolverError& e) {
       m.failure = Failure(e);
       m.status = e.status();
@@ -216,9 +226,10 @@ void BenchOptions::Validate() const {
     if (m == Method::kSemiImplicit)
       throw InvalidInputError(
           "method semi-implicit is not benchmarked: it has no tolerance (use newton-cholesky, "
-          "newton-pcg, pd or pd-lbfgs)");
+          "newton-pcg, newton-ldlt, pd or pd-lbfgs)");
   if (!(rel_tolerance > 0 && rel_tolerance < 1)) fail("rtol", rel_tolerance, "in (0, 1)");
-  if (!(backward_rel_tolerance < 1)) fail("backward rtol", backward_rel_tolerance, "< 1 (<= 0: same as rtol)");
+  if (!(backward_rel_tolerance < 1))
+    fail("backward rtol", backward_rel_tolerance, "< 1 (<= 0: derived from the forward's accuracy)");
   if (repeat < 1) fail("repeat", repeat, ">= 1");
   if (threads < 0 || threads > MaxSolverThreads()) fail("threads", threads, ThreadRange());
   if (max_iterations < 1) fail("max iterations", max_iterations, ">= 1");
@@ -273,6 +284,8 @@ BenchResult RunBench(const std::string& problem, const BenchOptions& options, st
       row.iters_per_step = m.iters_per_step;
       row.backward_iters_per_step = result.steps > 0 ? double(m.backward_iterations) / result.steps : 0;
       row.backward_fallbacks = m.backward_fallbacks;
+      row.backward_iterative_steps = m.backward_iterative_steps;
+      row.backward_direct_steps = m.backward_direct_steps;
       row.rounding_floor_steps = m.rounding_floor_steps;
       row.newton_fallback_steps = m.newton_fallback_steps;
       row.forward_per_iteration_ms = m.total_iterations > 0 ? 1e3 * m.forward_s / m.total_iterations : 0;
@@ -287,16 +300,30 @@ BenchResult RunBench(const std::string& problem, const BenchOptions& options, st
       for (int k = 0; k < 3; ++k)
         row.grad_rel_error_by_input[names[k]] =
             RelativeError(m.gradient.segment(2 * n + k, 1), reference.gradient.segment(2 * n + k, 1));
+      const Eigen::Index activations = reference.gradient.size() - (2 * n + 3);
+      if (activations > 0)
+        row.grad_rel_error_by_input["activation"] =
+            RelativeError(m.gradient.tail(activations), reference.gradient.tail(activations));
     }
     result.rows.push_back(row);
   }
-  const BenchRow* nc = nullptr;
-  for (const auto& row : result.rows)
-    if (row.method == ToString(Method::kNewtonCholesky) && row.failure.empty()) nc = &row;
-  if (nc)
-    for (auto& row : result.rows)
-      if (row.failure.empty() && row.forward_s + row.backward_s > 0)
-        row.speedup_vs_newton_cholesky = (nc->forward_s + nc->backward_s) / (row.forward_s + row.backward_s);
+  // (forward + backward) of a successful row of `method`, if any.
+  const auto total = [&result](Method method) -> std::optional<double> {
+    for (const auto& row : result.rows)
+      if (row.method == ToString(method) && row.failure.empty()) return row.forward_s + row.backward_s;
+    return std::nullopt;
+  };
+  const std::optional<double> cholesky = total(Method::kNewtonCholesky), pcg = total(Method::kNewtonPcg),
+                              ldlt = total(Method::kNewtonLdlt);
+  std::optional<double> best = cholesky;
+  if (pcg && (!best || *pcg < *best)) best = pcg;
+  for (auto& row : result.rows) {
+    const double own = row.forward_s + row.backward_s;
+    if (!row.failure.empty() || !(own > 0)) continue;
+    if (cholesky) row.speedup_vs_newton_cholesky = *cholesky / own;
+    if (best) row.speedup_vs_best_newton = *best / own;
+    if (ldlt) row.speedup_vs_newton_ldlt = *ldlt / own;
+  }
   return result;
 }
 
@@ -325,6 +352,13 @@ nlohmann::json BenchToJson(const BenchResult& result, const BenchOptions& option
          {"factorization_s", NumberOrNull(ok, r.factorization_s)},
          {"speedup_vs_newton_cholesky",
           r.speedup_vs_newton_cholesky ? nlohmann::json(*r.speedup_vs_newton_cholesky) : nlohmann::json(nullptr)},
+         {"speedup_vs_best_newton",
+          r.speedup_vs_best_newton ? nlohmann::json(*r.speedup_vs_best_newton) : nlohmann::json(nullptr)},
+         {"speedup_vs_newton_ldlt",
+          r.speedup_vs_newton_ldlt ? nlohmann::json(*r.speedup_vs_newton_ldlt) : nlohmann::json(nullptr)},
+         {"backward_iterative_steps", ok ? nlohmann::json(r.backward_iterative_steps) : nlohmann::json(nullptr)},
+         {"backward_direct_steps", ok ? nlohmann::json(r.backward_direct_steps) : nlohmann::json(nullptr)},
+         {"adjoint_solver", ToString(options.adjoint_solver)},
          {"problem", result.problem},
          {"dofs", result.dofs},
          {"elements", result.elements},

@@ -6,7 +6,8 @@
 // linear loss
 //   L = c_x . x_K + c_v . v_K,   c_x, c_v ~ N(0, 1) per entry (seed `seed`).
 // The "gradient" compared is the concatenation
-//   [dL/dx_0 (3n), dL/dv_0 (3n), dL/dE (per Pa), dL/dnu, dL/drho (per kg/m^3)].
+//   [dL/dx_0 (3n), dL/dv_0 (3n), dL/dE (per Pa), dL/dnu, dL/drho (per kg/m^3)],
+// followed by every step's dL/d(activation) for a scene with muscles.
 // The reference is newton-cholesky with rel_tolerance 1e-10 and
 // backward_rel_tolerance 1e-12 (kReferenceRelTolerance). Errors are relative
 // 2-norms ||a - ref|| / ||ref|| of the final state [x_K, v_K] and of the
@@ -86,12 +87,18 @@ struct RolloutMeasurement {
   // that fell back to a direct one, of the last run.
   long backward_iterations = 0;
   int backward_fallbacks = 0;
+  // Backward steps solved iteratively and by a factorisation of the step
+  // Hessian (BackwardReport), of the last run.
+  int backward_iterative_steps = 0;
+  int backward_direct_steps = 0;
   // Forward steps of the last run that ended at the rounding floor or were
   // finished by Newton after a PD-LBFGS stall (StepReport).
   int rounding_floor_steps = 0;
   int newton_fallback_steps = 0;
   State final_state;
-  // [dL/dx0, dL/dv0, dL/dE, dL/dnu, dL/drho] (6n + 3).
+  // [dL/dx0, dL/dv0, dL/dE, dL/dnu, dL/drho] (6n + 3), then, for a scene
+  // with muscles, dL/da of every step's activations in step order (K x
+  // muscles more).
   VectorXd gradient;
   bool ok() const { return failure.empty(); }
 };
@@ -111,13 +118,16 @@ VectorXd StackState(const State& s);
 struct BenchOptions {
   // Methods measured, in this order.
   std::vector<Method> methods = {Method::kPd, Method::kPdLbfgs, Method::kNewtonPcg, Method::kNewtonCholesky};
-  double rel_tolerance = 1e-4;                                     // forward rel_tolerance of every method
-  double backward_rel_tolerance = -1;                              // adjoint tolerance; <= 0: the same as rel_tolerance
-  int steps = -1;                                                  // <= 0: the problem's default
-  double time_step = -1;                                           // <= 0: the problem's default (s)
-  int threads = 0;                                                 // SolverOptions::num_threads
-  int max_iterations = 1000;                                       // SolverOptions::max_iterations of each step
-  double lbfgs_weight_scale = SolverOptions().lbfgs_weight_scale;  // pd-lbfgs preconditioner
+  double rel_tolerance = 1e-4;  // forward rel_tolerance of every method
+  // Adjoint tolerance; <= 0: the library's default (SolverOptions::
+  // backward_rel_tolerance = 0, derived per step from the forward's accuracy).
+  double backward_rel_tolerance = -1;
+  AdjointSolver adjoint_solver = SolverOptions().adjoint_solver;       // PD methods' backward and tangents
+  int steps = -1;                                                      // <= 0: the problem's default
+  double time_step = -1;                                               // <= 0: the problem's default (s)
+  int threads = 0;                                                     // SolverOptions::num_threads
+  int max_iterations = 1000;                                           // SolverOptions::max_iterations of each step
+  double lbfgs_weight_scale = SolverOptions().lbfgs_weight_scale;      // pd-lbfgs preconditioner
   bool rigid_mode_correction = SolverOptions().rigid_mode_correction;  // pd-lbfgs, PD backward
   int repeat = 1;                                                      // runs per method (median), >= 1
   int refine = 0;                                                      // MakeRefinedProblem doublings
@@ -139,6 +149,8 @@ struct BenchRow {
   double iters_per_step = 0;
   double backward_iters_per_step = 0;   // adjoint solver iterations per step (0: direct)
   int backward_fallbacks = 0;           // adjoint solves that fell back to a direct solve
+  int backward_iterative_steps = 0;     // backward steps solved by an iteration
+  int backward_direct_steps = 0;        // and by a factorisation of the step Hessian
   int rounding_floor_steps = 0;         // forward steps ended at the rounding floor
   int newton_fallback_steps = 0;        // PD-LBFGS steps finished by Newton after a stall
   double forward_per_iteration_ms = 0;  // forward_s / total iterations, ms
@@ -148,11 +160,16 @@ struct BenchRow {
   double velocity_rel_error = 0;        // of v alone (about |x error| / h: the strictest part)
   double grad_rel_error = 0;
   // Relative errors of the gradient's parts: "x0", "v0", "youngs_modulus",
-  // "poissons_ratio", "density".
+  // "poissons_ratio", "density", and "activation" for a scene with muscles.
   std::map<std::string, double> grad_rel_error_by_input;
   // (forward_s + backward_s) of newton-cholesky in this run over this
   // method's; empty when newton-cholesky is not among the methods or failed.
   std::optional<double> speedup_vs_newton_cholesky;
+  // The same against the faster of newton-cholesky and newton-pcg (this
+  // library's best Newton), and against newton-ldlt (the paper's Newton);
+  // empty when none of them ran successfully.
+  std::optional<double> speedup_vs_best_newton;
+  std::optional<double> speedup_vs_newton_ldlt;
 };
 
 struct BenchResult {
@@ -172,11 +189,13 @@ BenchResult RunBench(const std::string& problem, const BenchOptions& options, st
 
 // The rows as the JSON list the command prints: objects with method,
 // forward_s, backward_s, iters_per_step, state_rel_error, grad_rel_error,
-// forward_per_iteration_ms, speedup_vs_newton_cholesky (null if unknown),
+// forward_per_iteration_ms, speedup_vs_newton_cholesky,
+// speedup_vs_best_newton, speedup_vs_newton_ldlt (null if unknown),
 // grad_rel_error_by_input, backward_iters_per_step, backward_fallbacks,
-// rounding_floor_steps, newton_fallback_steps, status ("ok" or "failed: ..."), and the run's
-// problem, dofs, steps, time_step, rel_tolerance. A failed method has null
-// numbers.
+// backward_iterative_steps, backward_direct_steps, rounding_floor_steps,
+// newton_fallback_steps, status ("ok" or "failed: ..."), and the run's
+// problem, dofs, steps, time_step, rel_tolerance, adjoint_solver. A failed
+// method has null numbers.
 nlohmann::json BenchToJson(const BenchResult& result, const BenchOptions& options);
 
 // --scaling: the problem at several element counts (factors, powers of 2;

@@ -46,6 +46,27 @@ TEST(SolverAgreementTest, AllImplicitMethodsReachTheSameStateAndGradient) {
   }
 }
 
+TEST(SolverAgreementTest, PaperStyleNewtonLdltAgreesWithNewtonCholeskyForwardAndBackward) {
+  const Scene scene = testing::SmallBeamScene();
+  Simulator cholesky(scene, Tight(Method::kNewtonCholesky));
+  Simulator ldlt(scene, Tight(Method::kNewtonLdlt));
+  const State s0 = Deformed(cholesky);
+  const Rollout rc = cholesky.Simulate(s0, std::vector<StepInput>(3));
+  const Rollout rl = ldlt.Simulate(s0, std::vector<StepInput>(3));
+  for (int k = 1; k <= 3; ++k) {
+    EXPECT_LT((rl.states[k].x - rc.states[k].x).norm(), 1e-10 * rc.states[k].x.norm()) << k;
+    EXPECT_EQ(rl.reports[k - 1].iterations, rc.reports[k - 1].iterations) << k;
+  }
+  LossGradient dl(3);
+  dl.dx[3] = VectorXd::LinSpaced(cholesky.num_dofs(), -1, 1);
+  dl.dv[3] = VectorXd::LinSpaced(cholesky.num_dofs(), 2, -1);
+  const RolloutGradient gc = cholesky.Backward(rc, dl), gl = ldlt.Backward(rl, dl);
+  EXPECT_LT((gl.x0 - gc.x0).norm() / gc.x0.norm(), 1e-8);
+  EXPECT_LT((gl.v0 - gc.v0).norm() / gc.v0.norm(), 1e-8);
+  EXPECT_NEAR(gl.youngs_modulus, gc.youngs_modulus, 1e-8 * std::abs(gc.youngs_modulus));
+  EXPECT_EQ(gl.report.direct_steps, 3);
+}
+
 TEST(SolverAgreementTest, PdLbfgsPreconditionerScaleChangesNeitherTheStateNorTheGradient) {
   // lbfgs_weight_scale only changes the initial Hessian A of PD-LBFGS (and
   // its backward): every scale must converge to the same step and adjoint.
@@ -111,6 +132,7 @@ TEST(SolverAgreementTest, PdBackwardFallsBackToADirectSolveWhenTheIterationFails
   const Scene scene = testing::SmallBeamScene();
   SolverOptions o = Tight(Method::kPd);
   o.pd_backward = PdBackwardMethod::kFixedPoint;
+  o.adjoint_solver = AdjointSolver::kIterative;
   o.backward_max_iterations = 1;  // forces the fallback
   Simulator sim(scene, o);
   const Rollout r = sim.Simulate(Deformed(sim), std::vector<StepInput>(2));

@@ -58,10 +58,10 @@ TEST(SolverOptionsTest, InvalidFieldsAreRejectedWithTheFieldAndRange) {
       // Integers cast to the enums.
       {[](SolverOptions* o) { o->method = static_cast<Method>(7); },
        "solver options: method = 7 is invalid: must be a Method: semi-implicit (0), newton-cholesky (1), newton-pcg "
-       "(2), pd (3) or pd-lbfgs (4)"},
+       "(2), pd (3), pd-lbfgs (4) or newton-ldlt (5)"},
       {[](SolverOptions* o) { o->method = static_cast<Method>(-1); },
        "solver options: method = -1 is invalid: must be a Method: semi-implicit (0), newton-cholesky (1), newton-pcg "
-       "(2), pd (3) or pd-lbfgs (4)"},
+       "(2), pd (3), pd-lbfgs (4) or newton-ldlt (5)"},
       {[](SolverOptions* o) { o->pcg_preconditioner = static_cast<PcgPreconditioner>(2); },
        "solver options: pcg_preconditioner = 2 is invalid: must be kJacobi (0) or kIncompleteCholesky (1)"},
       {[](SolverOptions* o) { o->pd_backward = static_cast<PdBackwardMethod>(3); },
@@ -80,11 +80,17 @@ TEST(SolverOptionsTest, InvalidFieldsAreRejectedWithTheFieldAndRange) {
 }
 
 TEST(SolverOptionsTest, MethodNamesRoundTripAndUnknownNamesAreListed) {
-  for (const Method m :
-       {Method::kSemiImplicit, Method::kNewtonCholesky, Method::kNewtonPcg, Method::kPd, Method::kPdLbfgs})
+  for (const Method m : {Method::kSemiImplicit, Method::kNewtonCholesky, Method::kNewtonPcg, Method::kPd,
+                         Method::kPdLbfgs, Method::kNewtonLdlt})
     EXPECT_EQ(ParseMethod(ToString(m)), m);
+  EXPECT_EQ(ToString(Method::kNewtonLdlt), std::string("newton-ldlt"));
   EXPECT_EQ(MessageOf([] { ParseMethod("newton"); }),
-            "unknown method 'newton': valid methods are semi-implicit, newton-cholesky, newton-pcg, pd, pd-lbfgs");
+            "unknown method 'newton': valid methods are semi-implicit, newton-cholesky, newton-pcg, pd, pd-lbfgs, "
+            "newton-ldlt");
+  for (const AdjointSolver a : {AdjointSolver::kAuto, AdjointSolver::kIterative, AdjointSolver::kDirect})
+    EXPECT_EQ(ParseAdjointSolver(ToString(a)), a);
+  EXPECT_EQ(MessageOf([] { ParseAdjointSolver("cg"); }),
+            "unknown adjoint solver 'cg': valid adjoint solvers are auto, iterative, direct");
 }
 
 TEST(SolverOptionsTest, BadScenesAndInputsAreRejected) {

@@ -86,6 +86,12 @@ struct LossGradient {
 struct BackwardReport {
   int linear_iterations = 0;  // iterations of the iterative adjoint solves, summed
   int fallbacks = 0;          // adjoint solves that fell back to a direct solve
+  // Steps whose adjoint (tangent: whose P columns') system was solved by an
+  // iteration (PD's, or newton-pcg's PCG; a fallback still counts here) and
+  // by a factorisation of the step Hessian (newton-cholesky, newton-ldlt,
+  // and the PD methods' direct adjoint: SolverOptions::adjoint_solver).
+  int iterative_steps = 0;
+  int direct_steps = 0;
   double seconds = 0;
 };
 

@@ -12,8 +12,13 @@ enum class Method {
   kNewtonPcg,       // implicit Euler, Newton + preconditioned conjugate gradients
   kPd,              // implicit Euler, projective dynamics (local-global)
   kPdLbfgs,         // implicit Euler, L-BFGS with the PD matrix as initial Hessian
+  // Implicit Euler, Newton + simplicial LDL^T under AMD ordering (Eigen),
+  // ordered and analysed at every solve: the DiffPD paper's Newton baseline,
+  // for reproducing its speed-ups like for like (newton-cholesky is faster).
+  kNewtonLdlt,
 };
-// "semi-implicit", "newton-cholesky", "newton-pcg", "pd", "pd-lbfgs".
+// "semi-implicit", "newton-cholesky", "newton-pcg", "pd", "pd-lbfgs",
+// "newton-ldlt".
 const char* ToString(Method method);
 // Inverse of ToString; throws InvalidInputError listing the valid names.
 Method ParseMethod(const std::string& name);
@@ -41,6 +46,32 @@ enum class PdBackwardMethod {
   // recursion's 4 * lbfgs_history vector passes per iteration.
   kConjugateGradient,
 };
+
+// How the backward (adjoint) and tangent passes of the PD methods (pd,
+// pd-lbfgs) solve with the step Hessian H. Newton methods always use their
+// own linear solver (a factorisation of H, or PCG for newton-pcg).
+enum class AdjointSolver {
+  // Per step, whichever of the two below is cheaper on this problem, by
+  // their measured times: each is timed on a step as it runs, the cheaper
+  // one serves the following steps, and the other is timed again after
+  // max(8, (r - 1) / 0.05) of them (r: the ratio of the times; <= 5% extra). The
+  // measurements persist across Backward/Tangents calls of one simulator
+  // (SetOptions resets them). Which steps used which is reported
+  // (BackwardReport); the gradients agree with either to the adjoint's
+  // tolerance.
+  kAuto,
+  // The PD-preconditioned iteration (pd_backward), falling back to a direct
+  // solve when it fails.
+  kIterative,
+  // A sparse Cholesky factorisation of the assembled H (CHOLMOD; ordering
+  // and symbolic analysis once per simulator, numeric factorisation per
+  // step), sparse LU where H is indefinite.
+  kDirect,
+};
+// "auto", "iterative", "direct".
+const char* ToString(AdjointSolver solver);
+// Inverse of ToString; throws InvalidInputError listing the valid names.
+AdjointSolver ParseAdjointSolver(const std::string& name);
 
 struct SolverOptions {
   Method method = Method::kPd;
@@ -130,10 +161,28 @@ struct SolverOptions {
   // step must meet.
   bool rigid_mode_correction = true;
 
-  // Backward (adjoint) linear solves: relative residual ||H z - b|| / ||b||.
+  // PD methods' backward and tangent solves: iterative, direct or chosen
+  // per step by measured cost (AdjointSolver).
+  AdjointSolver adjoint_solver = AdjointSolver::kAuto;
   PdBackwardMethod pd_backward = PdBackwardMethod::kConjugateGradient;
-  double backward_rel_tolerance = 1e-10;
+  // Iterative backward (adjoint) and tangent solves stop at the relative
+  // residual ||H z - b|| / ||b|| <= backward_rel_tolerance, in [0, 1);
+  // 0 (default): per step, backward_tolerance_factor (in (0, 1]) times the
+  // relative residual that step's forward solve reached (final / initial,
+  // at most the forward's rel_tolerance), not below 1e-12. An adjoint solved
+  // far tighter than the forward buys no gradient accuracy, one much looser
+  // loses it; the default factor keeps the gradient as accurate as an exact
+  // adjoint at the same forward tolerance would (measured by
+  // benchmarks/backward_benchmark --sweep). A direct adjoint solve is exact
+  // whatever the tolerance.
+  double backward_rel_tolerance = 0;
+  double backward_tolerance_factor = 0.01;
   int backward_max_iterations = 1000;
+  // PD methods' iterative backward and tangent solves start from the
+  // Galerkin projection of the step's system onto the span of the latest
+  // this-many solutions of earlier steps (consecutive adjoints are close),
+  // at the cost of as many Hessian products per step; >= 0, 0: from zero.
+  int adjoint_guess_solutions = 8;
 
   // A step fails with SolverError(kDiverged) when the body's extent (the
   // diagonal of its nodes' bounding box) exceeds max_extent_ratio times its

@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include <chrono>
 #include <vector>
 
 #include <Eigen/CholmodSupport>
@@ -85,8 +86,13 @@ bool CholmodSolver::Factorize(const SparseMatrix& a) {
     ++num_analyses_;
   }
   const SerialOpenMpScope serial;
+  analysis_seconds_ = 0;
   factorized_ = impl_->With(layout_, [&](auto& llt) {
-    if (analyse) llt.analyzePattern(a);
+    if (analyse) {
+      const auto start = std::chrono::steady_clock::now();
+      llt.analyzePattern(a);
+      analysis_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
     llt.factorize(a);
     return llt.info() == Eigen::Success;
   });

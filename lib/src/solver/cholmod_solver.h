@@ -64,6 +64,9 @@ class CholmodSolver {
 
   CholmodLayout layout() const { return layout_; }
   int num_analyses() const { return num_analyses_; }
+  // Wall seconds of the latest Factorize's symbolic analysis (0 when it
+  // reused the previous one).
+  double analysis_seconds() const { return analysis_seconds_; }
   // Entries of the factor L after the latest analysis (CHOLMOD's lnz).
   double factor_nonzeros() const;
   int num_factorizations() const { return num_factorizations_; }
@@ -81,6 +84,7 @@ class CholmodSolver {
   Eigen::Index rows_ = -1;
   Eigen::Index nonzeros_ = -1;
   int num_analyses_ = 0;
+  double analysis_seconds_ = 0;
   int num_factorizations_ = 0;
   bool factorized_ = false;
 };

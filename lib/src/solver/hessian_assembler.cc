@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "diffpd/error.h"
+#include "fem/packed_element_matrices.h"
 
 namespace diffpd::internal {
 namespace {
@@ -42,17 +43,53 @@ HessianAssembler::HessianAssembler(const Mesh& mesh) : k_(NodesPerElement(mesh.t
   for (int d = 0; d < n; ++d) diag_index_[d] = ValueIndex(pattern_, d, d);
 }
 
+void HessianAssembler::FinishAssembly(const VectorXd& diagonal, const std::vector<char>& fixed, SparseMatrix* h) const {
+  double* values = h->valuePtr();
+  const int* rows = h->innerIndexPtr();
+  for (int d = 0; d < h->rows(); ++d) values[diag_index_[d]] += diagonal(d);
+  for (int col = 0; col < h->cols(); ++col)
+    for (int t = h->outerIndexPtr()[col]; t < h->outerIndexPtr()[col + 1]; ++t)
+      if (fixed[col] || fixed[rows[t]]) values[t] = rows[t] == col ? 1.0 : 0.0;
+}
+
+void HessianAssembler::AssemblePacked(const std::vector<double>& packed, const std::vector<double>& blocks,
+                                      const VectorXd& diagonal, const std::vector<char>& fixed, SparseMatrix* h) const {
+  const int entries = PackedEntries(k_), nb = 3 * k_;
+  const int elements = static_cast<int>(block_index_.size() / (nb * nb));
+  const int groups = (elements + kElementLanes - 1) / kElementLanes;
+  DIFFPD_CHECK(packed.size() == static_cast<size_t>(groups) * entries * kElementLanes,
+               "AssemblePacked: " << packed.size() << " packed entries for " << elements << " elements");
+  DIFFPD_CHECK(blocks.empty() || blocks.size() == block_index_.size(), "element block count mismatch");
+  *h = pattern_;
+  double* values = h->valuePtr();
+  for (int e = 0; e < elements; ++e) {
+    const double* lane =
+        packed.data() + static_cast<size_t>(e / kElementLanes) * entries * kElementLanes + e % kElementLanes;
+    const int* index = block_index_.data() + static_cast<size_t>(e) * nb * nb;  // (r, c) at c nb + r
+    // Packed entry t: node blocks (a, b), b = 0..K-1, a = 0..b, each 3 x 3
+    // column-major; an off-diagonal block also stands for its transpose.
+    int t = 0;
+    for (int b = 0; b < k_; ++b)
+      for (int a = 0; a <= b; ++a)
+        for (int j = 0; j < 3; ++j)
+          for (int i = 0; i < 3; ++i, ++t) {
+            const double v = lane[static_cast<size_t>(t) * kElementLanes];
+            const int r = 3 * a + i, c = 3 * b + j;
+            values[index[c * nb + r]] += v;
+            if (a != b) values[index[r * nb + c]] += v;
+          }
+  }
+  for (size_t t = 0; t < blocks.size(); ++t) values[block_index_[t]] += blocks[t];
+  FinishAssembly(diagonal, fixed, h);
+}
+
 void HessianAssembler::Assemble(const std::vector<double>& blocks, const VectorXd& diagonal,
                                 const std::vector<char>& fixed, SparseMatrix* h) const {
   DIFFPD_CHECK(blocks.size() == block_index_.size(), "element block count mismatch");
   *h = pattern_;
   double* values = h->valuePtr();
-  const int* rows = h->innerIndexPtr();
   for (size_t t = 0; t < block_index_.size(); ++t) values[block_index_[t]] += blocks[t];
-  for (int d = 0; d < h->rows(); ++d) values[diag_index_[d]] += diagonal(d);
-  for (int col = 0; col < h->cols(); ++col)
-    for (int t = h->outerIndexPtr()[col]; t < h->outerIndexPtr()[col + 1]; ++t)
-      if (fixed[col] || fixed[rows[t]]) values[t] = rows[t] == col ? 1.0 : 0.0;
+  FinishAssembly(diagonal, fixed, h);
 }
 
 }  // namespace diffpd::internal

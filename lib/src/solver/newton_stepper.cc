@@ -1,6 +1,8 @@
 // Newton's method on one implicit step: projected (SPD) element Hessians,
-// linear solve by CHOLMOD (pattern analysed once) or by PCG, Armijo line search.
+// linear solve by CHOLMOD (pattern analysed once), by the paper-style
+// simplicial LDL^T (newton-ldlt) or by PCG, Armijo line search.
 #include <cstdio>
+#include <string>
 
 #include <Eigen/IterativeLinearSolvers>
 
@@ -35,11 +37,12 @@ VectorXd SolveNewtonSystem(SimulatorImpl& sim, const SparseMatrix& h, const Vect
                         "newton-pcg: the conjugate-gradient solve did not reach its tolerance");
     return dx;
   }
-  CholmodSolver& llt = sim.newton_solver();
-  if (!llt.Factorize(h))
+  HessianFactorization& factor = sim.hessian_factorization();
+  if (!factor.Factorize(h))
     throw SolverError(SolverStatus::kFactorizationFailed,
-                      "newton-cholesky: the projected Hessian is not positive definite (a free rigid mode?)");
-  return llt.Solve(rhs);
+                      std::string(ToString(sim.options.method)) +
+                          ": the projected Hessian is not positive definite (a free rigid mode?)");
+  return factor.Solve(rhs);
 }
 
 }  // namespace

@@ -1,9 +1,10 @@
 #include "solver/preconditioned_iteration.h"
 
-#include "solver/lbfgs_pairs.h"
-
 #include <cmath>
 #include <memory>
+
+#include "diffpd/error.h"
+#include "solver/lbfgs_pairs.h"
 
 namespace diffpd::internal {
 namespace {
@@ -14,8 +15,8 @@ enum class ColumnStatus { kRunning, kConverged, kFailed };
 // step that consumes A^{-1} of it.
 class ColumnIteration {
  public:
-  ColumnIteration(const VectorXd& b, double rel_tolerance, const std::function<VectorXd(const VectorXd&)>& apply_h)
-      : b_(b), r_(b), z_(VectorXd::Zero(b.size())), tol_(rel_tolerance * b.norm()), apply_h_(apply_h) {}
+  ColumnIteration(const VectorXd& b, double tolerance, const std::function<VectorXd(const VectorXd&)>& apply_h)
+      : b_(b), r_(b), z_(VectorXd::Zero(b.size())), tol_(tolerance), apply_h_(apply_h) {}
   virtual ~ColumnIteration() = default;
   virtual const VectorXd& PreconditionerInput() = 0;
   virtual ColumnStatus Advance(const VectorXd& preconditioned) = 0;
@@ -66,9 +67,8 @@ class FixedPointColumn final : public ColumnIteration {
 
 class LbfgsColumn final : public ColumnIteration {
  public:
-  LbfgsColumn(const VectorXd& b, double rel_tolerance, const std::function<VectorXd(const VectorXd&)>& apply_h,
-              int history)
-      : ColumnIteration(b, rel_tolerance, apply_h), pairs_(history, b.size()) {}
+  LbfgsColumn(const VectorXd& b, double tolerance, const std::function<VectorXd(const VectorXd&)>& apply_h, int history)
+      : ColumnIteration(b, tolerance, apply_h), pairs_(history, b.size()) {}
 
   // First loop of the two-loop recursion on the gradient -r.
   const VectorXd& PreconditionerInput() override {
@@ -123,17 +123,18 @@ class ConjugateGradientColumn final : public ColumnIteration {
   double rs_ = 0;
 };
 
+// tolerance: the absolute residual norm to reach.
 std::unique_ptr<ColumnIteration> MakeColumn(const PreconditionedSolveOptions& options, const VectorXd& b,
-                                            const std::function<VectorXd(const VectorXd&)>& apply_h) {
+                                            double tolerance, const std::function<VectorXd(const VectorXd&)>& apply_h) {
   switch (options.method) {
     case PdBackwardMethod::kFixedPoint:
-      return std::make_unique<FixedPointColumn>(b, options.rel_tolerance, apply_h);
+      return std::make_unique<FixedPointColumn>(b, tolerance, apply_h);
     case PdBackwardMethod::kLbfgs:
-      return std::make_unique<LbfgsColumn>(b, options.rel_tolerance, apply_h, options.lbfgs_history);
+      return std::make_unique<LbfgsColumn>(b, tolerance, apply_h, options.lbfgs_history);
     case PdBackwardMethod::kConjugateGradient:
       break;
   }
-  return std::make_unique<ConjugateGradientColumn>(b, options.rel_tolerance, apply_h);
+  return std::make_unique<ConjugateGradientColumn>(b, tolerance, apply_h);
 }
 
 }  // namespace
@@ -147,12 +148,18 @@ void SolvePreconditioned(const PreconditionedSolveOptions& options, const Matrix
   ok->assign(cols, 0);
   std::vector<std::unique_ptr<ColumnIteration>> column(cols);
   std::vector<int> active;
+  const bool given = options.reference_norms.size() > 0;
+  DIFFPD_CHECK(
+      !given || options.reference_norms.size() == cols,
+      "SolvePreconditioned: " << options.reference_norms.size() << " reference norms for " << cols << " columns");
   for (int c = 0; c < cols; ++c) {
-    if (b.col(c).squaredNorm() == 0) {
+    const double norm = b.col(c).norm();
+    const double tolerance = options.rel_tolerance * (given ? options.reference_norms(c) : norm);
+    if (norm == 0 || (given && norm <= tolerance)) {
       (*ok)[c] = 1;
       continue;
     }
-    column[c] = MakeColumn(options, b.col(c), apply_h);
+    column[c] = MakeColumn(options, b.col(c), tolerance, apply_h);
     active.push_back(c);
   }
   for (int it = 1; it <= options.max_iterations && !active.empty(); ++it) {

@@ -15,9 +15,11 @@
 //                        the iteration counts match; CG skips the two-loop
 //                        recursion's 4m vector passes per iteration. Fails
 //                        on negative curvature.
-// A column converges when ||b - H z|| <= rel_tolerance ||b||, confirmed by a
-// recomputed (not recurred) residual. Failed columns are left to the caller
-// (the direct fallback).
+// A column converges when ||b - H z|| <= rel_tolerance ||b|| (or
+// rel_tolerance times its reference norm, when given: a correction solve
+// after an initial guess, whose b is that guess's residual), confirmed by a
+// recomputed (not recurred) residual; a column already within it takes no
+// iteration. Failed columns are left to the caller (the direct fallback).
 #pragma once
 
 #include <functional>
@@ -33,6 +35,8 @@ struct PreconditionedSolveOptions {
   double rel_tolerance = 1e-10;
   int max_iterations = 1000;
   int lbfgs_history = 20;  // kLbfgs only
+  // Per column, the norm the tolerance is relative to; empty: ||b_c||.
+  VectorXd reference_norms;
 };
 
 // apply_h(v): H v, zero at fixed DoFs; precondition(R): A^{-1} R column by

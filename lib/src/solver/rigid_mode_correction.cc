@@ -45,7 +45,9 @@ RigidModeCorrection::RigidModeCorrection(const VectorXd& x, const std::vector<ch
 void RigidModeCorrection::SetHessianProducts(const MatrixXd& hz) {
   DIFFPD_CHECK(hz.rows() == modes_.rows() && hz.cols() == kModes,
                "RigidModeCorrection: H Z is " << hz.rows() << " x " << hz.cols());
-  Eigen::Matrix<double, kModes, kModes> e = modes_.transpose() * hz;
+  // Coefficient-wise products: Eigen's blocked GEMM would open an OpenMP
+  // team for these thin ones (6 columns).
+  Eigen::Matrix<double, kModes, kModes> e = modes_.transpose().lazyProduct(hz);
   e = (0.5 * (e + e.transpose())).eval();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, kModes, kModes>> eig(e);
   const auto& values = eig.eigenvalues();
@@ -57,7 +59,8 @@ void RigidModeCorrection::SetHessianProducts(const MatrixXd& hz) {
 }
 
 void RigidModeCorrection::Add(const MatrixXd& r, MatrixXd* out) const {
-  *out += modes_ * (pseudo_inverse_ * (modes_.transpose() * r));
+  const MatrixXd coarse = pseudo_inverse_ * modes_.transpose().lazyProduct(r);
+  *out += modes_.lazyProduct(coarse);
 }
 
 void RigidModeCorrection::Add(const VectorXd& r, VectorXd* out) const {

@@ -9,6 +9,7 @@
 #include "contact/active_set_step.h"
 #include "diffpd/error.h"
 #include "forces/activation_scope.h"
+#include "solver/adjoint_tolerance.h"
 #include "solver/energy_bounded_step.h"
 #include "solver/rollout_checks.h"
 #include "solver/simulator_impl.h"
@@ -62,6 +63,7 @@ int Simulator::num_dofs() const { return impl_->num_dofs(); }
 void Simulator::SetOptions(const SolverOptions& options) {
   options.Validate();
   impl_->options = options;
+  impl_->ResetAdjointCostModels();
 }
 
 void Simulator::SetMaterial(const MaterialParameters& material) {
@@ -141,6 +143,7 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
       switch (sim.options.method) {
         case Method::kNewtonCholesky:
         case Method::kNewtonPcg:
+        case Method::kNewtonLdlt:
           return internal::NewtonSolve(objective, x0, r);
         case Method::kPd:
           return internal::PdSolve(objective, x0, r);
@@ -224,6 +227,8 @@ RolloutGradient BackwardPass(SimulatorImpl& sim, const Rollout& rollout, const L
   VectorXd dmass = VectorXd::Zero(n);
   const VectorXd gravity = internal::GravityPerDof(sim);
 
+  // The adjoints solved so far: the next step's initial guess.
+  internal::AdjointRecycling recycling(sim.options.adjoint_guess_solutions);
   for (int i = steps - 1; i >= 0; --i) {
     const State& s0 = rollout.states[i];
     const State& s1 = rollout.states[i + 1];
@@ -235,6 +240,10 @@ RolloutGradient BackwardPass(SimulatorImpl& sim, const Rollout& rollout, const L
       std::optional<internal::ContactPinScope> pins;
       if (contact) pins.emplace(sim, rollout.reports[i].contact_nodes, s1.x);
       internal::StepLinearization lin(sim, s1.x);
+      lin.set_recycling(&recycling);
+      lin.set_rel_tolerance(internal::AdjointRelTolerance(
+          sim.options, rollout.options.rel_tolerance,
+          static_cast<int>(rollout.reports.size()) == steps ? &rollout.reports[i] : nullptr));
       const VectorXd z = lin.Solve(b, &out.report);  // zero at fixed DoFs
       sim.elastic.PartLameDots(s1.x, z, sim.part_of_element, parts, &part_mu, &part_lambda, sim.threads());
       dmu -= part_mu;

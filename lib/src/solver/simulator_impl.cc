@@ -116,6 +116,20 @@ PdSystem& SimulatorImpl::pd_system() {
   return *pd_;
 }
 
+HessianFactorization& SimulatorImpl::hessian_factorization() {
+  const HessianFactorizationKind kind = options.method == Method::kNewtonLdlt
+                                            ? HessianFactorizationKind::kSimplicialLdlt
+                                            : HessianFactorizationKind::kCholmodSupernodal;
+  if (!hessian_factorization_ || hessian_factorization_->kind() != kind)
+    hessian_factorization_ = std::make_unique<HessianFactorization>(kind);
+  return *hessian_factorization_;
+}
+
+void SimulatorImpl::ResetAdjointCostModels() {
+  backward_cost_ = AdjointCostModel();
+  tangent_cost_.clear();
+}
+
 LbfgsPairs& SimulatorImpl::empty_lbfgs_pairs() {
   const int capacity = options.lbfgs_history;
   if (!lbfgs_pairs_ || lbfgs_pairs_->capacity() != capacity || lbfgs_pairs_->dimension() != num_dofs())

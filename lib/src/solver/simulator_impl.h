@@ -2,8 +2,11 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <vector>
+
+#include <Eigen/SparseLU>
 
 #include "diffpd/rollout.h"
 #include "diffpd/scene.h"
@@ -14,8 +17,10 @@
 #include "fem/lame_field.h"
 #include "fem/mass_model.h"
 #include "forces/state_forces.h"
-#include "solver/cholmod_solver.h"
+#include "solver/adjoint_cost_model.h"
+#include "solver/adjoint_recycling.h"
 #include "solver/hessian_assembler.h"
+#include "solver/hessian_factorization.h"
 #include "solver/lbfgs_pairs.h"
 #include "solver/pd_system.h"
 
@@ -88,7 +93,17 @@ class SimulatorImpl {
   bool UseRigidModeCorrection(bool static_problem) const {
     return options.rigid_mode_correction && scene.dirichlet.dofs.empty() && !static_problem;
   }
-  CholmodSolver& newton_solver() { return newton_llt_; }
+  // The direct solver of assembled step Hessians for the current method:
+  // Newton's iterations, PD-LBFGS's Newton fallback and every direct
+  // adjoint or tangent solve (simplicial LDL^T for newton-ldlt, else
+  // CHOLMOD's supernodal Cholesky, its analysis kept across steps).
+  HessianFactorization& hessian_factorization();
+  // The measured costs behind AdjointSolver::kAuto: one model for the
+  // backward pass (one right-hand side per step) and one per number of
+  // tangent directions. Reset by ResetAdjointCostModels (SetOptions).
+  AdjointCostModel& backward_cost_model() { return backward_cost_; }
+  AdjointCostModel& tangent_cost_model(int directions) { return tangent_cost_[directions]; }
+  void ResetAdjointCostModels();
   int pd_factorizations() const { return pd_ ? pd_->num_factorizations() : 0; }
   double pd_factorization_seconds() const { return pd_ ? pd_->factorization_seconds() : 0.0; }
 
@@ -100,7 +115,9 @@ class SimulatorImpl {
   std::unique_ptr<HessianAssembler> hessian_;
   std::unique_ptr<PdSystem> pd_;
   std::unique_ptr<LbfgsPairs> lbfgs_pairs_;
-  CholmodSolver newton_llt_;
+  std::unique_ptr<HessianFactorization> hessian_factorization_;
+  AdjointCostModel backward_cost_;
+  std::map<int, AdjointCostModel> tangent_cost_;
 };
 
 // True when `rollout` was made with the simulator's current materials (base
@@ -188,20 +205,31 @@ class StepObjective {
 
 // Exact Hessian of one step's objective at a point, over the free DoFs,
 // solved for one or several right-hand sides by the method's own machinery
-// (direct factorisation for Newton; PD-preconditioned iteration with a
-// direct fallback for PD and PD-LBFGS).
+// (step_linearization.cc): a direct factorisation for newton-cholesky and
+// newton-ldlt, PCG for newton-pcg; for PD and PD-LBFGS the PD-preconditioned
+// iteration (with a direct fallback), a direct factorisation, or either per
+// step by measured cost (SolverOptions::adjoint_solver).
 class StepLinearization {
  public:
   StepLinearization(SimulatorImpl& sim, const VectorXd& x, bool static_problem = false);
-  // Solves H z = b (3n; fixed entries of b ignored, of z zero). Throws
+  ~StepLinearization();
+  // Relative residual ||H z - b|| / ||b|| of the iterative solves (default:
+  // SolverOptions::backward_rel_tolerance).
+  void set_rel_tolerance(double rel_tolerance) { rel_tolerance_ = rel_tolerance; }
+  // The previous steps' solutions (not owned; nullptr: none): the iteration
+  // starts from their Galerkin guess, and the solution is added to them.
+  void set_recycling(AdjointRecycling* recycling) { recycling_ = recycling; }
+  // Solves H z = b (3n; fixed entries of b ignored, of z zero): one adjoint
+  // step (the simulator's backward cost model, AdjointSolver::kAuto). Throws
   // SolverError(kNonFinite) for a b with a non-finite entry or a solution
   // that overflows (an adjoint or tangent beyond double precision),
   // kFactorizationFailed for a singular H.
   VectorXd Solve(const VectorXd& b, BackwardReport* report);
   // Solves H Z = B for the P columns of B (3n x P) together: PD methods
   // iterate all columns in lockstep with one batched A^{-1} solve per
-  // iteration; Newton methods reuse one factorisation. Columns whose
-  // iteration fails fall back to the direct solve (counted per column).
+  // iteration, or factorise H once; Newton methods reuse one factorisation.
+  // Columns whose iteration fails fall back to the direct solve (counted
+  // per column).
   MatrixXd SolveColumns(const MatrixXd& b, BackwardReport* report);
   // H z (3n, free rows only).
   VectorXd Apply(const VectorXd& z);
@@ -210,13 +238,17 @@ class StepLinearization {
   VectorXd ApplyUnmasked(const VectorXd& z);
 
  private:
-  // The packed elastic element Hessians at x_ (computed on first use).
+  // The packed element Hessians at x_ (computed on first use).
   const std::vector<double>& PackedBlocks();
   // Assembles matrix_ (elastic and auxiliary blocks, inertia) once.
   void AssembleMatrix();
-  // False for a singular H; throws SolverError(kNonFinite) when z overflows.
-  bool DirectSolve(const VectorXd& b, VectorXd* z);
-  bool IterativeSolve(const VectorXd& b, VectorXd* z, int* iterations);
+  // Solves by the route the method and options give (timing it into `model`
+  // when the model chose it); fills the report's counts.
+  MatrixXd SolveSystem(const MatrixXd& b, AdjointCostModel* model, bool tangent, BackwardReport* report);
+  // The simulator's HessianFactorization of H (factorised again if another
+  // solve used it since), sparse LU where H is indefinite. False for a
+  // singular H; throws SolverError(kNonFinite) when z overflows.
+  bool DirectSolve(const MatrixXd& b, MatrixXd* z);
   // The PD-preconditioned iteration (options.pd_backward) on the columns of
   // b in lockstep; ok[c] tells which converged.
   void IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, std::vector<char>* ok, int* iterations);
@@ -225,14 +257,19 @@ class StepLinearization {
   SimulatorImpl& sim_;
   VectorXd x_;
   bool static_;
+  double rel_tolerance_;
   VectorXd inertia_;
-  // Elastic element Hessians at x_, not projected, packed
-  // (ElasticForces::PackedElementHessians): every product with H uses them.
+  // Element Hessians at x_ of the elastic and the auxiliary energies, not
+  // projected, packed (ElasticForces::PackedElementHessians' layout): every
+  // product with H and the assembled H use them.
   std::vector<double> packed_blocks_;
   SparseMatrix matrix_;  // assembled exact H (lazily)
   bool have_matrix_ = false;
   bool factored_ = false;
-  std::unique_ptr<CholmodSolver> llt_;
+  int factor_id_ = -1;           // HessianFactorization::num_factorizations() after ours
+  double analysis_seconds_ = 0;  // symbolic analyses our factorisations made
+  AdjointRecycling* recycling_ = nullptr;
+  std::unique_ptr<Eigen::SparseLU<SparseMatrix>> lu_;
 };
 
 // Forward solvers of one implicit step. Each returns x_{i+1} and fills the

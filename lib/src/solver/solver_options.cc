@@ -11,8 +11,9 @@
 
 namespace diffpd {
 namespace {
-constexpr Method kMethods[] = {Method::kSemiImplicit, Method::kNewtonCholesky, Method::kNewtonPcg, Method::kPd,
-                               Method::kPdLbfgs};
+constexpr Method kMethods[] = {Method::kSemiImplicit, Method::kNewtonCholesky, Method::kNewtonPcg,
+                               Method::kPd,           Method::kPdLbfgs,        Method::kNewtonLdlt};
+constexpr AdjointSolver kAdjointSolvers[] = {AdjointSolver::kAuto, AdjointSolver::kIterative, AdjointSolver::kDirect};
 
 template <class T>
 [[noreturn]] void Reject(const char* field, T value, const char* range) {
@@ -34,8 +35,32 @@ const char* ToString(Method method) {
       return "pd";
     case Method::kPdLbfgs:
       return "pd-lbfgs";
+    case Method::kNewtonLdlt:
+      return "newton-ldlt";
   }
   return "unknown";
+}
+
+const char* ToString(AdjointSolver solver) {
+  switch (solver) {
+    case AdjointSolver::kAuto:
+      return "auto";
+    case AdjointSolver::kIterative:
+      return "iterative";
+    case AdjointSolver::kDirect:
+      return "direct";
+  }
+  return "unknown";
+}
+
+AdjointSolver ParseAdjointSolver(const std::string& name) {
+  std::string valid;
+  for (const AdjointSolver a : kAdjointSolvers) {
+    if (name == ToString(a)) return a;
+    valid += valid.empty() ? "" : ", ";
+    valid += ToString(a);
+  }
+  throw InvalidInputError("unknown adjoint solver '" + name + "': valid adjoint solvers are " + valid);
 }
 
 Method ParseMethod(const std::string& name) {
@@ -53,7 +78,7 @@ int MaxSolverThreads() { return 4 * omp_get_num_procs(); }
 void SolverOptions::Validate() const {
   if (std::find(std::begin(kMethods), std::end(kMethods), method) == std::end(kMethods))
     Reject("method", static_cast<int>(method),
-           "a Method: semi-implicit (0), newton-cholesky (1), newton-pcg (2), pd (3) or pd-lbfgs (4)");
+           "a Method: semi-implicit (0), newton-cholesky (1), newton-pcg (2), pd (3), pd-lbfgs (4) or newton-ldlt (5)");
   if (pcg_preconditioner != PcgPreconditioner::kJacobi && pcg_preconditioner != PcgPreconditioner::kIncompleteCholesky)
     Reject("pcg_preconditioner", static_cast<int>(pcg_preconditioner), "kJacobi (0) or kIncompleteCholesky (1)");
   if (pd_backward != PdBackwardMethod::kFixedPoint && pd_backward != PdBackwardMethod::kLbfgs &&
@@ -73,9 +98,14 @@ void SolverOptions::Validate() const {
   if (lbfgs_history < 1) Reject("lbfgs_history", lbfgs_history, ">= 1");
   if (!(lbfgs_weight_scale > 0 && lbfgs_weight_scale <= 1))
     Reject("lbfgs_weight_scale", lbfgs_weight_scale, "in (0, 1]");
-  if (!(backward_rel_tolerance > 0 && backward_rel_tolerance < 1))
-    Reject("backward_rel_tolerance", backward_rel_tolerance, "in (0, 1)");
+  if (!(backward_rel_tolerance >= 0 && backward_rel_tolerance < 1))
+    Reject("backward_rel_tolerance", backward_rel_tolerance, "in [0, 1) (0: derived from the forward's accuracy)");
+  if (!(backward_tolerance_factor > 0 && backward_tolerance_factor <= 1))
+    Reject("backward_tolerance_factor", backward_tolerance_factor, "in (0, 1]");
+  if (std::find(std::begin(kAdjointSolvers), std::end(kAdjointSolvers), adjoint_solver) == std::end(kAdjointSolvers))
+    Reject("adjoint_solver", static_cast<int>(adjoint_solver), "kAuto (0), kIterative (1) or kDirect (2)");
   if (backward_max_iterations < 1) Reject("backward_max_iterations", backward_max_iterations, ">= 1");
+  if (adjoint_guess_solutions < 0) Reject("adjoint_guess_solutions", adjoint_guess_solutions, ">= 0");
   if (!(max_extent_ratio > 1)) Reject("max_extent_ratio", max_extent_ratio, "> 1 (infinity: no bound)");
   if (num_threads < 0 || num_threads > MaxSolverThreads()) {
     std::ostringstream range;

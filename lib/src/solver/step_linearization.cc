@@ -1,44 +1,68 @@
 // Linear solves with the exact Hessian of one step, H = M/h^2 + hess E(x),
 // used by the backward (adjoint) and forward-mode (tangent) passes.
 //
-// Newton methods assemble H and factorise it (CHOLMOD, or PCG for
-// newton-pcg). PD methods never assemble H: they apply it element by element
-// and iterate with the forward factor of A as preconditioner
-// (preconditioned_iteration.h: CG, the DiffPD fixed point or L-BFGS).
-// Residual growth, stagnation or negative curvature triggers a reported
-// fallback to a direct solve of the assembled H (CHOLMOD, then sparse LU
-// when H is indefinite).
+// Newton methods assemble H and factorise it (the simulator's
+// HessianFactorization: CHOLMOD, or simplicial LDL^T for newton-ldlt), or
+// solve it by PCG (newton-pcg). PD methods, by SolverOptions::adjoint_solver,
+// either apply H element by element and iterate with the forward factor of A
+// as preconditioner (preconditioned_iteration.h: CG, the DiffPD fixed point
+// or L-BFGS), or factorise the assembled H like Newton, or choose between
+// the two per step by their measured costs (adjoint_cost_model.h).
+// Residual growth, stagnation or negative curvature of the iteration
+// triggers a reported fallback to the direct solve (sparse LU when H is
+// indefinite).
+#include <chrono>
 #include <cstdio>
 #include <optional>
+#include <string>
 
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseLU>
 
 #include "diffpd/error.h"
+#include "solver/adjoint_recycling.h"
 #include "solver/preconditioned_iteration.h"
 #include "solver/rigid_mode_correction.h"
 #include "solver/simulator_impl.h"
 
 namespace diffpd::internal {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+bool IsPdMethod(Method m) { return m == Method::kPd || m == Method::kPdLbfgs; }
+
+}  // namespace
 
 StepLinearization::StepLinearization(SimulatorImpl& sim, const VectorXd& x, bool static_problem)
-    : sim_(sim), x_(x), static_(static_problem) {
+    : sim_(sim), x_(x), static_(static_problem), rel_tolerance_(sim.options.backward_rel_tolerance) {
   inertia_ = static_problem ? VectorXd::Zero(sim.num_dofs()) : VectorXd(sim.Mass() / (sim.h() * sim.h()));
-  const Method m = sim.options.method;
-  if (m == Method::kPd || m == Method::kPdLbfgs) PackedBlocks();
 }
 
+StepLinearization::~StepLinearization() = default;
+
 const std::vector<double>& StepLinearization::PackedBlocks() {
-  if (packed_blocks_.empty()) sim_.elastic.PackedElementHessians(x_, sim_.lame(), &packed_blocks_, sim_.threads());
+  if (!packed_blocks_.empty()) return packed_blocks_;
+  sim_.elastic.PackedElementHessians(x_, sim_.lame(), &packed_blocks_, sim_.threads());
+  if (!sim_.aux.empty()) {
+    // The auxiliary energies' element Hessians (muscles, penalty contact)
+    // join the packed elastic ones: one packed product per application of
+    // H instead of recomputing every muscle sample's Hessian each time (on
+    // the paper's tendon, a muscle in every element, that product took 3-10x
+    // the packed one).
+    const size_t block = 9 * static_cast<size_t>(sim_.fem.nodes_per_element()) * sim_.fem.nodes_per_element();
+    std::vector<double> aux(block * sim_.fem.num_elements(), 0.0), packed_aux;
+    sim_.aux.AddElementHessians(x_, sim_.activation, /*project_spd=*/false, &aux);
+    sim_.elastic.PackElementMatrices(aux, &packed_aux);
+    Eigen::Map<VectorXd>(packed_blocks_.data(), packed_blocks_.size()) +=
+        Eigen::Map<const VectorXd>(packed_aux.data(), packed_aux.size());
+  }
   return packed_blocks_;
 }
 
 void StepLinearization::AssembleMatrix() {
   if (have_matrix_) return;
-  std::vector<double> blocks;
-  sim_.elastic.ElementHessians(x_, sim_.lame(), /*project_spd=*/false, &blocks, sim_.threads());
-  sim_.aux.AddElementHessians(x_, sim_.activation, /*project_spd=*/false, &blocks);
-  sim_.hessian_assembler().Assemble(blocks, inertia_, sim_.fixed, &matrix_);
+  sim_.hessian_assembler().AssemblePacked(PackedBlocks(), {}, inertia_, sim_.fixed, &matrix_);
   have_matrix_ = true;
 }
 
@@ -52,29 +76,35 @@ VectorXd StepLinearization::ApplyUnmasked(const VectorXd& z) {
   VectorXd zf = z;
   sim_.ZeroFixed(&zf);
   VectorXd out;
-  sim_.elastic.ApplyElementMatrices(PackedBlocks(), zf, &out, sim_.threads());
-  sim_.aux.AddHessianProduct(x_, sim_.activation, zf, &out);
+  sim_.elastic.ApplyElementMatrices(PackedBlocks(), zf, &out, sim_.threads());  // elastic and auxiliary
   out.array() += inertia_.array() * zf.array();
   return out;
 }
 
-bool StepLinearization::DirectSolve(const VectorXd& b, VectorXd* z) {
-  if (!llt_) {
+bool StepLinearization::DirectSolve(const MatrixXd& b, MatrixXd* z) {
+  HessianFactorization& factor = sim_.hessian_factorization();
+  if (!(factored_ && factor_id_ == factor.num_factorizations()) && !lu_) {
+    // Not factorised yet, or another solve has factorised since.
     AssembleMatrix();
-    llt_ = std::make_unique<CholmodSolver>();
-    factored_ = llt_->Factorize(matrix_);
+    factored_ = factor.Factorize(matrix_);
+    factor_id_ = factor.num_factorizations();
+    analysis_seconds_ += factor.analysis_seconds();
+    if (!factored_) {  // indefinite H (e.g. strongly compressed elements): sparse LU
+      lu_ = std::make_unique<Eigen::SparseLU<SparseMatrix>>();
+      lu_->compute(matrix_);
+      if (lu_->info() != Eigen::Success) return false;
+    }
   }
-  VectorXd rhs = b;
-  sim_.ZeroFixed(&rhs);
-  if (factored_) {
-    *z = llt_->Solve(rhs);
-  } else {  // indefinite H (e.g. strongly compressed elements): sparse LU
-    Eigen::SparseLU<SparseMatrix> lu;
-    lu.compute(matrix_);
-    if (lu.info() != Eigen::Success) return false;
-    *z = lu.solve(rhs);
+  MatrixXd rhs = b;
+  for (int d = 0; d < rhs.rows(); ++d)
+    if (sim_.fixed[d]) rhs.row(d).setZero();
+  if (lu_) {
+    *z = lu_->solve(rhs);
+  } else {
+    *z = factor.Solve(rhs);
   }
-  sim_.ZeroFixed(z);
+  for (int d = 0; d < z->rows(); ++d)
+    if (sim_.fixed[d]) z->row(d).setZero();
   // A finite b whose solution overflows: the derivative exceeds double
   // precision, not a singular H.
   if (!z->allFinite()) throw SolverError(SolverStatus::kNonFinite, "the solution of H z = b overflowed");
@@ -89,7 +119,7 @@ void StepLinearization::IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, st
     if (sim_.fixed[d]) rhs.row(d).setZero();
   PreconditionedSolveOptions iteration;
   iteration.method = opt.pd_backward;
-  iteration.rel_tolerance = opt.backward_rel_tolerance;
+  iteration.rel_tolerance = rel_tolerance_;
   iteration.max_iterations = opt.backward_max_iterations;
   iteration.lbfgs_history = opt.lbfgs_history;
   // A^-1, plus the rigid modes' correction (rigid_mode_correction.h) for the
@@ -101,22 +131,31 @@ void StepLinearization::IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, st
     for (int k = 0; k < RigidModeCorrection::kModes; ++k) hz.col(k) = Apply(rigid->modes().col(k));
     rigid->SetHessianProducts(hz);
   }
+  const std::function<VectorXd(const VectorXd&)> apply_h = [this](const VectorXd& v) { return Apply(v); };
+  // From the Galerkin guess on the previous steps' solutions when there are
+  // any: the iteration solves for the correction, to the tolerance relative
+  // to the right-hand side itself.
+  MatrixXd guess, residual;
+  const bool guessed = recycling_ && recycling_->size() > 0;
+  if (guessed) {
+    recycling_->Guess(rhs, apply_h, &guess, &residual);
+    // Earlier steps may have other fixed DoFs (contact pins): H W was formed
+    // with them zeroed (Apply), so zeroing them in the guess keeps r0 exact.
+    for (int d = 0; d < guess.rows(); ++d)
+      if (sim_.fixed[d]) guess.row(d).setZero();
+    iteration.reference_norms = rhs.colwise().norm().transpose();
+  }
   SolvePreconditioned(
-      iteration, rhs, [this](const VectorXd& v) { return Apply(v); },
+      iteration, guessed ? residual : rhs, apply_h,
       [&pd, &rigid](const MatrixXd& r) {
         MatrixXd out = pd.Solve(r);
         if (rigid) rigid->Add(r, &out);
         return out;
       },
       z, ok, iterations);
-}
-
-bool StepLinearization::IterativeSolve(const VectorXd& b, VectorXd* z, int* iterations) {
-  MatrixXd zs;
-  std::vector<char> ok;
-  IterativeSolveColumns(b, &zs, &ok, iterations);
-  *z = zs.col(0);
-  return ok[0] != 0;
+  if (guessed)
+    for (int c = 0; c < z->cols(); ++c)
+      if ((*ok)[c]) z->col(c) += guess.col(c);
 }
 
 bool StepLinearization::PcgSolve(const VectorXd& b, VectorXd* z, int* iterations) {
@@ -124,7 +163,7 @@ bool StepLinearization::PcgSolve(const VectorXd& b, VectorXd* z, int* iterations
   VectorXd rhs = b;
   sim_.ZeroFixed(&rhs);
   Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>> cg;
-  cg.setTolerance(sim_.options.backward_rel_tolerance);
+  cg.setTolerance(rel_tolerance_);
   cg.setMaxIterations(sim_.options.pcg_max_iterations);
   cg.compute(matrix_);
   if (cg.info() != Eigen::Success) return false;
@@ -135,47 +174,46 @@ bool StepLinearization::PcgSolve(const VectorXd& b, VectorXd* z, int* iterations
 }
 
 VectorXd StepLinearization::Solve(const VectorXd& b, BackwardReport* report) {
-  VectorXd z;
-  const Method m = sim_.options.method;
-  if (!b.allFinite()) throw SolverError(SolverStatus::kNonFinite, "the right-hand side b is not finite");
-  int iterations = 0;
-  bool ok = false;
-  bool iterative = false;
-  if (m == Method::kPd || m == Method::kPdLbfgs) {
-    iterative = true;
-    ok = IterativeSolve(b, &z, &iterations);
-  } else if (m == Method::kNewtonPcg) {
-    iterative = true;
-    ok = PcgSolve(b, &z, &iterations);
-  }
-  if (report) report->linear_iterations += iterations;
-  if (ok) return z;
-  if (iterative) {
-    if (report) ++report->fallbacks;
-    if (sim_.options.verbosity >= 1)
-      std::fprintf(stderr,
-                   "%s backward: iterative adjoint solve failed after %d iterations; falling back to a direct solve\n",
-                   ToString(m), iterations);
-  }
-  if (!DirectSolve(b, &z))
-    throw SolverError(SolverStatus::kFactorizationFailed,
-                      std::string(ToString(m)) + " backward: the step Hessian is singular; no gradient exists here");
-  return z;
+  return SolveSystem(b, &sim_.backward_cost_model(), /*tangent=*/false, report).col(0);
 }
 
 MatrixXd StepLinearization::SolveColumns(const MatrixXd& b, BackwardReport* report) {
+  return SolveSystem(b, &sim_.tangent_cost_model(static_cast<int>(b.cols())), /*tangent=*/true, report);
+}
+
+MatrixXd StepLinearization::SolveSystem(const MatrixXd& b, AdjointCostModel* model, bool tangent,
+                                        BackwardReport* report) {
+  const auto start = Clock::now();
+  analysis_seconds_ = 0;
   const Method m = sim_.options.method;
-  if (!b.allFinite()) throw SolverError(SolverStatus::kNonFinite, "the right-hand sides B are not finite");
+  const char* pass = tangent ? "tangent" : "backward";
+  if (!b.allFinite())
+    throw SolverError(SolverStatus::kNonFinite,
+                      tangent ? "the right-hand sides B are not finite" : "the right-hand side b is not finite");
   const int cols = static_cast<int>(b.cols());
   MatrixXd z = MatrixXd::Zero(b.rows(), cols);
   std::vector<char> ok(cols, 0);
   int iterations = 0;
-  bool iterative = false;
-  if (m == Method::kPd || m == Method::kPdLbfgs) {
-    iterative = true;
+  // The route: Newton methods their own solver, PD methods by adjoint_solver.
+  bool iterative = m == Method::kNewtonPcg;
+  bool chosen = false;  // by the cost model
+  if (IsPdMethod(m)) {
+    switch (sim_.options.adjoint_solver) {
+      case AdjointSolver::kIterative:
+        iterative = true;
+        break;
+      case AdjointSolver::kDirect:
+        iterative = false;
+        break;
+      case AdjointSolver::kAuto:
+        iterative = model->Next() == AdjointCostModel::Solver::kIterative;
+        chosen = true;
+        break;
+    }
+  }
+  if (iterative && IsPdMethod(m)) {
     IterativeSolveColumns(b, &z, &ok, &iterations);
-  } else if (m == Method::kNewtonPcg) {
-    iterative = true;
+  } else if (iterative) {
     for (int c = 0; c < cols; ++c) {
       VectorXd zc;
       int it = 0;
@@ -185,19 +223,41 @@ MatrixXd StepLinearization::SolveColumns(const MatrixXd& b, BackwardReport* repo
     }
   }
   if (report) report->linear_iterations += iterations;
-  for (int c = 0; c < cols; ++c) {
-    if (ok[c]) continue;
+  std::vector<int> rest;  // columns left to the direct solve
+  for (int c = 0; c < cols; ++c)
+    if (!ok[c]) rest.push_back(c);
+  if (!rest.empty()) {
     if (iterative) {
-      if (report) ++report->fallbacks;
-      if (sim_.options.verbosity >= 1)
-        std::fprintf(stderr, "%s tangent: iterative solve of column %d failed; falling back to a direct solve\n",
-                     ToString(m), c);
+      if (report) report->fallbacks += static_cast<int>(rest.size());
+      if (sim_.options.verbosity >= 1) {
+        if (tangent) {
+          for (const int c : rest)
+            std::fprintf(stderr, "%s tangent: iterative solve of column %d failed; falling back to a direct solve\n",
+                         ToString(m), c);
+        } else {
+          std::fprintf(
+              stderr,
+              "%s backward: iterative adjoint solve failed after %d iterations; falling back to a direct solve\n",
+              ToString(m), iterations);
+        }
+      }
     }
-    VectorXd zc;
-    if (!DirectSolve(b.col(c), &zc))
-      throw SolverError(SolverStatus::kFactorizationFailed,
-                        std::string(ToString(m)) + " tangent: the step Hessian is singular; no derivative exists here");
-    z.col(c) = zc;
+    MatrixXd rhs(b.rows(), static_cast<Eigen::Index>(rest.size()));
+    for (size_t j = 0; j < rest.size(); ++j) rhs.col(j) = b.col(rest[j]);
+    MatrixXd solved;
+    if (!DirectSolve(rhs, &solved))
+      throw SolverError(SolverStatus::kFactorizationFailed, std::string(ToString(m)) + " " + pass +
+                                                                ": the step Hessian is singular; no " +
+                                                                (tangent ? "derivative" : "gradient") + " exists here");
+    for (size_t j = 0; j < rest.size(); ++j) z.col(rest[j]) = solved.col(j);
+  }
+  if (report) ++(iterative ? report->iterative_steps : report->direct_steps);
+  if (recycling_) recycling_->Push(z);
+  if (chosen) {
+    // The one-off symbolic analysis is not a per-step cost.
+    const double seconds = std::chrono::duration<double>(Clock::now() - start).count() - analysis_seconds_;
+    model->Record(iterative ? AdjointCostModel::Solver::kIterative : AdjointCostModel::Solver::kDirect,
+                  std::max(seconds, 0.0));
   }
   return z;
 }

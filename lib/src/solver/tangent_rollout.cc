@@ -32,6 +32,7 @@
 #include "diffpd/tangent_rollout.h"
 #include "contact/active_set_step.h"
 #include "forces/activation_scope.h"
+#include "solver/adjoint_tolerance.h"
 #include "solver/rollout_checks.h"
 #include "solver/simulator_impl.h"
 
@@ -271,6 +272,8 @@ TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std
     }
   };
 
+  // The tangents solved so far: the next step's initial guess.
+  internal::AdjointRecycling recycling(sim.options.adjoint_guess_solutions);
   for (int i = 0; i < steps; ++i) {
     const State& s0 = rollout.states[i];
     const State& s1 = rollout.states[i + 1];
@@ -309,6 +312,10 @@ TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std
       std::optional<internal::ContactPinScope> pins;
       if (!pinned.empty()) pins.emplace(sim, pinned, s1.x);
       internal::StepLinearization lin(sim, s1.x);
+      lin.set_recycling(&recycling);
+      lin.set_rel_tolerance(internal::AdjointRelTolerance(
+          sim.options, rollout.options.rel_tolerance,
+          static_cast<int>(rollout.reports.size()) == steps ? &rollout.reports[i] : nullptr));
       dx1 = lin.SolveColumns(b, &out.report) + dpin;  // zero at fixed DoFs but the pins
     } else {
       // Acceleration tangent on free DoFs, then symplectic update.

@@ -160,6 +160,33 @@ TEST(BenchTest, PdErrorAtRtol1e4IsBoundedAndShrinksWithTheTolerance) {
   EXPECT_LT(tight, loose / 30);
 }
 
+TEST(BenchTest, SpeedupsAreAgainstTheBestNewtonAndThePaperStyleLdltWhichMatchesCholesky) {
+  BenchOptions o = TinyCantilever();
+  o.methods = {Method::kPdLbfgs, Method::kNewtonPcg, Method::kNewtonCholesky, Method::kNewtonLdlt};
+  const BenchResult r = RunBench("cantilever", o);
+  ASSERT_EQ(r.rows.size(), 4u);
+  const auto total = [&r](const char* method) { return Row(r, method).forward_s + Row(r, method).backward_s; };
+  const double best = std::min(total("newton-cholesky"), total("newton-pcg"));
+  for (const auto& row : r.rows) {
+    ASSERT_TRUE(row.failure.empty()) << row.method << ": " << row.failure;
+    const double own = row.forward_s + row.backward_s;
+    ASSERT_TRUE(row.speedup_vs_best_newton.has_value()) << row.method;
+    ASSERT_TRUE(row.speedup_vs_newton_ldlt.has_value()) << row.method;
+    EXPECT_DOUBLE_EQ(*row.speedup_vs_best_newton, best / own) << row.method;
+    EXPECT_DOUBLE_EQ(*row.speedup_vs_newton_ldlt, total("newton-ldlt") / own) << row.method;
+    // Every backward step is counted once, as iterative or as direct.
+    EXPECT_EQ(row.backward_iterative_steps + row.backward_direct_steps, r.steps) << row.method;
+  }
+  // The paper's Newton is the same Newton with another factorisation: the
+  // same iterations and, to rounding, the same state and gradient errors.
+  const BenchRow& ldlt = Row(r, "newton-ldlt");
+  const BenchRow& cholesky = Row(r, "newton-cholesky");
+  EXPECT_EQ(ldlt.backward_direct_steps, r.steps);
+  EXPECT_EQ(ldlt.iters_per_step, cholesky.iters_per_step);
+  EXPECT_NEAR(ldlt.state_rel_error, cholesky.state_rel_error, 1e-6 * cholesky.state_rel_error);
+  EXPECT_NEAR(ldlt.grad_rel_error, cholesky.grad_rel_error, 1e-6 * cholesky.grad_rel_error);
+}
+
 TEST(BenchTest, JsonIsAListWithTheRequiredFields) {
   BenchOptions o = TinyCantilever();
   o.methods = {Method::kPdLbfgs, Method::kNewtonCholesky};
@@ -171,7 +198,8 @@ TEST(BenchTest, JsonIsAListWithTheRequiredFields) {
     for (const char* field :
          {"forward_s", "backward_s", "iters_per_step", "state_rel_error", "grad_rel_error", "forward_per_iteration_ms",
           "factorization_s", "speedup_vs_newton_cholesky", "backward_iters_per_step", "backward_fallbacks",
-          "rounding_floor_steps", "newton_fallback_steps"})
+          "rounding_floor_steps", "newton_fallback_steps", "speedup_vs_best_newton", "backward_iterative_steps",
+          "backward_direct_steps"})
       EXPECT_TRUE(row.at(field).is_number()) << field;
     EXPECT_TRUE(row.at("method").is_string());
     EXPECT_EQ(row.at("status"), "ok");
