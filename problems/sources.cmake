@@ -13,6 +13,7 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/scenes/bouncing_ball.cc
   ${CMAKE_CURRENT_LIST_DIR}/scenes/routing_tendon.cc
   # tools
+  ${CMAKE_CURRENT_LIST_DIR}/tools/derivative_verdict.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/gradcheck.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/bench.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/tradeoff.cc
