@@ -36,7 +36,8 @@ CheckVerdict Worse(CheckVerdict a, CheckVerdict b) { return Rank(a) >= Rank(b) ?
 DerivativeJudgement JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences,
                                     double tolerance) {
   if (differences.empty()) throw std::invalid_argument("JudgeDerivative: no differences");
-  if (!(tolerance > 0)) throw std::invalid_argument("JudgeDerivative: tolerance = " + Format(tolerance) + " must be > 0");
+  if (!(tolerance > 0))
+    throw std::invalid_argument("JudgeDerivative: tolerance = " + Format(tolerance) + " must be > 0");
   const size_t n = differences.size();
   // The uncertainty of fd(e_k) (see the header); the smallest step only
   // probes its neighbour's noise unless it is the only one.

@@ -68,7 +68,8 @@ TEST(DerivativeVerdictTest, ACorrectDerivativeUnderLargeNoiseIsUnresolvedWithThe
 TEST(DerivativeVerdictTest, AWrongDerivativeFailsUnderTheSameNoise) {
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {
     // 1e-3 relative off: resolved by differences good to 1e-7.
-    const DerivativeJudgement small_noise = JudgeDerivative(DF(0.4) * (1 + 1e-3), Differences(F, 0.4, 1e-13, 6, seed), 1e-4);
+    const DerivativeJudgement small_noise =
+        JudgeDerivative(DF(0.4) * (1 + 1e-3), Differences(F, 0.4, 1e-13, 6, seed), 1e-4);
     EXPECT_EQ(small_noise.verdict, CheckVerdict::kFail);
     EXPECT_GT(small_noise.error, 9e-4);
     EXPECT_LT(small_noise.margin, 1.0);

@@ -78,8 +78,7 @@ TEST(GradCheckTest, AnInaccurateAdjointFails) {
   bool reference_named = false;
   for (const auto& e : r.inputs)
     if (e.verdict == CheckVerdict::kFail)
-      reference_named =
-          reference_named || e.reason.rfind("differs from the Newton-Cholesky reference by ", 0) == 0;
+      reference_named = reference_named || e.reason.rfind("differs from the Newton-Cholesky reference by ", 0) == 0;
   EXPECT_TRUE(reference_named) << GradCheckTable(r);
   // Without the reference, the differences alone catch it.
   GradCheckOptions no_reference;
@@ -115,13 +114,15 @@ TEST(GradCheckTest, InvalidOptionsAreRefusedWithExactMessages) {
   EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }), "directions = 0 is invalid: must be >= 1");
   o = GradCheckOptions();
   o.tolerance = -1;
-  EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }), "tolerance = -1 is invalid: must be finite and > 0");
+  EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }),
+            "tolerance = -1 is invalid: must be finite and > 0");
   o = GradCheckOptions();
   o.step_count = 1;
   EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }), "step_count = 1 is invalid: must be >= 2");
   o = GradCheckOptions();
   o.reference_rel_tolerance = 1;
-  EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }), "reference_rel_tolerance = 1 is invalid: must be in (0, 1)");
+  EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }),
+            "reference_rel_tolerance = 1 is invalid: must be in (0, 1)");
 }
 
 }  // namespace
