@@ -36,9 +36,9 @@
 // rel_tolerance reference_rel_tolerance is compared too, per direction:
 // a reference error above the tolerance fails the input (the adjoint, not
 // the differences, is wrong) unless the differences are unresolved (the
-// forward's noise swamps the derivative, and the method's gradient is that
-// of its inexact trajectory): then the input stays unresolved and the
-// reason gives both. Differences that are unresolved while the
+// forward's noise or its residuals' worst case covers the derivative, and
+// the method's gradient is that of its inexact trajectory): then the input
+// stays unresolved and the reason gives both. Differences that are unresolved while the
 // reference agrees point at a noisy forward, not a wrong gradient.
 #pragma once
 
