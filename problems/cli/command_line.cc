@@ -103,6 +103,7 @@ rel_tolerance 1e-12 (the reference column). Exit code 4 when an input fails.)");
   const auto tradeoff = AddTradeoffCommand(&app);
   const auto stress = AddStressCommand(&app);
   const auto synth = AddSynthCommand(&app);
+  const auto table = AddTableCommand(&app);
 
   try {
     // CLI11 wants argv in reverse order, without the program name.
@@ -134,6 +135,7 @@ rel_tolerance 1e-12 (the reference column). Exit code 4 when an input fails.)");
     if (*tradeoff.app) return tradeoff.run();
     if (*stress.app) return stress.run();
     if (*synth.app) return synth.run();
+    if (*table.app) return table.run();
   } catch (const InvalidInputError& e) {
     std::fprintf(stderr, "diffpd: invalid input: %s\n", e.what());
     return 2;
