@@ -78,6 +78,27 @@ int RunCommandLine(const std::vector<std::string>& argv) {
 
   CLI::App* grad = app.add_subcommand("gradcheck", "compare rollout gradients with central finite differences");
   AddCommonOptions(grad, &grad_args, &grad_method);
+  GradCheckOptions grad_check;
+  grad->add_option("--tol", grad_check.tolerance, "relative tolerance of every verdict")
+      ->check(Positive("--tol"))
+      ->capture_default_str();
+  grad->add_option("--directions", grad_check.directions, "random directions per input kind")
+      ->check(IntegerAtLeast("--directions", 1))
+      ->capture_default_str();
+  bool grad_reference = false, grad_no_reference = false;
+  grad->add_flag("--reference", grad_reference,
+                 "also compare with a tightly converged Newton-Cholesky rollout's gradient (default for pd, pd-lbfgs, "
+                 "newton-pcg)");
+  grad->add_flag("--no-reference", grad_no_reference, "never compare with the Newton-Cholesky reference");
+  grad->footer(R"(
+Per input kind (x0, v0, external_force, activation, material and force
+parameters): the relative error of the gradient against central differences,
+the noise floor of the differences (from the forward's achieved residuals and
+from differences at several steps), the margin tolerance / max(error, floor)
+and a verdict: pass, fail, or unresolved (the differences cannot resolve the
+derivative to the tolerance; the reason gives the floor). For the iterative
+methods the gradient is also compared with a Newton-Cholesky rollout's at
+rel_tolerance 1e-12 (the reference column). Exit code 4 when an input fails.)");
   const auto bench = AddBenchCommand(&app);
   const auto tradeoff = AddTradeoffCommand(&app);
   const auto stress = AddStressCommand(&app);
@@ -104,7 +125,11 @@ int RunCommandLine(const std::vector<std::string>& argv) {
     }
     if (*grad) {
       grad_args.method = ParseMethod(grad_method);
-      return GradcheckCommand(grad_args);
+      if (grad_reference && grad_no_reference)
+        throw InvalidInputError("--reference and --no-reference exclude each other: give one");
+      if (grad_reference) grad_check.reference = true;
+      if (grad_no_reference) grad_check.reference = false;
+      return GradcheckCommand(grad_args, grad_check);
     }
     if (*bench.app) return bench.run();
     if (*tradeoff.app) return tradeoff.run();

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "diffpd/solver_options.h"
+#include "tools/gradcheck.h"
 
 namespace CLI {
 class App;
@@ -54,7 +55,9 @@ struct CommandArgs {
 
 int ListCommand(bool json);
 int RunCommand(const CommandArgs& args);
-int GradcheckCommand(const CommandArgs& args);
+// `diffpd gradcheck`: the check's own options in `check`; --rtol defaults to
+// RecommendedGradCheckRelTolerance(method). Exit code 4 when an input fails.
+int GradcheckCommand(const CommandArgs& args, const GradCheckOptions& check);
 
 // A subcommand that declares its own options: `app` is the CLI11 subcommand
 // (true once parsed), `run` runs it after parsing.

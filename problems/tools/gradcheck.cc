@@ -2,10 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
+#include <limits>
 #include <random>
 
+#include "cli/invalid_option.h"
+#include "diffpd/error.h"
 #include "diffpd/simulator.h"
+#include "tools/stress.h"
 
 namespace diffpd::problems {
 namespace {
@@ -17,186 +22,360 @@ VectorXd RandomVector(std::mt19937_64* rng, Eigen::Index n) {
   return v;
 }
 
-double RelativeError(double a, double b) {
-  const double scale = std::max({std::abs(a), std::abs(b), 1e-300});
-  return std::abs(a - b) / scale;
+// Random, entries of unit root mean square.
+VectorXd Direction(std::mt19937_64* rng, Eigen::Index n) {
+  const VectorXd d = RandomVector(rng, n);
+  return d * (std::sqrt(double(n)) / d.norm());
 }
+
+bool UsesReferenceByDefault(Method m) { return m == Method::kPd || m == Method::kPdLbfgs || m == Method::kNewtonPcg; }
+
+std::string Format(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.2g", v);
+  return buffer;
+}
+
+// The losses of a check: the loss vectors, the baseline inputs and the
+// gradient of one method's rollout.
+struct Evaluation {
+  VectorXd cx, cv;
+  std::vector<StepInput> inputs;
+  RolloutGradient gradient;
+};
 
 }  // namespace
 
+void GradCheckOptions::Validate() const {
+  const auto fail = ThrowInvalidOption;
+  if (directions < 1) fail("directions", directions, ">= 1");
+  if (!(tolerance > 0 && std::isfinite(tolerance))) fail("tolerance", tolerance, "finite and > 0");
+  if (!(largest_step > 0 && std::isfinite(largest_step))) fail("largest_step", largest_step, "finite and > 0");
+  if (step_count < 2) fail("step_count", step_count, ">= 2");
+  if (!(reference_rel_tolerance > 0 && reference_rel_tolerance < 1))
+    fail("reference_rel_tolerance", reference_rel_tolerance, "in (0, 1)");
+}
+
+int GradCheckResult::Count(CheckVerdict v) const {
+  int count = 0;
+  for (const auto& e : inputs) count += e.verdict == v;
+  return count;
+}
+
+double RecommendedGradCheckRelTolerance(Method method) {
+  // The differences' measured floor stays far below the check's 1e-4 at
+  // these (measured on every problem, docs/benchmarks.md); PD converges
+  // linearly, so a looser tolerance saves most of its iterations.
+  return method == Method::kPd ? 1e-10 : 1e-11;
+}
+
 GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& options, const State& initial, int steps,
                                      const GradCheckOptions& check) {
+  check.Validate();
+  if (steps < 1) ThrowInvalidOption("steps", steps, ">= 1");
   std::mt19937_64 rng(check.seed);
   Simulator sim(scene, options);
   const int n = sim.num_dofs();
-  const VectorXd cx = RandomVector(&rng, n), cv = RandomVector(&rng, n);
-  // A non-zero force baseline so that force and density gradients are generic.
-  std::vector<StepInput> inputs(steps);
-  const double node_force = sim.LumpedMass().maxCoeff() * 9.81;
-  for (auto& in : inputs) in.external_force = 0.1 * node_force * RandomVector(&rng, n);
+  const double h = options.time_step;
+  const VectorXd mass = sim.LumpedMass();
+  Evaluation base;
+  base.cx = RandomVector(&rng, n);
+  base.cv = RandomVector(&rng, n);
+  base.inputs.resize(steps);
+  const double node_force = mass.maxCoeff() * 9.81;
+  for (auto& in : base.inputs) in.external_force = 0.1 * node_force * RandomVector(&rng, n);
   const int num_muscles = static_cast<int>(scene.muscles.size());
   if (num_muscles > 0)
-    for (auto& in : inputs)
+    for (auto& in : base.inputs)
       in.activation = VectorXd::Constant(num_muscles, 0.9) + 0.02 * RandomVector(&rng, num_muscles);
-
-  auto loss = [&](Simulator& s, const State& init, const std::vector<StepInput>& in) {
-    const Rollout r = s.Simulate(init, in);
-    return cx.dot(r.states.back().x) + cv.dot(r.states.back().v);
-  };
-  const Rollout rollout = sim.Simulate(initial, inputs);
+  const std::vector<StepInput>& inputs = base.inputs;
+  const VectorXd &cx = base.cx, &cv = base.cv;
+  auto loss_of = [&](const State& last) { return cx.dot(last.x) + cv.dot(last.v); };
   LossGradient dl(steps);
   dl.dx[steps] = cx;
   dl.dv[steps] = cv;
+  const Rollout rollout = sim.Simulate(initial, inputs);
   const RolloutGradient grad = sim.Backward(rollout, dl);
 
   GradCheckResult result;
-  auto record = [&](const std::string& name, long entries, const std::function<double(double)>& perturbed_loss,
-                    double analytic, double eps) {
-    GradCheckEntry* entry = nullptr;
+  result.method = ToString(options.method);
+  result.tolerance = check.tolerance;
+  result.reference = check.reference.value_or(UsesReferenceByDefault(options.method));
+  RolloutGradient reference;
+  if (result.reference) {
+    SolverOptions tight = options;
+    tight.method = Method::kNewtonCholesky;
+    tight.rel_tolerance = check.reference_rel_tolerance;
+    tight.backward_rel_tolerance = check.reference_rel_tolerance;
+    tight.abs_tolerance = std::min(options.abs_tolerance, AutoAbsTolerance(scene, h));
+    tight.max_iterations = std::max(options.max_iterations, 200);
+    try {
+      Simulator newton(scene, tight);
+      reference = newton.Backward(newton.Simulate(initial, inputs), dl);
+    } catch (const SolverError& e) {
+      result.reference = false;
+      result.reference_failure = std::string(ToString(e.status())) + ": " + e.what();
+    }
+  }
+
+  // Rounding of one evaluation of the loss and the worst case of its error
+  // from the solves (see the header).
+  const State& last = rollout.states.back();
+  const VectorXd loss_terms_v = cv.cwiseAbs().cwiseProduct(last.v.cwiseAbs() + last.x.cwiseAbs() / h);
+  const double rounding = std::numeric_limits<double>::epsilon() *
+                          std::sqrt(cx.cwiseProduct(last.x).squaredNorm() + loss_terms_v.squaredNorm());
+  double solve_error_x = 0;
+  for (const auto& rep : rollout.reports) solve_error_x += rep.final_residual * h * h / mass.minCoeff();
+  const double solve_bound = (cx.norm() + cv.norm() / h) * solve_error_x;
+  Eigen::Map<const Eigen::Matrix3Xd> x0(initial.x.data(), 3, n / 3);
+  const double size = (x0.rowwise().maxCoeff() - x0.rowwise().minCoeff()).norm();  // m
+
+  // One direction of one input kind: perturbed(e) is the loss with the input
+  // moved by e (units of its scale along the direction); analytic and
+  // reference are the derivatives along the same.
+  auto record = [&](const std::string& name, long entries, double analytic, double reference_value,
+                    const std::function<double(double)>& perturbed) {
+    GradCheckInput* entry = nullptr;
     for (auto& e : result.inputs)
       if (e.input == name) entry = &e;
     if (!entry) {
-      result.inputs.push_back(GradCheckEntry{name, 0.0, entries, 0});
+      GradCheckInput fresh;
+      fresh.input = name;
+      fresh.entries = entries;
+      fresh.margin = std::numeric_limits<double>::infinity();
+      fresh.reference_error = result.reference ? 0.0 : std::numeric_limits<double>::quiet_NaN();
+      result.inputs.push_back(fresh);
       entry = &result.inputs.back();
     }
-    const double fd = (perturbed_loss(eps) - perturbed_loss(-eps)) / (2 * eps);
-    entry->max_rel_error = std::max(entry->max_rel_error, RelativeError(fd, analytic));
-    ++entry->directions;
-  };
-  const double eps_pos = check.relative_step * 0.1;  // m (0.1 m body scale)
-  for (int k = 0; k < check.directions; ++k) {
-    const VectorXd dx = RandomVector(&rng, n).normalized();
-    record(
-        "x0", n,
-        [&](double e) {
-          State s = initial;
-          s.x += e * dx;
-          return loss(sim, s, inputs);
-        },
-        grad.x0.dot(dx), eps_pos);
-    const VectorXd dv = RandomVector(&rng, n).normalized();
-    record(
-        "v0", n,
-        [&](double e) {
-          State s = initial;
-          s.v += e * dv;
-          return loss(sim, s, inputs);
-        },
-        grad.v0.dot(dv), eps_pos / options.time_step);
-    std::vector<VectorXd> df(steps);
-    double analytic = 0;
-    for (int i = 0; i < steps; ++i) {
-      df[i] = RandomVector(&rng, n) * (node_force / std::sqrt(double(n * steps)));
-      analytic += grad.external_force[i].dot(df[i]);
+    std::vector<FiniteDifference> differences;
+    double e = check.largest_step;
+    for (int k = 0; k < check.step_count; ++k, e /= 10)
+      differences.push_back({e, (perturbed(e) - perturbed(-e)) / (2 * e), rounding / e, solve_bound / e});
+    const DerivativeJudgement j = JudgeDerivative(analytic, differences, check.tolerance);
+    CheckVerdict verdict = j.verdict;
+    std::string reason = j.reason;
+    if (result.reference) {
+      const double scale = std::max(std::abs(analytic), std::abs(reference_value));
+      const double ref_error = scale > 0 ? std::abs(analytic - reference_value) / scale : 0.0;
+      entry->reference_error = std::max(entry->reference_error, ref_error);
+      if (!(ref_error <= check.tolerance) && verdict != CheckVerdict::kUnresolved) {
+        verdict = CheckVerdict::kFail;
+        reason = "differs from the Newton-Cholesky reference by " + Format(ref_error) + " relative (tolerance " +
+                 Format(check.tolerance) + ")" + (reason.empty() ? "" : "; differences: " + reason);
+      } else if (!(ref_error <= check.tolerance)) {
+        // The differences are unresolved (the forward's noise, or its
+        // residuals' worst case, covers the disagreement): the method's
+        // gradient is that of its inexact trajectory and cannot be held to
+        // the converged one's either.
+        reason +=
+            "; differs from the Newton-Cholesky reference by " + Format(ref_error) + ", within the forward's noise";
+      } else if (verdict == CheckVerdict::kUnresolved) {
+        reason += "; agrees with the Newton-Cholesky reference to " + Format(ref_error);
+      }
     }
-    record(
-        "external_force", long(n) * steps,
-        [&](double e) {
-          std::vector<StepInput> in = inputs;
-          for (int i = 0; i < steps; ++i) in[i].external_force += e * df[i];
-          return loss(sim, initial, in);
-        },
-        analytic, 100 * check.relative_step);  // forces act almost linearly: a larger step beats rounding
+    const bool first = entry->directions == 0;
+    const bool strictly_worse = verdict != entry->verdict && Worse(verdict, entry->verdict) == verdict;
+    if (first || strictly_worse || (verdict == entry->verdict && j.margin < entry->margin)) {
+      entry->step = j.step;
+      entry->reason = reason;
+    }
+    ++entry->directions;
+    entry->error = std::max(entry->error, j.error);
+    entry->floor = std::max(entry->floor, j.floor);
+    entry->bound = std::max(entry->bound, j.bound);
+    entry->verdict = first ? verdict : Worse(entry->verdict, verdict);
+    entry->margin = std::min(entry->margin, j.margin);
+  };
+  auto reference_dot = [&](const std::function<double(const RolloutGradient&)>& along) {
+    return result.reference ? along(reference) : 0.0;
+  };
+  auto rollout_loss = [&](Simulator& s, const State& init, const std::vector<StepInput>& in) {
+    return loss_of(s.Simulate(init, in).states.back());
+  };
+
+  for (int k = 0; k < check.directions; ++k) {
+    const VectorXd dx = size * Direction(&rng, n);
+    auto along_x = [&](const RolloutGradient& g) { return g.x0.dot(dx); };
+    record("x0", n, along_x(grad), reference_dot(along_x), [&](double e) {
+      State s = initial;
+      s.x += e * dx;
+      return rollout_loss(sim, s, inputs);
+    });
+    const VectorXd dv = (size / h) * Direction(&rng, n);
+    auto along_v = [&](const RolloutGradient& g) { return g.v0.dot(dv); };
+    record("v0", n, along_v(grad), reference_dot(along_v), [&](double e) {
+      State s = initial;
+      s.v += e * dv;
+      return rollout_loss(sim, s, inputs);
+    });
+    // A force that moves a node by about `size` in one step: m size / h^2.
+    std::vector<VectorXd> df(steps);
+    for (int i = 0; i < steps; ++i)
+      df[i] = (size / (h * h)) * mass.cwiseProduct(Direction(&rng, n)) / std::sqrt(double(steps));
+    auto along_f = [&](const RolloutGradient& g) {
+      double sum = 0;
+      for (int i = 0; i < steps; ++i) sum += g.external_force[i].dot(df[i]);
+      return sum;
+    };
+    record("external_force", long(n) * steps, along_f(grad), reference_dot(along_f), [&](double e) {
+      std::vector<StepInput> in = inputs;
+      for (int i = 0; i < steps; ++i) in[i].external_force += e * df[i];
+      return rollout_loss(sim, initial, in);
+    });
     if (num_muscles > 0) {
       std::vector<VectorXd> da(steps);
-      double analytic_a = 0;
-      for (int i = 0; i < steps; ++i) {
-        da[i] = RandomVector(&rng, num_muscles) / std::sqrt(double(num_muscles * steps));
-        analytic_a += grad.activation[i].dot(da[i]);
-      }
-      record(
-          "activation", long(num_muscles) * steps,
-          [&](double e) {
-            std::vector<StepInput> in = inputs;
-            for (int i = 0; i < steps; ++i) in[i].activation += e * da[i];
-            return loss(sim, initial, in);
-          },
-          analytic_a, check.relative_step);
+      for (int i = 0; i < steps; ++i) da[i] = Direction(&rng, num_muscles) / std::sqrt(double(steps));
+      auto along_a = [&](const RolloutGradient& g) {
+        double sum = 0;
+        for (int i = 0; i < steps; ++i) sum += g.activation[i].dot(da[i]);
+        return sum;
+      };
+      record("activation", long(num_muscles) * steps, along_a(grad), reference_dot(along_a), [&](double e) {
+        std::vector<StepInput> in = inputs;
+        for (int i = 0; i < steps; ++i) in[i].activation += e * da[i];
+        return rollout_loss(sim, initial, in);
+      });
     }
   }
-  // State-force parameters: a fresh simulator per perturbed scene. Forces are
-  // linear in them and act almost linearly: a larger step beats rounding.
-  const double force_step = 100 * check.relative_step;
-  auto scene_loss = [&](const Scene& perturbed) {
-    Simulator s(perturbed, options);
-    return loss(s, initial, inputs);
+
+  // Scalar parameters: one direction each (the directions above only repeat them).
+  // State-force parameters: a fresh simulator per perturbed scene.
+  auto record_scene = [&](const std::string& name, double scale,
+                          const std::function<double(const RolloutGradient&)>& derivative,
+                          const std::function<void(Scene*, double)>& perturb) {
+    record(name, 1, scale * derivative(grad), scale * reference_dot(derivative), [&](double e) {
+      Scene p = scene;
+      perturb(&p, e * scale);
+      Simulator s(p, options);
+      return rollout_loss(s, initial, inputs);
+    });
   };
-  auto record_scene = [&](const std::string& name, const std::function<void(Scene*, double)>& perturb, double analytic,
-                          double eps) {
-    record(
-        name, 1,
-        [&](double e) {
-          Scene p = scene;
-          perturb(&p, e);
-          return scene_loss(p);
-        },
-        analytic, eps);
-  };
+  auto unit_scale = [](double value) { return std::max(1.0, std::abs(value)); };
   if (scene.linear_damping)
     record_scene(
-        "linear_damping", [](Scene* p, double e) { *p->linear_damping += e; }, grad.state_forces.linear_damping,
-        force_step * std::max(1.0, *scene.linear_damping));
+        "linear_damping", unit_scale(*scene.linear_damping),
+        [](const RolloutGradient& g) { return g.state_forces.linear_damping; },
+        [](Scene* p, double e) { *p->linear_damping += e; });
   if (scene.hydrodynamics) {
     const Hydrodynamics& hy = *scene.hydrodynamics;
     record_scene(
-        "fluid_density", [](Scene* p, double e) { p->hydrodynamics->fluid_density += e; },
-        grad.state_forces.fluid_density, force_step * std::max(1.0, hy.fluid_density));
+        "fluid_density", unit_scale(hy.fluid_density),
+        [](const RolloutGradient& g) { return g.state_forces.fluid_density; },
+        [](Scene* p, double e) { p->hydrodynamics->fluid_density += e; });
     record_scene(
-        "drag_tangential", [](Scene* p, double e) { p->hydrodynamics->drag_tangential += e; },
-        grad.state_forces.drag_tangential, force_step);
+        "drag_tangential", unit_scale(hy.drag_tangential),
+        [](const RolloutGradient& g) { return g.state_forces.drag_tangential; },
+        [](Scene* p, double e) { p->hydrodynamics->drag_tangential += e; });
     record_scene(
-        "drag_normal", [](Scene* p, double e) { p->hydrodynamics->drag_normal += e; }, grad.state_forces.drag_normal,
-        force_step);
+        "drag_normal", unit_scale(hy.drag_normal), [](const RolloutGradient& g) { return g.state_forces.drag_normal; },
+        [](Scene* p, double e) { p->hydrodynamics->drag_normal += e; });
     record_scene(
-        "thrust", [](Scene* p, double e) { p->hydrodynamics->thrust += e; }, grad.state_forces.thrust, force_step);
+        "thrust", unit_scale(hy.thrust), [](const RolloutGradient& g) { return g.state_forces.thrust; },
+        [](Scene* p, double e) { p->hydrodynamics->thrust += e; });
   }
   bool any_friction = false;
   for (const auto& c : scene.penalty_contacts) any_friction = any_friction || c.friction > 0;
   if (any_friction) {
-    double analytic = 0;
-    for (size_t c = 0; c < scene.penalty_contacts.size(); ++c)
-      if (scene.penalty_contacts[c].friction > 0) analytic += grad.state_forces.penalty_friction[c];
+    // mu is at most 1 or so: a step of 1e-2 mu scale would cross stick/slip
+    // thresholds; the friction coefficients move by e x 1.
     record_scene(
-        "penalty_friction",
+        "penalty_friction", 1.0,
+        [&](const RolloutGradient& g) {
+          double sum = 0;
+          for (size_t c = 0; c < scene.penalty_contacts.size(); ++c)
+            if (scene.penalty_contacts[c].friction > 0) sum += g.state_forces.penalty_friction[c];
+          return sum;
+        },
         [](Scene* p, double e) {
           for (auto& c : p->penalty_contacts)
             if (c.friction > 0) c.friction += e;
-        },
-        analytic, force_step);
+        });
   }
-  const MaterialParameters base = scene.material;
-  auto material_loss = [&](MaterialParameters m) {
-    sim.SetMaterial(m);
-    const double l = loss(sim, initial, inputs);
-    sim.SetMaterial(base);
-    return l;
+  const MaterialParameters material = scene.material;
+  auto record_material = [&](const std::string& name, double scale,
+                             const std::function<double(const RolloutGradient&)>& derivative,
+                             const std::function<void(MaterialParameters*, double)>& perturb) {
+    record(name, 1, scale * derivative(grad), scale * reference_dot(derivative), [&](double e) {
+      MaterialParameters m = material;
+      perturb(&m, e * scale);
+      sim.SetMaterial(m);
+      const double l = rollout_loss(sim, initial, inputs);
+      sim.SetMaterial(material);
+      return l;
+    });
   };
-  record(
-      "youngs_modulus", 1,
-      [&](double e) {
-        MaterialParameters m = base;
-        m.youngs_modulus += e;
-        return material_loss(m);
-      },
-      grad.youngs_modulus, check.relative_step * base.youngs_modulus);
-  record(
-      "poissons_ratio", 1,
-      [&](double e) {
-        MaterialParameters m = base;
-        m.poissons_ratio += e;
-        return material_loss(m);
-      },
-      grad.poissons_ratio, check.relative_step * 0.1);
-  record(
-      "density", 1,
-      [&](double e) {
-        MaterialParameters m = base;
-        m.density += e;
-        return material_loss(m);
-      },
-      grad.density, check.relative_step * base.density);
-  for (const auto& e : result.inputs) result.max_rel_error = std::max(result.max_rel_error, e.max_rel_error);
+  record_material(
+      "youngs_modulus", material.youngs_modulus, [](const RolloutGradient& g) { return g.youngs_modulus; },
+      [](MaterialParameters* m, double e) { m->youngs_modulus += e; });
+  // Keep nu + e scale inside (-1, 0.5) for e <= 1e-2.
+  record_material(
+      "poissons_ratio", std::min(0.1, 0.5 * (0.5 - material.poissons_ratio)),
+      [](const RolloutGradient& g) { return g.poissons_ratio; },
+      [](MaterialParameters* m, double e) { m->poissons_ratio += e; });
+  record_material(
+      "density", material.density, [](const RolloutGradient& g) { return g.density; },
+      [](MaterialParameters* m, double e) { m->density += e; });
+
+  result.min_margin = std::numeric_limits<double>::infinity();
+  for (const auto& e : result.inputs) {
+    result.verdict = Worse(result.verdict, e.verdict);
+    result.max_error = std::max(result.max_error, e.error);
+    result.min_margin = std::min(result.min_margin, e.margin);
+  }
   return result;
+}
+
+std::string GradCheckTable(const GradCheckResult& r) {
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof(line), "%-16s %10s %10s %10s %9s %10s %10s %-11s %s\n", "input", "error", "floor",
+                "margin", "step", "worst_case", "reference", "verdict", "reason");
+  out += line;
+  for (const auto& e : r.inputs) {
+    char ref[32];
+    if (std::isnan(e.reference_error))
+      std::snprintf(ref, sizeof(ref), "%10s", "-");
+    else
+      std::snprintf(ref, sizeof(ref), "%10.2e", e.reference_error);
+    std::snprintf(line, sizeof(line), "%-16s %10.2e %10.2e %10.3g %9.0e %10.2e %s %-11s %s\n", e.input.c_str(), e.error,
+                  e.floor, e.margin, e.step, e.bound, ref, ToString(e.verdict), e.reason.c_str());
+    out += line;
+  }
+  std::snprintf(line, sizeof(line),
+                "# %s: %s (tolerance %g; %d pass, %d fail, %d unresolved; smallest margin %.3g)%s\n", r.method.c_str(),
+                ToString(r.verdict), r.tolerance, r.Count(CheckVerdict::kPass), r.Count(CheckVerdict::kFail),
+                r.Count(CheckVerdict::kUnresolved), r.min_margin, r.reference ? "; reference: newton-cholesky" : "");
+  out += line;
+  if (!r.reference_failure.empty()) out += "# the Newton-Cholesky reference failed: " + r.reference_failure + "\n";
+  return out;
+}
+
+nlohmann::json GradCheckToJson(const GradCheckResult& r) {
+  // JSON has no NaN or infinity: null stands for "not compared" / "exact".
+  auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  nlohmann::json inputs = nlohmann::json::object();
+  for (const auto& e : r.inputs)
+    inputs[e.input] = {{"verdict", ToString(e.verdict)},
+                       {"error", number(e.error)},
+                       {"floor", number(e.floor)},
+                       {"worst_case", number(e.bound)},
+                       {"margin", number(e.margin)},
+                       {"step", e.step},
+                       {"reference_error", number(e.reference_error)},
+                       {"reason", e.reason},
+                       {"entries", e.entries},
+                       {"directions", e.directions}};
+  return {{"method", r.method},
+          {"tolerance", r.tolerance},
+          {"verdict", ToString(r.verdict)},
+          {"max_error", number(r.max_error)},
+          {"min_margin", number(r.min_margin)},
+          {"reference", r.reference},
+          {"reference_failure", r.reference_failure},
+          {"pass", r.Count(CheckVerdict::kPass)},
+          {"fail", r.Count(CheckVerdict::kFail)},
+          {"unresolved", r.Count(CheckVerdict::kUnresolved)},
+          {"inputs", inputs}};
 }
 
 }  // namespace diffpd::problems

@@ -1,50 +1,119 @@
-// Central finite-difference check of a rollout's reverse-mode gradient.
+// Central finite-difference check of a rollout's reverse-mode gradient, with
+// a verdict per input kind that separates a wrong gradient from noisy
+// differences.
 //
 // Loss: L = c_x . x_K + c_v . v_K with c_x, c_v fixed pseudo-random vectors
-// (seed `seed`). For each input kind (initial positions, initial velocities,
-// per-step external forces, Young's modulus, Poisson's ratio, density) and
-// each of `directions` random directions d, compares dL/dtheta . d with
-//   (L(theta + eps d) - L(theta - eps d)) / (2 eps).
-// Scenes that declare them add: "activation" (per-step muscle activations,
-// baseline 0.9 + 0.02 N(0,1)), "linear_damping", the hydrodynamic parameters
-// "fluid_density", "drag_tangential", "drag_normal", "thrust", and
-// "penalty_friction" (all penalty contacts' mu along one direction).
+// (seed `seed`), over `steps` steps from `initial` under a baseline of
+// per-step external forces (0.1 x a node's weight, random directions) and,
+// for scenes with muscles, activations 0.9 + 0.02 N(0,1). For each input kind
+// and each of `directions` random directions d (entries of unit root mean
+// square), dL/dtheta . d is compared with central differences
+//   fd(e) = (L(theta + e s d) - L(theta - e s d)) / 2e
+// at the steps e = largest_step, largest_step / 10, ... (step_count of them)
+// in units of the input's scale s: x0 the body's size (bounding-box
+// diagonal, m); v0 size / h; the per-step external forces m_i size / h^2 /
+// sqrt(steps); activations 1 / sqrt(steps); E, rho, the state-force
+// parameters their own value (at least 1); nu min(0.1, (0.5 - nu) / 2).
+// Input kinds: "x0", "v0", "external_force", "youngs_modulus",
+// "poissons_ratio", "density", and where the scene has them "activation",
+// "linear_damping", "fluid_density", "drag_tangential", "drag_normal",
+// "thrust", "penalty_friction" (all penalty contacts' mu along one direction).
+//
+// Noise floor: JudgeDerivative (derivative_verdict.h) measures each
+// difference's truncation and noise from its neighbours (Richardson-style),
+// adds the loss's rounding eps |(c_x,i x_i, |c_v,i| (|v_i| + |x_i| / h))|_2 / e
+// (rounding errors of independent sign), picks the step of least
+// uncertainty and gives the
+// verdict. The forward's achieved residuals r_k give the worst case of the
+// differences' error,
+//   (|c_x| + |c_v| / h) sum_k r_k h^2 / m_min / e
+// (a residual r moves x by at most r h^2 / m_min); a disagreement within it
+// is unresolved, never a failure. An input kind's verdict is the worst over
+// its directions.
+//
+// Reference: for the iterative methods (pd, pd-lbfgs, newton-pcg) by
+// default, the same loss's gradient from a Newton-Cholesky rollout at
+// rel_tolerance reference_rel_tolerance is compared too, per direction:
+// a reference error above the tolerance fails the input (the adjoint, not
+// the differences, is wrong) unless the differences are unresolved (the
+// forward's noise or its residuals' worst case covers the derivative, and
+// the method's gradient is that of its inexact trajectory): then the input
+// stays unresolved and the reason gives both. Differences that are unresolved while the
+// reference agrees point at a noisy forward, not a wrong gradient.
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "diffpd/rollout.h"
 #include "diffpd/scene.h"
 #include "diffpd/solver_options.h"
+#include "tools/derivative_verdict.h"
 
 namespace diffpd::problems {
 
 struct GradCheckOptions {
-  int directions = 2;          // random directions per input kind
-  std::uint64_t seed = 20211;  // seed of the loss and the directions
-  // Relative finite-difference step: eps = relative_step * typical scale of
-  // the input (1 for positions in m, velocities in m/s, forces scaled by the
-  // gravity force of a node; E, rho relative; nu absolute).
-  double relative_step = 1e-5;
+  int directions = 2;          // random directions per input kind; >= 1
+  std::uint64_t seed = 20211;  // seed of the loss, the baseline inputs and the directions
+  double tolerance = 1e-4;     // relative tolerance of every verdict; > 0
+  double largest_step = 1e-2;  // first step e, in units of the input's scale; > 0
+  int step_count = 6;          // steps e, each a tenth of the one before; >= 2
+  // Compare with a Newton-Cholesky rollout's gradient; unset: for pd,
+  // pd-lbfgs and newton-pcg (never for semi-implicit, whose time
+  // discretisation differs).
+  std::optional<bool> reference;
+  double reference_rel_tolerance = 1e-12;  // of the reference's forward and adjoint solves
+
+  // Throws InvalidInputError naming the field, its value and the valid range.
+  void Validate() const;
 };
 
-struct GradCheckEntry {
+struct GradCheckInput {
   std::string input;  // "x0", "v0", "external_force", "youngs_modulus", ...
-  double max_rel_error = 0;
-  long entries = 0;  // number of scalar inputs of this kind
+  long entries = 0;   // number of scalar inputs of this kind
   int directions = 0;
+  CheckVerdict verdict = CheckVerdict::kPass;  // worst over the directions (differences and reference)
+  double error = 0;                            // largest relative error against the differences
+  double floor = 0;                            // largest relative noise floor of the differences
+  double bound = 0;                            // largest relative worst case from the residuals
+  double margin = 0;                           // smallest tolerance / max(error, floor)
+  double step = 0;                             // the step of the worst direction (units of the scale)
+  // Largest relative difference from the reference gradient; NaN: not compared.
+  double reference_error = 0;
+  std::string reason;  // empty for a pass: why the worst direction failed or is unresolved
 };
 
 struct GradCheckResult {
-  std::vector<GradCheckEntry> inputs;
-  double max_rel_error = 0;
+  std::string method;             // the checked method (ToString)
+  double tolerance = 0;           // GradCheckOptions::tolerance
+  bool reference = false;         // whether the Newton-Cholesky reference was compared
+  std::string reference_failure;  // non-empty: the reference rollout failed (its error); not compared
+  std::vector<GradCheckInput> inputs;
+  CheckVerdict verdict = CheckVerdict::kPass;  // worst over the inputs
+  double max_error = 0;                        // over the inputs
+  double min_margin = 0;                       // over the inputs
+
+  int Count(CheckVerdict verdict) const;
 };
 
-// Runs the check; the solver options are used as given (make tolerances
-// tight: the finite differences are only as good as the forward solves).
+// Runs the check with the solver options as given (make tolerances tight:
+// the noise floor follows the residuals the solves reach). Throws
+// InvalidInputError on bad check options, SolverError from the checked
+// method's own solves.
 GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& options, const State& initial, int steps,
                                      const GradCheckOptions& check = GradCheckOptions());
+
+// The solve tolerance `diffpd gradcheck` recommends for a method: tight enough
+// that the differences resolve the gradient to well within 1e-4.
+double RecommendedGradCheckRelTolerance(Method method);
+
+// Reports made from a result: a table (one line per input and a summary
+// line) and one JSON object with the same fields.
+std::string GradCheckTable(const GradCheckResult& result);
+nlohmann::json GradCheckToJson(const GradCheckResult& result);
 
 }  // namespace diffpd::problems

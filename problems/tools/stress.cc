@@ -2,12 +2,11 @@
 
 #include <chrono>
 #include <cmath>
-#include <functional>
 #include <limits>
-#include <random>
 #include <sstream>
 
 #include "tools/bench.h"
+#include "tools/gradcheck.h"
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
 #include "cli/invalid_option.h"
@@ -72,126 +71,8 @@ void StressOptions::Validate() const {
   if (!(explicit_energy_tolerance >= 0)) fail("explicit_energy_tolerance", explicit_energy_tolerance, ">= 0");
   if (gradcheck_steps < 0) fail("gradcheck_steps", gradcheck_steps, ">= 0");
   if (!(gradcheck_tolerance > 0)) fail("gradcheck_tolerance", gradcheck_tolerance, "> 0");
-}
-
-DerivativeVerdict JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences, double tolerance) {
-  DerivativeVerdict verdict;
-  verdict.error = std::numeric_limits<double>::infinity();
-  bool resolved = false;
-  for (const auto& d : differences) {
-    const double scale = std::max(std::abs(d.value), std::abs(analytic));
-    verdict.error = std::min(verdict.error, scale > 0 ? std::abs(d.value - analytic) / scale : 0.0);
-    if (d.noise <= tolerance * scale) resolved = true;
-  }
-  if (differences.empty()) verdict.error = 0;
-  // Agreement within `tolerance` is no coincidence; disagreement counts only
-  // where a difference resolves the derivative.
-  verdict.tested = !differences.empty() && (verdict.error <= tolerance || resolved);
-  return verdict;
-}
-
-StressGradientCheck CheckStressGradient(const Scene& scene, const SolverOptions& options, const State& initial,
-                                        int steps, std::uint64_t seed, double tolerance) {
-  Simulator sim(scene, options);
-  const int n = sim.num_dofs();
-  const double h = options.time_step;
-  const VectorXd mass = sim.LumpedMass();
-  const LinearLoss loss = LinearLoss::Random(n, seed);
-  std::mt19937_64 rng(seed + 1);
-  std::normal_distribution<double> normal(0.0, 1.0);
-  auto direction = [&]() {  // random, entries of unit root-mean-square
-    VectorXd d(n);
-    for (int i = 0; i < n; ++i) d(i) = normal(rng);
-    return VectorXd(d * (std::sqrt(double(n)) / d.norm()));
-  };
-  const std::vector<StepInput> inputs(steps);
-  const Rollout rollout = sim.Simulate(initial, inputs);
-  LossGradient dl(steps);
-  dl.dx[steps] = loss.cx;
-  dl.dv[steps] = loss.cv;
-  const RolloutGradient g = sim.Backward(rollout, dl);
-  const State& last = rollout.states.back();
-  // Rounding scale of the loss: sum of |c_i s_i|, v = (x_K - x_{K-1}) / h
-  // carrying the rounding of x over h.
-  const double loss_magnitude =
-      loss.cx.cwiseAbs().dot(last.x.cwiseAbs()) + loss.cv.cwiseAbs().dot(last.v.cwiseAbs() + last.x.cwiseAbs() / h);
-  // Estimate of the loss error the solves leave: a residual r moves x by at
-  // most r h^2 / m_min (hess g >= M / h^2 at a minimum) and v by that over h;
-  // r_k = 10 x step k's final residual (the perturbed rollouts stop at
-  // residuals like the base one's; 10 covers the variation).
-  double solve_error_x = 0;
-  for (const auto& rep : rollout.reports) solve_error_x += 10 * rep.final_residual * h * h / mass.minCoeff();
-  const double solve_noise = (loss.cx.norm() + loss.cv.norm() / h) * solve_error_x;
-  Eigen::Map<const Eigen::Matrix3Xd> x0(initial.x.data(), 3, n / 3);
-  const double size = (x0.rowwise().maxCoeff() - x0.rowwise().minCoeff()).norm();  // m
-  const MaterialParameters base = scene.material;
-
-  StressGradientCheck result;
-  // perturbed(e) is the loss with the input moved by e (in units of its scale).
-  auto record = [&](const std::string& name, double analytic, const std::function<double(double)>& perturbed) {
-    std::vector<FiniteDifference> fds;
-    for (int k = 2; k <= 7; ++k) {
-      const double e = std::pow(10.0, -k);
-      const double noise = (1e-13 * loss_magnitude + solve_noise) / e;  // rounding and solve error
-      fds.push_back({e, (perturbed(e) - perturbed(-e)) / (2 * e), noise});
-    }
-    const DerivativeVerdict verdict = JudgeDerivative(analytic, fds, tolerance);
-    result.inputs.push_back(name);
-    result.errors.push_back(verdict.error);
-    result.resolved.push_back(verdict.tested);
-    if (verdict.tested) result.max_error = std::max(result.max_error, verdict.error);
-  };
-  auto rollout_loss = [&](const State& init, const std::vector<StepInput>& in) {
-    return loss.Value(sim.Simulate(init, in).states.back());
-  };
-  auto material_loss = [&](const MaterialParameters& m) {
-    sim.SetMaterial(m);
-    const double l = rollout_loss(initial, inputs);
-    sim.SetMaterial(base);
-    return l;
-  };
-  const VectorXd dx = size * direction();
-  record("x0", g.x0.dot(dx), [&](double e) {
-    State s = initial;
-    s.x += e * dx;
-    return rollout_loss(s, inputs);
-  });
-  const VectorXd dv = (size / h) * direction();
-  record("v0", g.v0.dot(dv), [&](double e) {
-    State s = initial;
-    s.v += e * dv;
-    return rollout_loss(s, inputs);
-  });
-  // A force that moves a node by about `size` in one step: m size / h^2.
-  std::vector<VectorXd> df(steps);
-  double analytic = 0;
-  for (int i = 0; i < steps; ++i) {
-    df[i] = (size / (h * h)) * mass.cwiseProduct(direction()) / std::sqrt(double(steps));
-    analytic += g.external_force[i].dot(df[i]);
-  }
-  record("external_force", analytic, [&](double e) {
-    std::vector<StepInput> in(steps);
-    for (int i = 0; i < steps; ++i) in[i].external_force = e * df[i];
-    return rollout_loss(initial, in);
-  });
-  record("youngs_modulus", g.youngs_modulus * base.youngs_modulus, [&](double e) {
-    MaterialParameters m = base;
-    m.youngs_modulus *= 1 + e;
-    return material_loss(m);
-  });
-  // Keep nu + e scale inside (-1, 0.5) for e <= 1e-2.
-  const double nu_scale = std::min(0.1, 0.5 * (0.5 - base.poissons_ratio));
-  record("poissons_ratio", g.poissons_ratio * nu_scale, [&](double e) {
-    MaterialParameters m = base;
-    m.poissons_ratio += e * nu_scale;
-    return material_loss(m);
-  });
-  record("density", g.density * base.density, [&](double e) {
-    MaterialParameters m = base;
-    m.density *= 1 + e;
-    return material_loss(m);
-  });
-  return result;
+  if (!(gradcheck_rel_tolerance > 0 && gradcheck_rel_tolerance < 1))
+    fail("gradcheck_rel_tolerance", gradcheck_rel_tolerance, "in (0, 1)");
 }
 
 StressCase RunStressCase(const StressProblem& problem, Method method, double youngs_modulus, double poissons_ratio,
@@ -309,25 +190,38 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
     const int prefix = std::min(options.gradcheck_steps, steps);
     if (prefix > 0) {
       SolverOptions tight = so;
-      tight.rel_tolerance = 1e-10;
-      tight.backward_rel_tolerance = 1e-12;
+      tight.rel_tolerance = options.gradcheck_rel_tolerance;
+      tight.backward_rel_tolerance = std::min(1e-12, options.gradcheck_rel_tolerance);
       tight.max_iterations = std::max(so.max_iterations, 20000);
       tight.abs_tolerance = AutoAbsTolerance(scene, time_step);
-      StressGradientCheck check;
+      GradCheckOptions gc;
+      gc.directions = 1;
+      gc.tolerance = options.gradcheck_tolerance;
+      gc.seed = options.seed;
+      GradCheckResult check;
       try {
-        check = CheckStressGradient(scene, tight, initial, prefix, options.seed, options.gradcheck_tolerance);
+        check = CheckRolloutGradient(scene, tight, initial, prefix, gc);
       } catch (const SolverError& e) {
-        return finish("failed", "gradient check (solves at rel_tolerance 1e-10): " + Describe(e));
-      }
-      c.gradcheck_error = check.max_error;
-      for (size_t k = 0; k < check.inputs.size(); ++k)
-        if (!check.resolved[k]) c.gradcheck_unresolved.push_back(check.inputs[k]);
-      if (!(check.max_error <= options.gradcheck_tolerance)) {
         std::ostringstream msg;
-        msg << "gradient check: relative error " << check.max_error << " > " << options.gradcheck_tolerance << " (";
-        for (size_t k = 0; k < check.inputs.size(); ++k)
-          msg << (k ? ", " : "") << check.inputs[k] << " " << check.errors[k];
-        msg << ")";
+        msg << "gradient check (solves at rel_tolerance " << options.gradcheck_rel_tolerance << "): " << Describe(e);
+        return finish("failed", msg.str());
+      }
+      c.gradcheck_run = true;
+      c.gradcheck_margin = std::numeric_limits<double>::infinity();
+      for (const auto& input : check.inputs) {
+        if (input.verdict == CheckVerdict::kUnresolved) {
+          c.gradcheck_unresolved.push_back(input.input);
+          continue;
+        }
+        c.gradcheck_error = std::max(c.gradcheck_error, input.error);
+        c.gradcheck_floor = std::max(c.gradcheck_floor, input.floor);
+        c.gradcheck_margin = std::min(c.gradcheck_margin, input.margin);
+      }
+      if (check.verdict == CheckVerdict::kFail) {
+        std::ostringstream msg;
+        msg << "gradient check fails (tolerance " << options.gradcheck_tolerance << "):";
+        for (const auto& input : check.inputs)
+          if (input.verdict == CheckVerdict::kFail) msg << " " << input.input << " " << input.reason << ";";
         return finish("violation", msg.str());
       }
     }
@@ -361,7 +255,24 @@ std::vector<StressCase> RunStress(const StressOptions& options, std::ostream* pr
   return cases;
 }
 
+StressSummary SummarizeStress(const std::vector<StressCase>& cases) {
+  StressSummary s;
+  s.min_gradcheck_margin = std::numeric_limits<double>::infinity();
+  for (const auto& c : cases) {
+    ++s.cases;
+    if (c.outcome == "ok") ++s.ok;
+    if (c.outcome == "failed") ++s.failed;
+    if (c.outcome == "violation") ++s.violations;
+    if (!c.gradcheck_run) continue;
+    ++s.gradchecks;
+    s.unresolved_cases += !c.gradcheck_unresolved.empty();
+    s.min_gradcheck_margin = std::min(s.min_gradcheck_margin, c.gradcheck_margin);
+  }
+  return s;
+}
+
 nlohmann::json StressToJson(const std::vector<StressCase>& cases) {
+  auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   nlohmann::json out = nlohmann::json::array();
   for (const auto& c : cases)
     out.push_back({{"problem", c.problem},
@@ -375,7 +286,10 @@ nlohmann::json StressToJson(const std::vector<StressCase>& cases) {
                    {"rounding_floor_steps", c.rounding_floor_steps},
                    {"newton_fallback_steps", c.newton_fallback_steps},
                    {"max_energy_excess", c.max_energy_excess},
+                   {"gradcheck_run", c.gradcheck_run},
                    {"gradcheck_error", c.gradcheck_error},
+                   {"gradcheck_floor", c.gradcheck_floor},
+                   {"gradcheck_margin", number(c.gradcheck_margin)},
                    {"gradcheck_unresolved", c.gradcheck_unresolved},
                    {"seconds", c.seconds}});
   return out;

@@ -9,8 +9,10 @@
 //    energies involved, see StressCase::max_energy_excess), as implicit Euler
 //    only dissipates; the backward pass of the whole rollout returned finite
 //    gradients; and on the first gradcheck_steps steps the reverse-mode
-//    gradient passes CheckStressGradient (below; solves at rel_tolerance
-//    1e-10, above the rounding floor) within gradcheck_tolerance;
+//    gradient passes CheckRolloutGradient (gradcheck.h: one direction per
+//    input kind, six steps, the Newton-Cholesky reference for the iterative
+//    methods; solves at rel_tolerance gradcheck_rel_tolerance) within
+//    gradcheck_tolerance, or is unresolved (listed, not a violation);
 //  - "failed": a SolverError stopped the rollout, its backward pass or the
 //    gradient check; `message` carries its status, its text and where;
 //  - "violation": anything else (a non-finite value returned without an
@@ -56,8 +58,11 @@ struct StressOptions {
   // energy scale (the measure tends to 1 as energy explodes) is instability.
   double explicit_energy_tolerance = 0.5;
   int gradcheck_steps = 3;  // prefix checked by finite differences (0: skip)
-  // Allowed relative error of the check (CheckStressGradient's tolerance).
+  // Relative tolerance of the check's verdicts (GradCheckOptions::tolerance).
   double gradcheck_tolerance = 1e-4;
+  // Solve tolerance of the check's rollouts: tight, so that the differences'
+  // noise floor stays well below gradcheck_tolerance.
+  double gradcheck_rel_tolerance = 1e-11;
   std::uint64_t seed = 20211;
   // SolverOptions::rigid_mode_correction of every case (used by PD-LBFGS and
   // the PD backward on bodies without Dirichlet DoFs: the falling cube).
@@ -82,8 +87,14 @@ struct StressCase {
   // max over steps of (T_k - T_0) / (|T_0 parts| + |T_k parts| + 1e-300),
   // where the parts are kinetic, elastic and gravitational (relative to T_0).
   double max_energy_excess = 0;
-  double gradcheck_error = 0;  // max relative error of the check (0 if not run)
-  // Inputs the check could not resolve above the noise (see StressGradientCheck).
+  // The gradient check (gradcheck.h; zeros and empty when not run): the
+  // largest relative error and noise floor, the smallest margin
+  // (tolerance / max(error, floor)) over the resolved inputs (infinite
+  // when none), and the inputs it could not resolve.
+  bool gradcheck_run = false;
+  double gradcheck_error = 0;
+  double gradcheck_floor = 0;
+  double gradcheck_margin = 0;
   std::vector<std::string> gradcheck_unresolved;
   double seconds = 0;
 };
@@ -99,51 +110,6 @@ struct StressCase {
 // falling for minutes) can still reach it.
 double AutoAbsTolerance(const Scene& scene, double time_step);
 
-// Directional central-difference check of the reverse-mode gradient of
-// L = c_x . x_K + c_v . v_K (c ~ N(0,1), `seed`) over `steps` steps from
-// `initial` with no external force, for x0, v0, the per-step external forces,
-// E, nu and rho. Each input moves along a random direction in units of its
-// scale (x0: the body's size s; v0: s / h; forces: m_i s / h^2; E, rho:
-// relative; nu: min(0.1, (0.5 - nu) / 2)), by e = 1e-2, 1e-3, .., 1e-7; the error of
-// an input is the smallest over e of
-//   |fd - g.d| / max(|fd|, |g.d|).
-// An input passes when that is <= tolerance (agreement to 1e-4 is no
-// coincidence); above it, the input fails only if some step e resolves the
-// derivative to that tolerance, i.e. its noise estimate
-//   noise / e <= tolerance * max(|fd|, |g.d|),
-// noise = 1e-13 (sum |c_x,i x_i| + |c_v,i| (|v_i| + |x_i| / h)) (rounding of
-// the loss) + (|c_x| + |c_v| / h) sum_k r_k h^2 / m_min (the loss error the
-// solves leave, r_k = 10 x the final residual of step k of the unperturbed
-// rollout; perturbed rollouts stop at similar residuals). Trying
-// several steps finds the window between truncation and rounding that a
-// fixed step misses at the grid's extremes; a wrong gradient disagrees at
-// every step. An input that disagrees and has no resolved step (its effect
-// on L within the noise, e.g. E for a nearly rigid body over 3 steps) is
-// reported as unresolved: not tested, and not in max_error.
-// One central difference of a directional derivative: step e, value
-// (L(+e) - L(-e)) / 2e and an estimate of its error from noise (absolute).
-struct FiniteDifference {
-  double step = 0;
-  double value = 0;
-  double noise = 0;
-};
-struct DerivativeVerdict {
-  double error = 0;     // min over the differences of |value - analytic| / max(|value|, |analytic|)
-  bool tested = false;  // false: the derivative disagrees but is within the noise at every step
-};
-// The rule of CheckStressGradient below for one derivative.
-DerivativeVerdict JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences, double tolerance);
-
-struct StressGradientCheck {
-  std::vector<std::string> inputs;  // "x0", "v0", "external_force", ...
-  std::vector<double> errors;       // per input, smallest over the steps
-  std::vector<bool> resolved;       // per input: false = unresolved (untested)
-  double max_error = 0;
-};
-// Throws SolverError from the solves (use tight options).
-StressGradientCheck CheckStressGradient(const Scene& scene, const SolverOptions& options, const State& initial,
-                                        int steps, std::uint64_t seed, double tolerance = 1e-4);
-
 // Runs one case; a line every 10 s of a long rollout goes to `progress`
 // (nullptr: silent).
 StressCase RunStressCase(const StressProblem& problem, Method method, double youngs_modulus, double poissons_ratio,
@@ -153,7 +119,16 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
 // case on `progress` (nullptr: silent). Throws InvalidInputError on bad options.
 std::vector<StressCase> RunStress(const StressOptions& options, std::ostream* progress = nullptr);
 
-// JSON list of the cases (fields as in StressCase).
+// Summary of a grid: case counts per outcome, the cases whose gradient check
+// ran, left inputs unresolved, and the smallest margin of a resolved input.
+struct StressSummary {
+  int cases = 0, ok = 0, failed = 0, violations = 0;
+  int gradchecks = 0, unresolved_cases = 0;
+  double min_gradcheck_margin = 0;  // infinite when no input was resolved
+};
+StressSummary SummarizeStress(const std::vector<StressCase>& cases);
+
+// JSON list of the cases (fields as in StressCase; infinite margins as null).
 nlohmann::json StressToJson(const std::vector<StressCase>& cases);
 
 }  // namespace diffpd::problems

@@ -4,6 +4,8 @@ diffpd_add_test(contact_problems_test ${_dir}/scenes/contact_problems_test.cc LI
 diffpd_add_test(bench_test ${_dir}/tools/bench_test.cc LIBS diffpd_problems)
 diffpd_add_test(tradeoff_test ${_dir}/tools/tradeoff_test.cc LIBS diffpd_problems)
 diffpd_add_test(stress_test ${_dir}/tools/stress_test.cc LIBS diffpd_problems)
+diffpd_add_test(derivative_verdict_test ${_dir}/tools/derivative_verdict_test.cc LIBS diffpd_problems)
+diffpd_add_test(gradcheck_test ${_dir}/tools/gradcheck_test.cc LIBS diffpd_problems)
 # Calibration problems (with the Ceres adapter) and control problems (with the Ipopt adapter).
 if(TARGET diffpd_ceres)
   diffpd_add_test(calibrate_cantilever_test ${_dir}/calibration/calibrate_cantilever_test.cc LIBS diffpd_problems)

@@ -1,5 +1,6 @@
 // Rollout gradients of every method and input kind vs central finite
-// differences (relative error < 1e-5), on small hex and tet meshes.
+// differences (every input kind passes the check with a margin of at least
+// 10 at tolerance 1e-4), on small hex and tet meshes.
 #include <gtest/gtest.h>
 
 #include "diffpd/simulator.h"
@@ -8,6 +9,13 @@
 
 namespace diffpd {
 namespace {
+
+// One random direction per input kind (the check's default is two).
+problems::GradCheckOptions OneDirection() {
+  problems::GradCheckOptions check;
+  check.directions = 1;
+  return check;
+}
 
 struct Case {
   Method method;
@@ -22,7 +30,8 @@ TEST_P(SimulatorGradientTest, MatchesCentralFiniteDifferencesForEveryInputKind) 
   SolverOptions options;
   options.method = c.method;
   options.time_step = c.method == Method::kSemiImplicit ? 2e-4 : 0.01;
-  options.rel_tolerance = 1e-12;
+  // The check measures its noise floor: the solve tolerance it recommends suffices.
+  options.rel_tolerance = problems::RecommendedGradCheckRelTolerance(options.method);
   options.abs_tolerance = 1e-11;  // N, above the rounding floor (~3e-13 here)
   options.backward_rel_tolerance = 1e-13;
   options.max_iterations = 20000;
@@ -35,9 +44,12 @@ TEST_P(SimulatorGradientTest, MatchesCentralFiniteDifferencesForEveryInputKind) 
     initial.v(3 * i + 1) = 0.2 * initial.x(3 * i);
   }
   const int steps = c.method == Method::kSemiImplicit ? 20 : 4;
-  const problems::GradCheckResult result = problems::CheckRolloutGradient(scene, options, initial, steps);
+  const problems::GradCheckResult result =
+      problems::CheckRolloutGradient(scene, options, initial, steps, OneDirection());
   for (const auto& entry : result.inputs) {
-    EXPECT_LT(entry.max_rel_error, 1e-5) << ToString(c.method) << " input " << entry.input;
+    EXPECT_EQ(entry.verdict, problems::CheckVerdict::kPass)
+        << ToString(c.method) << " input " << entry.input << ": " << entry.reason;
+    EXPECT_GE(entry.margin, 10.0) << ToString(c.method) << " input " << entry.input;  // error and floor <= 1e-5
     EXPECT_GT(entry.directions, 0);
   }
   EXPECT_EQ(result.inputs.size(), 6u);

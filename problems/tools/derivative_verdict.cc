@@ -1,0 +1,103 @@
+#include "tools/derivative_verdict.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+namespace diffpd::problems {
+namespace {
+
+std::string Format(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.2g", v);
+  return buffer;
+}
+
+int Rank(CheckVerdict v) { return v == CheckVerdict::kPass ? 0 : v == CheckVerdict::kUnresolved ? 1 : 2; }
+
+}  // namespace
+
+const char* ToString(CheckVerdict verdict) {
+  switch (verdict) {
+    case CheckVerdict::kPass:
+      return "pass";
+    case CheckVerdict::kFail:
+      return "fail";
+    case CheckVerdict::kUnresolved:
+      return "unresolved";
+  }
+  return "unknown";
+}
+
+CheckVerdict Worse(CheckVerdict a, CheckVerdict b) { return Rank(a) >= Rank(b) ? a : b; }
+
+DerivativeJudgement JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences,
+                                    double tolerance) {
+  if (differences.empty()) throw std::invalid_argument("JudgeDerivative: no differences");
+  if (!(tolerance > 0))
+    throw std::invalid_argument("JudgeDerivative: tolerance = " + Format(tolerance) + " must be > 0");
+  const size_t n = differences.size();
+  // The uncertainty of fd(e_k) (see the header); the smallest step only
+  // probes its neighbour's noise unless it is the only one.
+  auto uncertainty = [&](size_t k) {
+    const FiniteDifference& d = differences[k];
+    double u = d.noise;
+    if (k > 0) {
+      const double r = differences[k - 1].step / d.step;
+      u = std::max(u, std::abs(differences[k - 1].value - d.value) / (r * r - 1));
+    } else if (n > 1) {
+      u = std::max(u, std::abs(differences[1].value - d.value));
+    }
+    if (k + 1 < n) u = std::max(u, std::abs(differences[k + 1].value - d.value) * differences[k + 1].step / d.step);
+    return std::isfinite(u) ? u : std::numeric_limits<double>::infinity();
+  };
+  const size_t candidates = n > 1 ? n - 1 : 1;
+  size_t best = 0;
+  double best_uncertainty = uncertainty(0);
+  for (size_t k = 1; k < candidates; ++k) {
+    const double u = uncertainty(k);
+    if (u < best_uncertainty) {
+      best_uncertainty = u;
+      best = k;
+    }
+  }
+  const FiniteDifference& d = differences[best];
+  DerivativeJudgement j;
+  j.step = d.step;
+  j.tolerance = tolerance;
+  const double scale = std::max(std::abs(d.value), std::abs(analytic));
+  const double difference = std::abs(d.value - analytic);
+  if (!std::isfinite(d.value)) {
+    j.error = j.floor = j.bound = std::numeric_limits<double>::infinity();
+  } else if (scale > 0) {
+    j.error = difference / scale;
+    j.floor = best_uncertainty / scale;
+    j.bound = d.bound / scale;
+  } else {  // both exactly zero
+    j.error = 0;
+    j.floor = best_uncertainty > 0 ? std::numeric_limits<double>::infinity() : 0;
+    j.bound = d.bound > 0 ? std::numeric_limits<double>::infinity() : 0;
+  }
+  const double worst = std::max(j.error, j.floor);
+  j.margin = worst > 0 ? tolerance / worst : std::numeric_limits<double>::infinity();
+  if (j.error <= tolerance && j.floor <= tolerance) {
+    j.verdict = CheckVerdict::kPass;
+  } else if (j.error > tolerance && j.error > 3 * j.floor && j.error > j.bound) {
+    j.verdict = CheckVerdict::kFail;
+    j.reason = "differs by " + Format(j.error) + " relative, above the tolerance " + Format(tolerance) +
+               ", 3x the noise floor " + Format(j.floor) + " and the solves' worst case " + Format(j.bound);
+  } else if (j.floor <= tolerance) {
+    j.verdict = CheckVerdict::kUnresolved;
+    j.reason = "differs by " + Format(j.error) + " relative, within the worst case " + Format(j.bound) +
+               " the solves' residuals allow (tolerance " + Format(tolerance) + ")";
+  } else {
+    j.verdict = CheckVerdict::kUnresolved;
+    j.reason = "the differences resolve the derivative only to " + Format(j.floor) + " relative (tolerance " +
+               Format(tolerance) + "; error " + Format(j.error) + ")";
+  }
+  return j;
+}
+
+}  // namespace diffpd::problems

@@ -1,0 +1,116 @@
+// The verdict on a derivative from central differences at several steps, on
+// synthetic functions with known noise: a correct derivative passes (or, under
+// noise too large to resolve it, is unresolved and says the floor), a wrong
+// one fails; the chosen step balances truncation and noise.
+#include "tools/derivative_verdict.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <stdexcept>
+
+namespace diffpd::problems {
+namespace {
+
+// Central differences of f at x over steps 1e-1, 1e-2, ... (count of them),
+// each evaluation carrying uniform noise of amplitude `noise` (declared to
+// the judge as noise / e, the bound on the difference's error).
+std::vector<FiniteDifference> Differences(const std::function<double(double)>& f, double x, double noise, int count,
+                                          std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  std::vector<FiniteDifference> out;
+  double e = 1e-1;
+  for (int k = 0; k < count; ++k, e /= 10) {
+    const double plus = f(x + e) + noise * unit(rng), minus = f(x - e) + noise * unit(rng);
+    out.push_back({e, (plus - minus) / (2 * e), noise / e});
+  }
+  return out;
+}
+
+double F(double x) { return std::exp(x) * std::sin(3 * x); }
+double DF(double x) { return std::exp(x) * (std::sin(3 * x) + 3 * std::cos(3 * x)); }
+
+TEST(DerivativeVerdictTest, ACorrectDerivativeWithSmallNoisePassesWithItsMarginStated) {
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const auto d = Differences(F, 0.4, 1e-13, 6, seed);
+    const DerivativeJudgement j = JudgeDerivative(DF(0.4), d, 1e-4);
+    EXPECT_EQ(j.verdict, CheckVerdict::kPass) << j.reason;
+    EXPECT_LT(j.error, 1e-7);
+    EXPECT_GE(j.margin, 100.0);
+    EXPECT_EQ(j.margin, 1e-4 / std::max(j.error, j.floor));
+    EXPECT_TRUE(j.reason.empty());
+    // Truncation ~ e^2 and noise ~ 1e-13 / e balance near e = 1e-4.
+    EXPECT_GE(j.step, 1e-5);
+    EXPECT_LE(j.step, 1e-3);
+  }
+}
+
+TEST(DerivativeVerdictTest, ACorrectDerivativeUnderLargeNoiseIsUnresolvedWithTheFloor) {
+  // Noise 1e-6 per evaluation: the best difference is good to ~1e-4 only.
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const auto d = Differences(F, 0.4, 1e-5, 5, seed);
+    const DerivativeJudgement j = JudgeDerivative(DF(0.4), d, 1e-5);
+    EXPECT_NE(j.verdict, CheckVerdict::kFail) << j.reason;
+    if (j.verdict == CheckVerdict::kUnresolved) {
+      EXPECT_GT(j.floor, 1e-5);
+      EXPECT_NE(j.reason.find("resolve the derivative only to"), std::string::npos) << j.reason;
+    }
+  }
+  // The same noise with a looser tolerance resolves it.
+  const DerivativeJudgement loose = JudgeDerivative(DF(0.4), Differences(F, 0.4, 1e-5, 5, 3), 1e-2);
+  EXPECT_EQ(loose.verdict, CheckVerdict::kPass) << loose.reason;
+  EXPECT_GE(loose.margin, 3.0);
+}
+
+TEST(DerivativeVerdictTest, AWrongDerivativeFailsUnderTheSameNoise) {
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    // 1e-3 relative off: resolved by differences good to 1e-7.
+    const DerivativeJudgement small_noise =
+        JudgeDerivative(DF(0.4) * (1 + 1e-3), Differences(F, 0.4, 1e-13, 6, seed), 1e-4);
+    EXPECT_EQ(small_noise.verdict, CheckVerdict::kFail);
+    EXPECT_GT(small_noise.error, 9e-4);
+    EXPECT_LT(small_noise.margin, 1.0);
+    EXPECT_EQ(small_noise.reason.rfind("differs by ", 0), 0u) << small_noise.reason;
+    // 10% off under noise that resolves the derivative to ~1e-4 only.
+    const DerivativeJudgement large_noise = JudgeDerivative(DF(0.4) * 1.1, Differences(F, 0.4, 1e-5, 5, seed), 1e-5);
+    EXPECT_EQ(large_noise.verdict, CheckVerdict::kFail);
+  }
+  // A zero derivative where there is one.
+  EXPECT_EQ(JudgeDerivative(0.0, Differences(F, 0.4, 1e-13, 6, 1), 1e-4).verdict, CheckVerdict::kFail);
+}
+
+TEST(DerivativeVerdictTest, NoiseThatSwampsTheDerivativeIsUnresolvedNotPassedOrFailed) {
+  // A derivative of 1e-9 against noise of 1e-6 per evaluation: the differences
+  // scatter; the analytic value can neither be confirmed nor refuted.
+  const auto flat = [](double x) { return 1e-9 * x; };
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const DerivativeJudgement j = JudgeDerivative(1e-9, Differences(flat, 0.0, 1e-6, 4, seed), 1e-4);
+    EXPECT_EQ(j.verdict, CheckVerdict::kUnresolved) << j.reason;
+    EXPECT_GT(j.floor, 1.0);
+  }
+}
+
+TEST(DerivativeVerdictTest, AKinkWithinTheLargerStepsMovesTheChoiceToSmallerOnes) {
+  // |x - 0.005| + 2x: derivative 1 at x = 0, seen by steps below 5e-3 only.
+  const auto kinked = [](double x) { return std::abs(x - 0.005) + 2 * x; };
+  const DerivativeJudgement j = JudgeDerivative(1.0, Differences(kinked, 0.0, 1e-15, 5, 1), 1e-6);
+  EXPECT_EQ(j.verdict, CheckVerdict::kPass) << j.reason;
+  EXPECT_LE(j.step, 1e-3);
+}
+
+TEST(DerivativeVerdictTest, VerdictsOrderAndNames) {
+  EXPECT_EQ(Worse(CheckVerdict::kPass, CheckVerdict::kUnresolved), CheckVerdict::kUnresolved);
+  EXPECT_EQ(Worse(CheckVerdict::kFail, CheckVerdict::kUnresolved), CheckVerdict::kFail);
+  EXPECT_EQ(Worse(CheckVerdict::kPass, CheckVerdict::kPass), CheckVerdict::kPass);
+  EXPECT_STREQ(ToString(CheckVerdict::kPass), "pass");
+  EXPECT_STREQ(ToString(CheckVerdict::kFail), "fail");
+  EXPECT_STREQ(ToString(CheckVerdict::kUnresolved), "unresolved");
+  EXPECT_THROW(JudgeDerivative(1.0, {}, 1e-4), std::invalid_argument);
+  EXPECT_THROW(JudgeDerivative(1.0, {{1e-2, 1.0, 0.0}}, 0.0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace diffpd::problems

@@ -1,0 +1,129 @@
+// The rollout gradient check: on a small beam, pd-lbfgs and newton-cholesky
+// at the recommended solve tolerance pass every input kind with a margin of
+// at least 10 (pd-lbfgs also against the Newton-Cholesky reference); an
+// inaccurate adjoint fails, and says against what; the reports carry the
+// result's numbers; bad options are refused with exact messages.
+#include "tools/gradcheck.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "diffpd/error.h"
+#include "diffpd/simulator.h"
+#include "test_scenes.h"
+#include "util/expect_message.h"
+
+namespace diffpd::problems {
+namespace {
+
+SolverOptions CheckOptions(Method method) {
+  SolverOptions o = testing::TightOptions(method);
+  o.rel_tolerance = RecommendedGradCheckRelTolerance(method);
+  o.backward_rel_tolerance = 1e-12;
+  return o;
+}
+
+GradCheckResult Check(const SolverOptions& options, const GradCheckOptions& check = GradCheckOptions()) {
+  const Scene scene = testing::SmallBeamScene();
+  Simulator sim(scene, options);
+  return CheckRolloutGradient(scene, options, testing::MovingStart(sim), 3, check);
+}
+
+class GradCheckMethodTest : public ::testing::TestWithParam<Method> {};
+
+TEST_P(GradCheckMethodTest, EveryInputKindPassesWithAMarginOfAtLeastTen) {
+  const Method method = GetParam();
+  const GradCheckResult r = Check(CheckOptions(method));
+  EXPECT_EQ(r.method, ToString(method));
+  EXPECT_EQ(r.verdict, CheckVerdict::kPass) << GradCheckTable(r);
+  EXPECT_GE(r.min_margin, 10.0) << GradCheckTable(r);
+  EXPECT_EQ(r.inputs.size(), 6u);
+  for (const auto& e : r.inputs) {
+    SCOPED_TRACE(e.input);
+    EXPECT_EQ(e.verdict, CheckVerdict::kPass) << e.reason;
+    EXPECT_EQ(e.directions, e.entries == 1 ? 1 : 2);  // scalar parameters: one direction
+    EXPECT_LE(e.error * 10, r.tolerance);
+    EXPECT_LE(e.floor * 10, r.tolerance);
+    EXPECT_GT(e.step, 0.0);
+  }
+  // The iterative method is compared with a converged Newton-Cholesky
+  // rollout by default; Newton-Cholesky itself is not.
+  EXPECT_EQ(r.reference, method == Method::kPdLbfgs);
+  for (const auto& e : r.inputs) {
+    if (r.reference) {
+      EXPECT_LE(e.reference_error, 1e-6) << e.input;
+    } else {
+      EXPECT_TRUE(std::isnan(e.reference_error)) << e.input;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, GradCheckMethodTest, ::testing::Values(Method::kPdLbfgs, Method::kNewtonCholesky),
+                         [](const ::testing::TestParamInfo<Method>& info) {
+                           return info.param == Method::kPdLbfgs ? std::string("pd_lbfgs")
+                                                                 : std::string("newton_cholesky");
+                         });
+
+// An adjoint stopped at a relative residual of 0.3 gives a gradient wrong by
+// far more than the tolerance: the differences and the reference both catch it.
+TEST(GradCheckTest, AnInaccurateAdjointFails) {
+  SolverOptions options = CheckOptions(Method::kPdLbfgs);
+  options.backward_rel_tolerance = 0.3;
+  const GradCheckResult r = Check(options);
+  EXPECT_EQ(r.verdict, CheckVerdict::kFail) << GradCheckTable(r);
+  EXPECT_GE(r.Count(CheckVerdict::kFail), 1);
+  EXPECT_LT(r.min_margin, 1.0);
+  bool reference_named = false;
+  for (const auto& e : r.inputs)
+    if (e.verdict == CheckVerdict::kFail)
+      reference_named = reference_named || e.reason.rfind("differs from the Newton-Cholesky reference by ", 0) == 0;
+  EXPECT_TRUE(reference_named) << GradCheckTable(r);
+  // Without the reference, the differences alone catch it.
+  GradCheckOptions no_reference;
+  no_reference.reference = false;
+  const GradCheckResult d = Check(options, no_reference);
+  EXPECT_EQ(d.verdict, CheckVerdict::kFail) << GradCheckTable(d);
+  for (const auto& e : d.inputs)
+    if (e.verdict == CheckVerdict::kFail) {
+      EXPECT_EQ(e.reason.rfind("differs by ", 0), 0u) << e.reason;
+    }
+}
+
+TEST(GradCheckTest, TableAndJsonReportTheResult) {
+  GradCheckOptions check;
+  check.directions = 1;
+  const GradCheckResult r = Check(CheckOptions(Method::kNewtonCholesky), check);
+  const nlohmann::json j = GradCheckToJson(r);
+  EXPECT_EQ(j.at("method"), "newton-cholesky");
+  EXPECT_EQ(j.at("verdict"), "pass");
+  EXPECT_EQ(j.at("pass").get<int>(), static_cast<int>(r.inputs.size()));
+  EXPECT_EQ(j.at("unresolved").get<int>(), 0);
+  EXPECT_DOUBLE_EQ(j.at("inputs").at("x0").at("error").get<double>(), r.inputs[0].error);
+  EXPECT_TRUE(j.at("inputs").at("x0").at("reference_error").is_null());  // not compared
+  const std::string table = GradCheckTable(r);
+  EXPECT_NE(table.find("youngs_modulus"), std::string::npos) << table;
+  EXPECT_NE(table.find("# newton-cholesky: pass (tolerance 0.0001; 6 pass, 0 fail, 0 unresolved"), std::string::npos)
+      << table;
+}
+
+TEST(GradCheckTest, InvalidOptionsAreRefusedWithExactMessages) {
+  GradCheckOptions o;
+  o.directions = 0;
+  EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }), "directions = 0 is invalid: must be >= 1");
+  o = GradCheckOptions();
+  o.tolerance = -1;
+  EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }),
+            "tolerance = -1 is invalid: must be finite and > 0");
+  o = GradCheckOptions();
+  o.step_count = 1;
+  EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }), "step_count = 1 is invalid: must be >= 2");
+  o = GradCheckOptions();
+  o.reference_rel_tolerance = 1;
+  EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }),
+            "reference_rel_tolerance = 1 is invalid: must be in (0, 1)");
+}
+
+}  // namespace
+}  // namespace diffpd::problems
