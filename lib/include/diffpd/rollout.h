@@ -62,8 +62,14 @@ struct Rollout {
   // One per Scene::material_regions entry, in order (empty without regions).
   std::vector<MaterialParameters> region_materials;
   SolverOptions options;
+  // Closed loop (Simulator::Simulate with a Controller, controller.h): the
+  // controller's memory m_0..m_K and the parameters it acted with; `inputs`
+  // hold its actions. Both empty for an open-loop rollout.
+  std::vector<VectorXd> controller_memory;
+  VectorXd controller_parameters;
 
   int num_steps() const { return static_cast<int>(inputs.size()); }
+  bool closed_loop() const { return !controller_memory.empty(); }
   double forward_seconds() const;
 };
 
@@ -95,6 +101,12 @@ struct RolloutGradient {
   // One per Scene::material_regions entry, in order (empty without regions):
   // dL/dE_r (per Pa), dL/dnu_r, dL/drho_r (per kg/m^3) of region r.
   std::vector<MaterialComponents> region_materials;
+  // Closed loop (Backward with the rollout's controller): dL/dtheta of the
+  // controller's parameters and dL/dm_0 of its initial memory; empty
+  // otherwise. `activation` and `external_force` then hold dL/du_k, the
+  // gradients w.r.t. the recorded actions.
+  VectorXd controller_parameters;
+  VectorXd controller_memory;
   BackwardReport report;
 };
 
