@@ -11,6 +11,8 @@
 #include "scenes/cantilever_plane.h"
 #include "diffpd/error.h"
 #include "control/locomotion.h"
+#include "control/shark_control.h"
+#include "control/starfish_control.h"
 #include "scenes/rolling_sphere.h"
 #include "scenes/routing_tendon.h"
 
@@ -29,6 +31,8 @@ std::vector<std::unique_ptr<Problem>> AllProblems() {
   all.push_back(std::make_unique<Locomotion>(Locomotion::Body::kTorus));
   all.push_back(std::make_unique<Locomotion>(Locomotion::Body::kQuadruped));
   all.push_back(std::make_unique<Locomotion>(Locomotion::Body::kCow));
+  all.push_back(std::make_unique<StarfishControl>());
+  all.push_back(std::make_unique<SharkControl>());
   all.push_back(std::make_unique<CantileverCalibration>());
   all.push_back(std::make_unique<PlantCalibration>());
   all.push_back(std::make_unique<BouncingBallCalibration>());

@@ -22,6 +22,11 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/control/bunny.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/routing_tendon_opt.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/locomotion.cc
+  # control: closed-loop swimming, controllers trained through the simulation (Adam)
+  ${CMAKE_CURRENT_LIST_DIR}/control/adam.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_control.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/starfish_control.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/shark_control.cc
   # tools
   ${CMAKE_CURRENT_LIST_DIR}/tools/gradcheck.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/bench.cc

@@ -34,6 +34,10 @@ struct CommandArgs {
   bool small = false;
   bool compare_newton = true;
   std::vector<std::string> ipopt_options;
+  // Control problems (starfish-control, shark-control): training
+  // evaluations (-1: the problem's) and the network's seed (-1: the problem's).
+  int evaluations = -1;
+  long long seed = -1;
   // Calibration problems (calibrate-*): the captured-motion file (default:
   // the problem's file in data/), the methods to fit with and compare
   // (default: the problem's), a cap on Ceres iterations (-1: the problem's);

@@ -55,6 +55,11 @@ int main(int argc, char** argv) {
   run->add_flag("!--no-compare", run_args.compare_newton,
                 "optimisation problems: skip the repeat with newton-cholesky");
   run->add_option("--ipopt", run_args.ipopt_options, "optimisation problems: Ipopt option name=value (repeatable)");
+  run->add_option("--evaluations", run_args.evaluations,
+                  "control problems: training evaluations (rollout + gradient; default 100, --small fewer)")
+      ->check(CLI::PositiveNumber);
+  run->add_option("--seed", run_args.seed, "control problems: seed of the network's initial weights (default 42)")
+      ->check(CLI::NonNegativeNumber);
   run->add_option("--data", run_args.data_file,
                   "calibration problems: captured-motion CSV (default: the problem's in data/)");
   run->add_option("--methods", run_args.methods,

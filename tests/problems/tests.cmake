@@ -14,3 +14,7 @@ diffpd_add_test(trajectory_optimization_test ${_dir}/control/trajectory_optimiza
 diffpd_add_test(bench_test ${_dir}/tools/bench_test.cc LIBS diffpd_problems)
 diffpd_add_test(tradeoff_test ${_dir}/tools/tradeoff_test.cc LIBS diffpd_problems)
 diffpd_add_test(stress_test ${_dir}/tools/stress_test.cc LIBS diffpd_problems)
+diffpd_add_test(adam_test ${_dir}/control/adam_test.cc LIBS diffpd_problems)
+diffpd_add_test(swimmer_scenes_test ${_dir}/control/swimmer_scenes_test.cc LIBS diffpd_problems)
+diffpd_add_test(starfish_control_test ${_dir}/control/starfish_control_test.cc LIBS diffpd_problems)
+diffpd_add_test(shark_control_test ${_dir}/control/shark_control_test.cc LIBS diffpd_problems)
