@@ -1,7 +1,8 @@
 # Sources of the problems library (paths relative to problems/), by kind:
-# the problem interface and registry, scenes, calibration (Ceres), control
-# (Ipopt), tools (bench, tradeoff, stress, gradcheck) and the command-line
-# program's subcommands.
+# the problem interface and registry, scenes, tools (bench, tradeoff, stress,
+# gradcheck) and the command-line program's subcommands; calibration (with
+# the Ceres adapter) and control (with the Ipopt adapter) in lists of their
+# own, compiled when the adapter is built.
 set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/problem_registry.cc
   ${CMAKE_CURRENT_LIST_DIR}/shared_data.cc
@@ -11,18 +12,7 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/scenes/rolling_sphere.cc
   ${CMAKE_CURRENT_LIST_DIR}/scenes/bouncing_ball.cc
   ${CMAKE_CURRENT_LIST_DIR}/scenes/routing_tendon.cc
-  # calibration: system identification with Ceres
-  ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_problem.cc
-  ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_cantilever.cc
-  ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_plant.cc
-  ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_bouncing_ball.cc
-  ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_starfish.cc
-  # control: trajectory and control optimisation with Ipopt
-  ${CMAKE_CURRENT_LIST_DIR}/control/trajectory_optimization.cc
-  ${CMAKE_CURRENT_LIST_DIR}/control/bunny.cc
-  ${CMAKE_CURRENT_LIST_DIR}/control/routing_tendon_opt.cc
-  ${CMAKE_CURRENT_LIST_DIR}/control/locomotion.cc
-  # control: closed-loop swimming, controllers trained through the simulation (Adam)
+  # control: closed-loop swimming, controllers trained through the simulation
   ${CMAKE_CURRENT_LIST_DIR}/control/adam.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_control.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/starfish_control.cc
@@ -40,6 +30,19 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/cli/tradeoff_command.cc
   ${CMAKE_CURRENT_LIST_DIR}/cli/stress_command.cc
   ${CMAKE_CURRENT_LIST_DIR}/cli/synth_command.cc)
+# calibration: system identification with Ceres
+set(DIFFPD_PROBLEMS_CALIBRATION_SOURCES
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_problem.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_cantilever.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_plant.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_bouncing_ball.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_starfish.cc)
+# control: trajectory and control optimisation with Ipopt
+set(DIFFPD_PROBLEMS_CONTROL_SOURCES
+  ${CMAKE_CURRENT_LIST_DIR}/control/trajectory_optimization.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/bunny.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/routing_tendon_opt.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/locomotion.cc)
 get_filename_component(DIFFPD_DEFAULT_SHARED_DATA_DIR "${CMAKE_CURRENT_LIST_DIR}/../../shared/data" ABSOLUTE)
 set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/shared_data.cc PROPERTIES
   COMPILE_DEFINITIONS "DIFFPD_SHARED_DATA_DIR=\"${DIFFPD_DEFAULT_SHARED_DATA_DIR}\"")

@@ -13,8 +13,10 @@
 #include "cli/commands.h"
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
-#include "diffpd/solvers/coordinate_manifold.h"
-#include "diffpd/solvers/marker_cost_function.h"
+#include "diffpd/solvers/ceres/coordinate_manifold.h"
+#include "diffpd/solvers/ceres/rollout_cost_function.h"
+#include "diffpd/solvers/ceres/rollout_evaluation_callback.h"
+#include "diffpd/solvers/core/marker_residuals.h"
 #include "diffpd/vtk_writer.h"
 
 #ifndef DIFFPD_PROJECT_DATA_DIR
@@ -24,15 +26,15 @@
 namespace diffpd::problems {
 namespace {
 
-using solvers::MaterialParameter;
+using solvers::MaterialField;
 
-double Value(const MaterialParameters& m, MaterialParameter p) {
+double Value(const MaterialParameters& m, MaterialField p) {
   switch (p) {
-    case MaterialParameter::kYoungsModulus:
+    case MaterialField::kYoungsModulus:
       return m.youngs_modulus;
-    case MaterialParameter::kPoissonsRatio:
+    case MaterialField::kPoissonsRatio:
       return m.poissons_ratio;
-    case MaterialParameter::kDensity:
+    case MaterialField::kDensity:
       return m.density;
   }
   return 0;
@@ -41,13 +43,13 @@ double Value(const MaterialParameters& m, MaterialParameter p) {
 // Ceres' iteration table with the current parameter values appended.
 class IterationTable : public ceres::IterationCallback {
  public:
-  IterationTable(FILE* log, const std::vector<MaterialParameter>& fitted, const double* block)
+  IterationTable(FILE* log, const std::vector<MaterialField>& fitted, const double* block)
       : log_(log), fitted_(fitted), block_(block) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     if (s.iteration == 0) {
       std::fprintf(log_, "%4s %13s %11s %11s %11s %10s %9s %9s", "iter", "cost", "cost_change", "|gradient|", "|step|",
                    "tr_radius", "iter_time", "total_t");
-      for (MaterialParameter p : fitted_) std::fprintf(log_, " %14s", ToString(p));
+      for (MaterialField p : fitted_) std::fprintf(log_, " %14s", ToString(p));
       std::fprintf(log_, "\n");
     }
     std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %11.3e %10.3e %9.2e %9.2e", s.iteration, s.cost, s.cost_change,
@@ -61,7 +63,7 @@ class IterationTable : public ceres::IterationCallback {
 
  private:
   FILE* log_;
-  std::vector<MaterialParameter> fitted_;
+  std::vector<MaterialField> fitted_;
   const double* block_;
 };
 
@@ -236,43 +238,42 @@ std::string CalibrationProblem::DefaultDataPath() const {
 CalibrationFit CalibrationProblem::Fit(const CapturedMotion& motion, Method method, int max_iterations,
                                        FILE* log) const {
   const auto start = std::chrono::steady_clock::now();
-  solvers::CalibrationSetup setup;
-  setup.scene = MakeScene();
-  setup.scene.material = initial_guess();
-  setup.solver = FitOptions(method);
-  setup.motion = motion;
-  setup.fitted = fitted();
-  setup.num_steps = MarkerObservations::RequiredSteps(motion, setup.solver.time_step);
-  {
-    Simulator sim(setup.scene, setup.solver);
-    setup.initial = InitialState(sim);
-    setup.inputs = Inputs(sim, setup.num_steps);
-  }
-  solvers::CalibrationModel model(setup);
+  Scene scene = MakeScene();
+  scene.material = initial_guess();
+  const SolverOptions solver = FitOptions(method);
+  const int steps = MarkerObservations::RequiredSteps(motion, solver.time_step);
+  solvers::RolloutFunction function(scene, solver, steps);
+  function.SetInitialState(InitialState(function.simulator()));
+  function.SetInputs(Inputs(function.simulator(), steps));
+  const std::vector<MaterialField> fields = fitted();
+  function.AddBlock(std::make_unique<solvers::MaterialBlock>(
+      std::vector<solvers::MaterialBlock::Entry>(fields.begin(), fields.end()), scene));
+  const int markers =
+      function.AddFunctional(std::make_unique<solvers::MarkerResiduals>(motion, scene.mesh, solver.time_step, steps));
   CalibrationFit fit;
   fit.method = method;
-  fit.fitted = setup.fitted;
-  std::vector<double> block(setup.fitted.size());
-  model.InitialMaterialBlock(block.data());
+  fit.fitted = fields;
+  const VectorXd start_values = function.initial_parameters();
+  std::vector<double> block(start_values.data(), start_values.data() + start_values.size());
   fit.initial = block;
 
-  solvers::RolloutEvaluationCallback callback(&model, {block.data()});
+  solvers::RolloutEvaluationCallback callback(&function, {block.data()});
   ceres::Problem::Options problem_options;
   problem_options.evaluation_callback = &callback;
   ceres::Problem problem(problem_options);
-  solvers::AddMarkerResidualBlocks(&problem, &model, {block.data()});
+  const size_t frames = solvers::AddMarkerResidualBlocks(&problem, &function, markers, {block.data()}).size();
   // E and rho step in log space; nu linearly within bounds [0.01, 0.49].
   std::vector<solvers::CoordinateMap> maps;
-  for (size_t i = 0; i < setup.fitted.size(); ++i) {
-    if (setup.fitted[i] == MaterialParameter::kPoissonsRatio) {
+  for (size_t i = 0; i < fields.size(); ++i) {
+    if (fields[i] == MaterialField::kPoissonsRatio) {
       maps.push_back(solvers::CoordinateMap::Linear());
     } else {
       maps.push_back(solvers::CoordinateMap::Log());
     }
   }
   problem.SetManifold(block.data(), new solvers::CoordinateManifold(maps));
-  for (size_t i = 0; i < setup.fitted.size(); ++i)
-    if (setup.fitted[i] == MaterialParameter::kPoissonsRatio) {
+  for (size_t i = 0; i < fields.size(); ++i)
+    if (fields[i] == MaterialField::kPoissonsRatio) {
       problem.SetParameterLowerBound(block.data(), static_cast<int>(i), 0.01);
       problem.SetParameterUpperBound(block.data(), static_cast<int>(i), 0.49);
     }
@@ -285,13 +286,13 @@ CalibrationFit CalibrationProblem::Fit(const CapturedMotion& motion, Method meth
   options.gradient_tolerance = 1e-14;
   options.update_state_every_iteration = true;
   options.logging_type = ceres::SILENT;
-  IterationTable table(log, setup.fitted, block.data());
+  IterationTable table(log, fields, block.data());
   if (log) {
     options.callbacks.push_back(&table);
     std::fprintf(
         log,
         "# fit with %s: Levenberg-Marquardt on log E and nu in [0.01, 0.49]; %zu residual blocks (one per frame)\n",
-        ToString(method), model.SamplesByFrame().size());
+        ToString(method), frames);
   }
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
@@ -301,14 +302,15 @@ CalibrationFit CalibrationProblem::Fit(const CapturedMotion& motion, Method meth
   fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
   fit.usable = summary.IsSolutionUsable() && summary.termination_type != ceres::FAILURE;
   fit.termination = summary.message;
-  const std::vector<const double*> final_blocks = {block.data()};
-  if (model.Evaluate(final_blocks.data(), false)) {
-    fit.rollout = model.rollout();
-    fit.marker_rmse_m = MarkerRmse(model.observations(), fit.rollout.states);
+  const Rollout* rollout = function.RolloutAt(Eigen::Map<const VectorXd>(block.data(), block.size()));
+  if (rollout) {
+    fit.rollout = *rollout;
+    const auto& residuals = dynamic_cast<const solvers::MarkerResiduals&>(function.functional(markers));
+    fit.marker_rmse_m = MarkerRmse(residuals.observations(), fit.rollout.states);
   } else {
     fit.usable = false;
   }
-  fit.statistics = model.statistics();
+  fit.statistics = function.statistics();
   fit.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return fit;
 }
@@ -319,7 +321,7 @@ nlohmann::json CalibrationProblem::Report(const std::vector<CalibrationFit>& fit
   out["data_file"] = data_path;
   const MaterialParameters t = truth();
   nlohmann::json truth_json, fits_json = nlohmann::json::array();
-  for (MaterialParameter p : fitted()) truth_json[ToString(p)] = Value(t, p);
+  for (MaterialField p : fitted()) truth_json[ToString(p)] = Value(t, p);
   for (const CalibrationFit& f : fits) {
     nlohmann::json j;
     j["method"] = ToString(f.method);
@@ -379,7 +381,7 @@ int CalibrationProblem::Run(const CommandArgs& args) const {
   std::fprintf(log, "# captured motion: %s (%zu markers, %zu samples)\n", data_path.c_str(), motion.markers.size(),
                motion.samples.size());
   std::fprintf(log, "# fitting");
-  for (MaterialParameter p : fitted())
+  for (MaterialField p : fitted())
     std::fprintf(log, " %s (start %g, truth %g)", ToString(p), Value(guess, p), Value(t, p));
   std::fprintf(log, "\n");
 
@@ -393,9 +395,9 @@ int CalibrationProblem::Run(const CommandArgs& args) const {
   }
 
   std::fprintf(log, "\n# recovered vs true parameters\n%-16s", "method");
-  for (MaterialParameter p : fitted()) std::fprintf(log, " %14s %10s", ToString(p), "rel_err");
+  for (MaterialField p : fitted()) std::fprintf(log, " %14s %10s", ToString(p), "rel_err");
   std::fprintf(log, " %14s\n%-16s", "marker_rmse_mm", "truth");
-  for (MaterialParameter p : fitted()) std::fprintf(log, " %14.6g %10s", Value(t, p), "");
+  for (MaterialField p : fitted()) std::fprintf(log, " %14.6g %10s", Value(t, p), "");
   std::fprintf(log, "\n");
   for (const CalibrationFit& f : fits) {
     std::fprintf(log, "%-16s", ToString(f.method));
@@ -409,7 +411,7 @@ int CalibrationProblem::Run(const CommandArgs& args) const {
   std::fprintf(log, "\n# the paper's columns (Sec. 7.1)\n%-16s %10s %10s %12s %14s %10s\n", "method", "forward_s",
                "backward_s", "evaluations", "final_loss", "total_s");
   for (const CalibrationFit& f : fits)
-    std::fprintf(log, "%-16s %10.2f %10.2f %12d %14.6e %10.2f\n", ToString(f.method), f.statistics.forward_seconds,
+    std::fprintf(log, "%-16s %10.2f %10.2f %12ld %14.6e %10.2f\n", ToString(f.method), f.statistics.forward_seconds,
                  f.statistics.backward_seconds, f.statistics.rollouts, f.final_cost, f.total_seconds);
   std::fprintf(log, "# evaluations: rollouts (distinct parameter values); backward: forward-mode Jacobians\n");
 

@@ -1,6 +1,6 @@
 // System identification problems (DiffPD Sec. 7.1): fit material parameters
-// to captured marker motion with Ceres through the calibration adapters
-// (diffpd/solvers/calibration_model.h), once per simulator method, and
+// to captured marker motion with Ceres over the rollout core
+// (diffpd/solvers/core/rollout_function.h), once per simulator method, and
 // report the paper's table columns.
 //
 // The captured motion shipped in data/ is synthesised by the problem itself
@@ -20,7 +20,8 @@
 #include <nlohmann/json.hpp>
 
 #include "diffpd/captured_motion.h"
-#include "diffpd/solvers/calibration_model.h"
+#include "diffpd/solvers/core/material_block.h"
+#include "diffpd/solvers/core/rollout_function.h"
 #include "problem.h"
 
 namespace diffpd::problems {
@@ -28,14 +29,14 @@ namespace diffpd::problems {
 // The outcome of one fit.
 struct CalibrationFit {
   Method method = Method::kPd;
-  std::vector<solvers::MaterialParameter> fitted;
-  std::vector<double> values;   // fitted values, in `fitted` order
-  std::vector<double> initial;  // starting values
-  double initial_cost = 0;      // 1/2 sum of squared weighted residuals
+  std::vector<solvers::MaterialField> fitted;  // of the base material
+  std::vector<double> values;                  // fitted values, in `fitted` order
+  std::vector<double> initial;                 // starting values
+  double initial_cost = 0;                     // 1/2 sum of squared weighted residuals
   double final_cost = 0;
-  double marker_rmse_m = 0;                   // sqrt(mean over samples of |simulated - captured|^2), unweighted
-  int iterations = 0;                         // Ceres iterations
-  solvers::CalibrationStatistics statistics;  // evaluations (rollouts), timings
+  double marker_rmse_m = 0;               // sqrt(mean over samples of |simulated - captured|^2), unweighted
+  int iterations = 0;                     // Ceres iterations
+  solvers::RolloutStatistics statistics;  // evaluations (rollouts), timings
   double total_seconds = 0;
   bool usable = false;      // Ceres' solution is usable
   std::string termination;  // Ceres' message
@@ -51,8 +52,8 @@ class CalibrationProblem : public Problem {
   virtual MaterialParameters truth() const = 0;
   // Where every fit starts.
   virtual MaterialParameters initial_guess() const = 0;
-  virtual std::vector<solvers::MaterialParameter> fitted() const {
-    return {solvers::MaterialParameter::kYoungsModulus, solvers::MaterialParameter::kPoissonsRatio};
+  virtual std::vector<solvers::MaterialField> fitted() const {
+    return {solvers::MaterialField::kYoungsModulus, solvers::MaterialField::kPoissonsRatio};
   }
   // Markers (ids 0..) and capture times (s) of the synthetic motion.
   virtual std::vector<Marker> Markers(const Mesh& mesh) const = 0;

@@ -17,6 +17,9 @@
 #include "diffpd/csv_fields.h"
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
+#include "diffpd/solvers/core/least_squares_loss.h"
+#include "diffpd/solvers/core/marker_residuals.h"
+#include "diffpd/solvers/core/material_block.h"
 #include "diffpd/surface_mesh.h"
 #include "diffpd/tetgen_io.h"
 #include "shared_data.h"
@@ -63,30 +66,38 @@ double Logit(double s) { return std::log(s / (1 - s)); }
 
 // The fit's objective over the bounded coordinates u (5 numbers: see
 // StarfishCalibration::FromCoordinates and ActuationFromCoordinates): the
-// model's scalar loss with its reverse-mode gradient, chained through the
-// coordinate maps.
+// model's scalar loss (its only row) with its reverse-mode gradient, chained
+// through the coordinate maps.
 // With arms (StarfishRegions::kBodyArms) u has a sixth coordinate, the arms'
 // E, and the model's material block is {E, nu, E_arms, nu_arms} with nu_arms
 // tied to nu.
 class BoundedLoss : public ceres::FirstOrderFunction {
  public:
-  BoundedLoss(solvers::CalibrationModel* model, double density, bool arms)
+  BoundedLoss(solvers::RolloutFunction* model, double density, bool arms)
       : model_(model), density_(density), arms_(arms) {}
   bool Evaluate(const double* u, double* cost, double* gradient) const override {
     const MaterialParameters m = StarfishCalibration::FromCoordinates(u, density_);
     const StarfishActuation a = StarfishCalibration::ActuationFromCoordinates(u + 2);
     const double arms_e = arms_ ? StarfishCalibration::FromCoordinates(u + 5, density_).youngs_modulus : 0;
-    const double material[4] = {m.youngs_modulus, m.poissons_ratio, arms_e, m.poissons_ratio};
-    const double actuation[3] = {a.slack, a.lag, a.length};
-    const double* blocks[2] = {material, actuation};
-    double g[7] = {0, 0, 0, 0, 0, 0, 0};
-    if (!model_->EvaluateLoss(blocks, {}, cost, gradient ? g : nullptr)) return false;
+    VectorXd p(arms_ ? 7 : 5);
+    if (arms_)
+      p << m.youngs_modulus, m.poissons_ratio, arms_e, m.poissons_ratio, a.slack, a.lag, a.length;
+    else
+      p << m.youngs_modulus, m.poissons_ratio, a.slack, a.lag, a.length;
+    VectorXd g;
+    if (gradient) {
+      if (!model_->Gradient(p, VectorXd::Ones(1), &g, cost)) return false;
+    } else {
+      VectorXd value;
+      if (!model_->Evaluate(p, {0}, &value, nullptr)) return false;
+      *cost = value(0);
+    }
     if (gradient) {
       // g: the material block (2 or 4 values) then the actuation block.
-      const double* ga = g + (arms_ ? 4 : 2);
-      const double g_nu = arms_ ? g[1] + g[3] : g[1];
+      const double* ga = g.data() + (arms_ ? 4 : 2);
+      const double g_nu = arms_ ? g(1) + g(3) : g(1);
       const double se = Sigmoid(u[0]), sn = Sigmoid(u[1]), ss = Sigmoid(u[2]), sl = Sigmoid(u[3]);
-      gradient[0] = g[0] * m.youngs_modulus * std::log(kMaxE / kMinE) * se * (1 - se);
+      gradient[0] = g(0) * m.youngs_modulus * std::log(kMaxE / kMinE) * se * (1 - se);
       gradient[1] = g_nu * m.poissons_ratio * std::log(kMaxNu / kMinNu) * sn * (1 - sn);
       gradient[2] = ga[0] * kMaxSlack * ss * (1 - ss);
       gradient[3] = ga[1] * a.lag * std::log(kMaxLag / kMinLag) * sl * (1 - sl);
@@ -94,7 +105,7 @@ class BoundedLoss : public ceres::FirstOrderFunction {
       gradient[4] = ga[2] * a.length * std::log(kMaxLength / kMinLength) * st * (1 - st);
       if (arms_) {
         const double sa = Sigmoid(u[5]);
-        gradient[5] = g[2] * arms_e * std::log(kMaxE / kMinE) * sa * (1 - sa);
+        gradient[5] = g(2) * arms_e * std::log(kMaxE / kMinE) * sa * (1 - sa);
       }
     }
     return std::isfinite(*cost);
@@ -102,31 +113,51 @@ class BoundedLoss : public ceres::FirstOrderFunction {
   int NumParameters() const override { return arms_ ? 6 : 5; }
 
  private:
-  solvers::CalibrationModel* model_;
+  solvers::RolloutFunction* model_;
   double density_;
   bool arms_;
 };
 
-// The activations of a window as the model's input block {slack, lag, length}.
-class TendonActuationInputs : public solvers::InputParameters {
+// The tendon actuation model (StarfishActivations) as a parameter block
+// {slack, lag, length} (m, s, m): it writes the activation of every muscle at
+// every step.
+class TendonActuationBlock : public solvers::ParameterBlock {
  public:
-  TendonActuationInputs(std::vector<double> contraction, double h, int muscles)
-      : contraction_(std::move(contraction)), h_(h), muscles_(muscles) {}
-  int size() const override { return 3; }
-  void Apply(const double* p, State* initial, std::vector<StepInput>* inputs,
-             std::vector<InputDirection>* directions) const override {
+  TendonActuationBlock(std::vector<double> contraction, double h, int muscles, const StarfishActuation& start)
+      : ParameterBlock(3), contraction_(std::move(contraction)), h_(h), muscles_(muscles) {
+    SetInitial(Eigen::Vector3d(start.slack, start.lag, start.length));
+  }
+  std::string name() const override { return "tendon_actuation"; }
+  void CheckFits(const Scene& scene, int num_steps) const override {
+    DIFFPD_CHECK(
+        static_cast<int>(scene.muscles.size()) == muscles_ && static_cast<int>(contraction_.size()) == num_steps,
+        "tendon actuation for " << muscles_ << " muscles over " << contraction_.size() << " steps");
+  }
+  void Apply(const Eigen::Ref<const VectorXd>& values, solvers::RolloutSetup* setup) const override {
+    const std::vector<double> a = StarfishActivations(contraction_, h_, At(values), nullptr);
+    for (size_t k = 0; k < a.size(); ++k) setup->inputs[k].activation = VectorXd::Constant(muscles_, a[k]);
+  }
+  void PullBack(const Eigen::Ref<const VectorXd>& values, const RolloutGradient& grad,
+                Eigen::Ref<VectorXd> out) const override {
     std::vector<std::array<double, 3>> d;
-    const std::vector<double> a =
-        StarfishActivations(contraction_, h_, StarfishActuation{p[0], p[1], p[2]}, directions ? &d : nullptr);
-    DIFFPD_CHECK(inputs->size() == a.size(), "TendonActuationInputs: step count mismatch");
-    for (size_t k = 0; k < a.size(); ++k) (*inputs)[k].activation = VectorXd::Constant(muscles_, a[k]);
-    if (!directions) return;
-    directions->assign(3, InputDirection());
-    for (size_t k = 0; k < a.size(); ++k)
-      for (int j = 0; j < 3; ++j) (*directions)[j].activation.push_back(VectorXd::Constant(muscles_, d[k][j]));
+    StarfishActivations(contraction_, h_, At(values), &d);
+    out.setZero();
+    for (int j = 0; j < 3; ++j)
+      for (size_t k = 0; k < d.size() && k < grad.activation.size(); ++k)
+        if (grad.activation[k].size()) out(j) += grad.activation[k].dot(VectorXd::Constant(muscles_, d[k][j]));
+  }
+  int FirstAffectedState(int j) const override { return 1; }
+  void PushForward(const Eigen::Ref<const VectorXd>& values, int j, const solvers::RolloutSetup& setup,
+                   InputDirection* direction) const override {
+    std::vector<std::array<double, 3>> d;
+    StarfishActivations(contraction_, h_, At(values), &d);
+    for (size_t k = 0; k < d.size(); ++k) direction->activation[k] = VectorXd::Constant(muscles_, d[k][j]);
   }
 
  private:
+  static StarfishActuation At(const Eigen::Ref<const VectorXd>& values) {
+    return StarfishActuation{values(0), values(1), values(2)};
+  }
   std::vector<double> contraction_;
   double h_;
   int muscles_;
@@ -520,38 +551,44 @@ StarfishErrors StarfishCalibration::WindowErrors(const Mesh& mesh, const std::ve
   return out;
 }
 
-std::unique_ptr<solvers::CalibrationModel> StarfishCalibration::MakeModel(const StarfishRecording& rec,
-                                                                          const StarfishWindow& w,
-                                                                          const SolverOptions& options,
-                                                                          const MaterialParameters& material,
-                                                                          const StarfishActuation& actuation) const {
-  solvers::CalibrationSetup setup;
-  setup.scene = MakeScene();
-  setup.scene.material = material;
-  for (MaterialRegion& region : setup.scene.material_regions) region.material = material;
-  setup.solver = options;
-  setup.solver.time_step = WindowTimeStep(rec, w, substeps_);
-  setup.fitted = {solvers::MaterialParameter::kYoungsModulus, solvers::MaterialParameter::kPoissonsRatio};
-  if (regions_ == StarfishRegions::kBodyArms)
-    setup.fitted_regions = {{0, solvers::MaterialParameter::kYoungsModulus},
-                            {0, solvers::MaterialParameter::kPoissonsRatio}};
-  setup.inputs = WindowInputs(rec, w, actuation);
-  setup.num_steps = static_cast<int>(setup.inputs.size());
-  setup.input_parameters =
-      std::make_shared<TendonActuationInputs>(WindowContractions(rec, w), setup.solver.time_step, 4);
-  setup.jacobian = solvers::JacobianMode::kReverse;
+std::unique_ptr<solvers::RolloutFunction> StarfishCalibration::MakeModel(const StarfishRecording& rec,
+                                                                         const StarfishWindow& w,
+                                                                         const SolverOptions& options,
+                                                                         const MaterialParameters& material,
+                                                                         const StarfishActuation& actuation) const {
+  using solvers::MaterialField;
+  Scene scene = MakeScene();
+  scene.material = material;
+  for (MaterialRegion& region : scene.material_regions) region.material = material;
+  SolverOptions solver = options;
+  solver.time_step = WindowTimeStep(rec, w, substeps_);
+  std::vector<StepInput> inputs = WindowInputs(rec, w, actuation);
+  const int steps = static_cast<int>(inputs.size());
+  State initial;
   {
-    Simulator sim(setup.scene, setup.solver);
-    setup.initial = WindowInitialState(sim, rec, w, actuation);
+    Simulator sim(scene, solver);
+    initial = WindowInitialState(sim, rec, w, actuation);
   }
-  setup.motion = WindowMotion(setup.scene.mesh, *setup.initial, rec, w);
-  return std::make_unique<solvers::CalibrationModel>(std::move(setup));
+  auto model = std::make_unique<solvers::RolloutFunction>(scene, solver, steps);
+  model->SetInitialState(initial);
+  model->SetInputs(std::move(inputs));
+  std::vector<solvers::MaterialBlock::Entry> fitted = {MaterialField::kYoungsModulus, MaterialField::kPoissonsRatio};
+  if (regions_ == StarfishRegions::kBodyArms) {
+    fitted.push_back({MaterialField::kYoungsModulus, 0});
+    fitted.push_back({MaterialField::kPoissonsRatio, 0});
+  }
+  model->AddBlock(std::make_unique<solvers::MaterialBlock>(fitted, scene));
+  model->AddBlock(std::make_unique<TendonActuationBlock>(WindowContractions(rec, w), solver.time_step,
+                                                         static_cast<int>(scene.muscles.size()), actuation));
+  model->AddFunctional(std::make_unique<solvers::LeastSquaresLoss>(std::make_unique<solvers::MarkerResiduals>(
+      WindowMotion(scene.mesh, initial, rec, w), scene.mesh, solver.time_step, steps)));
+  return model;
 }
 
 StarfishFit StarfishCalibration::Fit(const StarfishRecording& rec, const StarfishWindow& w,
                                      const SolverOptions& options, const MaterialParameters& guess,
                                      const StarfishActuation& actuation_guess, int max_iterations, FILE* log) const {
-  std::unique_ptr<solvers::CalibrationModel> model = MakeModel(rec, w, options, guess, actuation_guess);
+  std::unique_ptr<solvers::RolloutFunction> model = MakeModel(rec, w, options, guess, actuation_guess);
   const bool arms = regions_ == StarfishRegions::kBodyArms;
   double u[6];
   ToCoordinates(guess, u);
@@ -709,14 +746,14 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                               args.max_iterations >= 0 ? args.max_iterations : kDefaultIterations, log);
   const MaterialParameters& fitted = fit.material;
   const StarfishActuation& actuation = fit.actuation;
-  const solvers::CalibrationStatistics& stats = fit.statistics;
+  const solvers::RolloutStatistics& stats = fit.statistics;
   std::fprintf(log,
                "# fit: %s after %d iterations; E = %.6g Pa, nu = %.6g, slack = %.3f mm, lag = %.4f s, "
                "length = %.2f mm; loss %.6e -> %.6e\n",
                fit.termination.c_str(), fit.iterations, fitted.youngs_modulus, fitted.poissons_ratio,
                actuation.slack / kMm, actuation.lag, actuation.length / kMm, fit.initial_cost, fit.final_cost);
-  std::fprintf(log, "# fit: %d rollouts (%.2f s forward), %d gradients (%.2f s backward), %d failed\n", stats.rollouts,
-               stats.forward_seconds, stats.gradients, stats.backward_seconds, stats.failures);
+  std::fprintf(log, "# fit: %ld rollouts (%.2f s forward), %ld gradients (%.2f s backward), %ld failed\n",
+               stats.rollouts, stats.forward_seconds, stats.gradients, stats.backward_seconds, stats.failures);
   if (!fit.region_materials.empty())
     std::fprintf(log, "# fit: arms E = %.6g Pa (body E = %.6g Pa, ratio %.3g)\n",
                  fit.region_materials[0].youngs_modulus, fitted.youngs_modulus,

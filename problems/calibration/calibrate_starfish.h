@@ -37,7 +37,7 @@
 #include <nlohmann/json.hpp>
 
 #include "diffpd/captured_motion.h"
-#include "diffpd/solvers/calibration_model.h"
+#include "diffpd/solvers/core/rollout_function.h"
 #include "problem.h"
 
 namespace diffpd::problems {
@@ -145,10 +145,10 @@ struct StarfishFit {
   StarfishActuation actuation;  // fitted
   double initial_cost = 0;      // loss 1/2 |r|^2 (see WindowMotion) at the start
   double final_cost = 0;
-  int iterations = 0;                         // Ceres L-BFGS iterations
-  bool usable = false;                        // Ceres' solution is usable
-  std::string termination;                    // Ceres' message
-  solvers::CalibrationStatistics statistics;  // rollouts, gradients, timings
+  int iterations = 0;                     // Ceres L-BFGS iterations
+  bool usable = false;                    // Ceres' solution is usable
+  std::string termination;                // Ceres' message
+  solvers::RolloutStatistics statistics;  // rollouts, gradients, timings
 };
 
 class StarfishCalibration : public Problem {
@@ -207,16 +207,17 @@ class StarfishCalibration : public Problem {
   // at a multiple of the cost), backward relative tolerance 1e-8.
   SolverOptions Options(Method method, int threads) const;
 
-  // The calibration model of a window (reverse-mode gradients of the scalar
-  // loss 1/2 |r|^2) at `material` and `actuation`. Parameter blocks: {E, nu}
-  // (Pa, 1; with kBodyArms {E, nu, E_arms, nu_arms}, the arms region starting
-  // at `material` too) and {slack, lag, length} (m, s, m; the activations are
-  // an input block). The initial state is WindowInitialState at `actuation` and is
-  // held fixed, so the gradient is exact when the window starts with the
-  // tendon slack (a = 1, as in the default fit window from rest).
-  std::unique_ptr<solvers::CalibrationModel> MakeModel(const StarfishRecording& recording, const StarfishWindow& window,
-                                                       const SolverOptions& options, const MaterialParameters& material,
-                                                       const StarfishActuation& actuation) const;
+  // The rollout function of a window at `material` and `actuation`: blocks
+  // {E, nu} (Pa, 1; with kBodyArms {E, nu, E_arms, nu_arms}, the arms region
+  // starting at `material` too) and {slack, lag, length} (m, s, m; the tendon
+  // actuation model, which writes every step's activations), and one row, the
+  // scalar loss 1/2 |r|^2 of the marker residuals (LeastSquaresLoss; its
+  // gradient is one adjoint). The initial state is WindowInitialState at
+  // `actuation` and is held fixed, so the gradient is exact when the window
+  // starts with the tendon slack (a = 1, as in the default fit window from rest).
+  std::unique_ptr<solvers::RolloutFunction> MakeModel(const StarfishRecording& recording, const StarfishWindow& window,
+                                                      const SolverOptions& options, const MaterialParameters& material,
+                                                      const StarfishActuation& actuation) const;
 
   // Fits E, nu, slack, lag and length on a window with Ceres' L-BFGS
   // (GradientProblem) on the bounded coordinates below (u = 2 material then

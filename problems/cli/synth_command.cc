@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <memory>
 
+#if DIFFPD_WITH_CERES
 #include "calibration/calibrate_problem.h"
+#endif
 #include "cli/commands.h"
 #include "diffpd/error.h"
 #include "problem_registry.h"
@@ -26,7 +28,8 @@ Subcommand AddSynthCommand(CLI::App* parent) {
   cmd->add_option("--dir", args->dir, "output directory")->capture_default_str();
   Subcommand sub;
   sub.app = cmd;
-  sub.run = [args]() {
+  sub.run = [args]() -> int {
+#if DIFFPD_WITH_CERES
     const std::unique_ptr<Problem> problem = MakeProblem(args->problem);
     const auto* calibration = dynamic_cast<const CalibrationProblem*>(problem.get());
     if (!calibration)
@@ -34,6 +37,11 @@ Subcommand AddSynthCommand(CLI::App* parent) {
                               "' has no synthetic captured motion (not a calibration problem)");
     for (const std::string& path : calibration->WriteSyntheticData(args->dir)) std::printf("wrote %s\n", path.c_str());
     return 0;
+#else
+    throw InvalidInputError(
+        "diffpd synth: this diffpd was built without the Ceres adapter (DIFFPD_WITH_CERES), "
+        "so it has no calibration problem");
+#endif
   };
   return sub;
 }

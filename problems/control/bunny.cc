@@ -5,8 +5,8 @@
 #include "diffpd/state_forces.h"
 #include "diffpd/surface_mesh.h"
 #include "diffpd/voxelizer.h"
-#include "diffpd/solvers/control_variables.h"
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/initial_state_block.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 #include "shared_data.h"
 
 namespace diffpd::problems {
@@ -46,23 +46,21 @@ State Bunny::InitialState(const Simulator& sim) const {
   return s;
 }
 
-Ipopt::SmartPtr<solvers::RolloutNlp> Bunny::MakeNlp(Simulator* sim, InstanceSize size) const {
+Ipopt::SmartPtr<solvers::RolloutNlp> Bunny::MakeNlp(const SolverOptions& options, InstanceSize size) const {
   using namespace solvers;
   const int K = steps(size);
-  RolloutSetup setup;
-  setup.initial = sim->RestState();
-  setup.inputs.resize(K);
-  setup.material = sim->scene().material;
-  Ipopt::SmartPtr<RolloutNlp> nlp = new RolloutNlp(sim, setup);
-  const int n = sim->scene().mesh.num_vertices();
+  Ipopt::SmartPtr<RolloutNlp> nlp = new RolloutNlp(std::make_unique<RolloutFunction>(MakeScene(size), options, K));
+  const Simulator& sim = nlp->function().simulator();
+  const int n = sim.scene().mesh.num_vertices();
   std::vector<int> all(n);
   for (int i = 0; i < n; ++i) all[i] = i;
-  auto velocity = std::make_unique<InitialStateVariables>(InitialStateVariables::kVelocity, all);
+  auto velocity = std::make_unique<InitialStateBlock>(InitialStateBlock::kVelocity, all);
   velocity->SetBounds(-3.0, 3.0);
   velocity->SetInitial(kInitialGuess);
   nlp->AddVariables(std::move(velocity));
-  const TrackedPoint com = CentreOfMass(sim->LumpedMass());
-  const Vec3 target = com.At(setup.initial.x) + Vec3(options_.target_offset.x(), options_.target_offset.y(), 0.0);
+  const TrackedPoint com = CentreOfMass(sim.LumpedMass());
+  const Vec3 target =
+      com.At(nlp->function().base().initial.x) + Vec3(options_.target_offset.x(), options_.target_offset.y(), 0.0);
   nlp->AddObjective(
       std::make_unique<PointDistanceSquared>(com, kFinalState, target, "landing_error", Vec3(1.0, 1.0, 0.0)));
   nlp->AddConstraint(std::make_unique<PointCoordinate>(com, K / 4, Vec3::UnitZ(), "clear_wall"), options_.wall_height,

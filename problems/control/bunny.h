@@ -29,7 +29,7 @@ class Bunny : public TrajectoryOptimizationProblem {
   Scene MakeScene(InstanceSize size) const override;
   int steps(InstanceSize size) const override { return size == InstanceSize::kSmall ? 40 : 60; }
   double time_step(InstanceSize size) const override { return 0.01; }
-  Ipopt::SmartPtr<solvers::RolloutNlp> MakeNlp(Simulator* sim, InstanceSize size) const override;
+  Ipopt::SmartPtr<solvers::RolloutNlp> MakeNlp(const SolverOptions& options, InstanceSize size) const override;
   solvers::IpoptOptions DefaultIpoptOptions(InstanceSize size) const override;
   double improvement_margin() const override { return 0.9; }
   // The forward simulation of `diffpd run`-style tools starts with the initial guess.

@@ -2,9 +2,9 @@
 
 #include <cmath>
 
-#include "diffpd/solvers/control_variables.h"
-#include "diffpd/solvers/linear_constraint.h"
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/activation_block.h"
+#include "diffpd/solvers/ipopt/linear_constraint.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 #include "diffpd/state_forces.h"
 #include "diffpd/surface_mesh.h"
 #include "diffpd/voxelizer.h"
@@ -174,22 +174,19 @@ SolverOptions Locomotion::BaseOptions(InstanceSize size) const {
   return o;
 }
 
-Ipopt::SmartPtr<solvers::RolloutNlp> Locomotion::MakeNlp(Simulator* sim, InstanceSize size) const {
+Ipopt::SmartPtr<solvers::RolloutNlp> Locomotion::MakeNlp(const SolverOptions& options, InstanceSize size) const {
   using namespace solvers;
   const int K = steps(size);
   const double h = time_step(size);
-  const Scene& scene = sim->scene();
+  Ipopt::SmartPtr<RolloutNlp> nlp = new RolloutNlp(std::make_unique<RolloutFunction>(MakeScene(size), options, K));
+  const Scene& scene = nlp->function().scene();
   const Mesh& mesh = scene.mesh;
-  RolloutSetup setup;
-  setup.initial = sim->RestState();
-  setup.inputs.resize(K);
-  setup.material = scene.material;
-  Ipopt::SmartPtr<RolloutNlp> nlp = new RolloutNlp(sim, setup);
+  const State& initial = nlp->function().base().initial;
 
   const int muscles = static_cast<int>(scene.muscles.size());
-  std::vector<ActivationControl::Channel> channels;
+  std::vector<ActivationBlock::Channel> channels;
   for (int m = 0; m < muscles; ++m) channels.push_back({m, std::make_unique<FourierSignal>(K, h, kPeriod, 1)});
-  auto activation = std::make_unique<ActivationControl>(std::move(channels));
+  auto activation = std::make_unique<ActivationBlock>(std::move(channels));
   VectorXd start(3 * muscles);
   for (int m = 0; m < muscles; ++m) {
     const double phase = 2 * M_PI * m / muscles;  // a travelling wave over the muscles
@@ -205,7 +202,7 @@ Ipopt::SmartPtr<solvers::RolloutNlp> Locomotion::MakeNlp(Simulator* sim, Instanc
                                                         "activation_range_" + std::to_string(m)))
       nlp->AddLinearConstraint(std::move(row));
 
-  const TrackedPoint com = CentreOfMass(sim->LumpedMass());
+  const TrackedPoint com = CentreOfMass(nlp->function().simulator().LumpedMass());
   nlp->AddObjective(std::make_unique<PointTravel>(com, 0, kFinalState, Vec3::UnitX(), "forward_travel"), -100.0);
 
   // The "up" axis: the wheel's axle for the torus, lower to upper body otherwise.
@@ -221,7 +218,7 @@ Ipopt::SmartPtr<solvers::RolloutNlp> Locomotion::MakeNlp(Simulator* sim, Instanc
     b = NodesWhere(mesh, [&](const Vec3& p) { return p.z() > lo.z() + 0.75 * height; });
   }
   const TrackedPoint pa = MeanOf(mesh.num_vertices(), a), pb = MeanOf(mesh.num_vertices(), b);
-  const Vec3 rest_axis = (pb.At(setup.initial.x) - pa.At(setup.initial.x)).normalized();
+  const Vec3 rest_axis = (pb.At(initial.x) - pa.At(initial.x)).normalized();
   nlp->AddConstraint(std::make_unique<AxisAlignment>(pa, pb, kFinalState, rest_axis, "upright"),
                      std::cos(kMaxTiltDegrees * M_PI / 180), 1.0);
   return nlp;

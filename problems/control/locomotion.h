@@ -50,7 +50,7 @@ class Locomotion : public TrajectoryOptimizationProblem {
   int steps(InstanceSize size) const override { return size == InstanceSize::kSmall ? small_steps_ : 40; }
   double time_step(InstanceSize size) const override { return 0.01; }
   SolverOptions BaseOptions(InstanceSize size) const override;
-  Ipopt::SmartPtr<solvers::RolloutNlp> MakeNlp(Simulator* sim, InstanceSize size) const override;
+  Ipopt::SmartPtr<solvers::RolloutNlp> MakeNlp(const SolverOptions& options, InstanceSize size) const override;
   solvers::IpoptOptions DefaultIpoptOptions(InstanceSize size) const override;
   double RequiredObjective(double initial_objective) const override { return initial_objective - 0.2; }
   std::string improvement_rule() const override { return "at least 0.2 cm more forward travel than the start"; }

@@ -1,8 +1,8 @@
 #include "control/routing_tendon_opt.h"
 
 #include "diffpd/box_mesh.h"
-#include "diffpd/solvers/control_variables.h"
-#include "diffpd/solvers/trajectory_constraint.h"
+#include "diffpd/solvers/core/activation_block.h"
+#include "diffpd/solvers/core/trajectory_function.h"
 #include "scenes/routing_tendon.h"
 
 namespace diffpd::problems {
@@ -60,27 +60,24 @@ std::vector<StepInput> RoutingTendonOpt::Inputs(const Simulator& sim, int steps)
   return RoutingTendon().Inputs(sim, steps);
 }
 
-Ipopt::SmartPtr<solvers::RolloutNlp> RoutingTendonOpt::MakeNlp(Simulator* sim, InstanceSize size) const {
+Ipopt::SmartPtr<solvers::RolloutNlp> RoutingTendonOpt::MakeNlp(const SolverOptions& options, InstanceSize size) const {
   using namespace solvers;
   const int K = steps(size);
   const int knots = size == InstanceSize::kSmall ? 4 : 6;
-  RolloutSetup setup;
-  setup.initial = sim->RestState();
-  setup.inputs.resize(K);
-  setup.material = sim->scene().material;
-  Ipopt::SmartPtr<RolloutNlp> nlp = new RolloutNlp(sim, setup);
-  std::vector<ActivationControl::Channel> channels;
-  for (int m = 0; m < static_cast<int>(sim->scene().muscles.size()); ++m)
+  Ipopt::SmartPtr<RolloutNlp> nlp = new RolloutNlp(std::make_unique<RolloutFunction>(MakeScene(size), options, K));
+  const Scene& scene = nlp->function().scene();
+  std::vector<ActivationBlock::Channel> channels;
+  for (int m = 0; m < static_cast<int>(scene.muscles.size()); ++m)
     channels.push_back({m, std::make_unique<PiecewiseLinearSignal>(K, knots)});
-  auto activation = std::make_unique<ActivationControl>(std::move(channels));
+  auto activation = std::make_unique<ActivationBlock>(std::move(channels));
   activation->SetBounds(0.6, 1.0);
   const int count = activation->size();
   const int offset = nlp->AddVariables(std::move(activation));
   nlp->AddRegularization(offset, count, 1e-2, 1.0);
 
-  const Mesh& mesh = sim->scene().mesh;
-  const TrackedPoint tip = Marker(mesh.num_vertices(), TipNode(mesh));
-  const Vec3 rest = tip.At(setup.initial.x);
+  const Mesh& mesh = scene.mesh;
+  const TrackedPoint tip = NodePoint(mesh.num_vertices(), TipNode(mesh));
+  const Vec3 rest = tip.At(nlp->function().base().initial.x);
   const Vec3 target = rest + Vec3(0.02, 0.012, -0.004);
   nlp->AddObjective(std::make_unique<PointDistanceSquared>(tip, kFinalState, target, "tip_error"), 1e6);
   for (int k : {K / 2, K})

@@ -28,7 +28,7 @@ class RoutingTendonOpt : public TrajectoryOptimizationProblem {
   int default_steps() const override;
   std::vector<StepInput> Inputs(const Simulator& sim, int steps) const override;
   double time_step(InstanceSize size) const override { return 0.01; }
-  Ipopt::SmartPtr<solvers::RolloutNlp> MakeNlp(Simulator* sim, InstanceSize size) const override;
+  Ipopt::SmartPtr<solvers::RolloutNlp> MakeNlp(const SolverOptions& options, InstanceSize size) const override;
   double improvement_margin() const override { return 0.9; }
   // tol 1e-4 (the rollouts' own tolerance limits how far the optimality
   // error can fall), acceptable after 5 iterations at 1e-3.

@@ -129,8 +129,7 @@ OptimizationReport RunOptimization(const TrajectoryOptimizationProblem& problem,
     options.lbfgs_weight_scale = settings.lbfgs_weight_scale;
     options.rigid_mode_correction = settings.rigid_mode_correction;
     options.verbosity = settings.verbosity;
-    Simulator sim(problem.MakeScene(settings.size), options);
-    Ipopt::SmartPtr<solvers::RolloutNlp> nlp = problem.MakeNlp(&sim, settings.size);
+    Ipopt::SmartPtr<solvers::RolloutNlp> nlp = problem.MakeNlp(options, settings.size);
     IpoptOptions ipopt = problem.DefaultIpoptOptions(settings.size);
     ipopt.string_options.insert(ipopt.string_options.end(), settings.ipopt.string_options.begin(),
                                 settings.ipopt.string_options.end());
@@ -145,7 +144,7 @@ OptimizationReport RunOptimization(const TrajectoryOptimizationProblem& problem,
     run.jacobian_mode = nlp->ResolvedJacobianMode();
     run.num_variables = nlp->num_variables();
     run.num_constraints = nlp->num_constraints();
-    run.num_dofs = sim.num_dofs();
+    run.num_dofs = nlp->function().simulator().num_dofs();
     run.num_steps = problem.steps(settings.size);
     if (settings.log)
       std::fprintf(settings.log,
@@ -169,7 +168,7 @@ OptimizationReport RunOptimization(const TrajectoryOptimizationProblem& problem,
       if (r == 0) {  // frames of the optimised motion of the main run
         const Rollout* rollout = nlp->RolloutAt(s.x);
         if (rollout) {
-          const Mesh& mesh = sim.scene().mesh;
+          const Mesh& mesh = nlp->function().scene().mesh;
           PvdWriter pvd((std::filesystem::path(settings.out_dir) / "frames").string(), problem.name());
           for (size_t k = 0; k < rollout->states.size(); ++k)
             pvd.AddFrame(k * options.time_step, mesh,

@@ -1,5 +1,6 @@
 // Trajectory and control optimisation problems solved with Ipopt (DiffPD
-// paper Sec. 7.2-7.3): a problem builds a scene and a RolloutNlp over it;
+// paper Sec. 7.2-7.3): a problem builds a scene and a RolloutNlp over a
+// rollout function of it (diffpd/solvers/ipopt/rollout_nlp.h);
 // RunOptimization solves it with the chosen simulator method and, for
 // comparison, again with Newton-Cholesky, then reports, writes VTK frames of
 // the optimised motion and a PNG plot of the objective history.
@@ -12,8 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "diffpd/solvers/ipopt_solve.h"
-#include "diffpd/solvers/rollout_nlp.h"
+#include "diffpd/solvers/ipopt/ipopt_solve.h"
+#include "diffpd/solvers/ipopt/rollout_nlp.h"
 #include "problem.h"
 
 namespace diffpd::problems {
@@ -32,9 +33,9 @@ class TrajectoryOptimizationProblem : public Problem {
   virtual double time_step(InstanceSize size) const = 0;
   // Simulator settings besides method, time step and threads (tolerances).
   virtual SolverOptions BaseOptions(InstanceSize size) const;
-  // The optimisation: variables, objective, constraints, over `sim` (not
-  // owned; it outlives the NLP) for `steps(size)` steps.
-  virtual Ipopt::SmartPtr<solvers::RolloutNlp> MakeNlp(Simulator* sim, InstanceSize size) const = 0;
+  // The optimisation: variables, objective, constraints, over rollouts of
+  // MakeScene(size) for `steps(size)` steps simulated with `options`.
+  virtual Ipopt::SmartPtr<solvers::RolloutNlp> MakeNlp(const SolverOptions& options, InstanceSize size) const = 0;
   // Ipopt options of the problem (max_iter, tol, ...), before the user's.
   virtual solvers::IpoptOptions DefaultIpoptOptions(InstanceSize size) const;
   // What "improves the objective" means for this problem: the solution's
@@ -80,7 +81,7 @@ struct OptimizationSettings {
 struct OptimizationRun {
   Method method = Method::kPd;
   solvers::IpoptSummary summary;
-  solvers::ConstraintJacobianMode jacobian_mode = solvers::ConstraintJacobianMode::kReverse;
+  solvers::DerivativeMode jacobian_mode = solvers::DerivativeMode::kReverse;
   int num_variables = 0, num_constraints = 0, num_dofs = 0, num_steps = 0;
   double required_objective = 0;  // RequiredObjective(initial objective)
   bool improved = false;          // feasible (violation <= 1e-6) and objective <= required_objective

@@ -239,6 +239,18 @@ TEST_P(ClosedLoopGradientTest, NetworkControllerGradientsMatchCentralDifferences
     EXPECT_TRUE(testing::Passes(testing::CompareCentralDifference(plus, minus, h, g.youngs_modulus, policy)))
         << "Young's modulus";
   }
+  // A truncated closed-loop rollout keeps its controller's memory: the
+  // adjoint of a loss on the first 3 states is the same on it.
+  LossGradient early(steps);
+  for (int k = 0; k <= 3; ++k) early.dx[k] = loss.dx[k];
+  LossGradient early_truncated(3);
+  for (int k = 0; k <= 3; ++k) early_truncated.dx[k] = loss.dx[k];
+  const Rollout truncated = rollout.Truncated(3);
+  ASSERT_EQ(truncated.controller_memory.size(), 4u);
+  const RolloutGradient g_early = sim.Backward(rollout, early, controller);
+  const RolloutGradient g_truncated = sim.Backward(truncated, early_truncated, controller);
+  EXPECT_LT((g_early.controller_parameters - g_truncated.controller_parameters).norm(),
+            1e-8 * g_early.controller_parameters.norm());
   // The closed loop matters: the gradient of the recorded actions held
   // fixed (open loop) differs from it.
   const RolloutGradient g_open = sim.Backward(rollout, loss);

@@ -71,6 +71,15 @@ struct Rollout {
   int num_steps() const { return static_cast<int>(inputs.size()); }
   bool closed_loop() const { return !controller_memory.empty(); }
   double forward_seconds() const;
+  // The rollout truncated after `num_steps` steps: states[0..num_steps],
+  // inputs[0..num_steps), the reports of those steps (as many as there are),
+  // the same materials and options (closed loop: controller_memory[0..num_steps]
+  // and the controller's parameters). Simulator::Backward on it gives the
+  // gradient of a loss that reads states 0..num_steps only, at num_steps
+  // adjoint steps instead of K; its per-step gradients then have num_steps
+  // entries. Throws InvalidInputError unless 0 <= num_steps <= K
+  // ("Truncated: num_steps = 7 is out of range [0, 5]").
+  Rollout Truncated(int num_steps) const;
 };
 
 // dL/dx_k and dL/dv_k of a loss for k = 0..K (each 3n, or empty for zero).

@@ -229,9 +229,15 @@ TEST_F(StarfishFitTest, LossGradientMatchesCentralDifferences) {
   const StarfishActuation actuation{0.004, 0.03, 0.05};
   auto model = starfish_.MakeModel(recording_, window_, options, material, actuation);
   auto loss = [&](const double* p, double* gradient) {
-    const double* blocks[2] = {p, p + 2};
+    const Eigen::Map<const VectorXd> point(p, 5);
+    VectorXd g, value;
+    if (!gradient) {
+      EXPECT_TRUE(model->Evaluate(point, {0}, &value, nullptr)) << model->statistics().last_error;
+      return value(0);
+    }
     double cost = 0;
-    EXPECT_TRUE(model->EvaluateLoss(blocks, {}, &cost, gradient)) << model->statistics().last_error;
+    EXPECT_TRUE(model->Gradient(point, VectorXd::Ones(1), &g, &cost)) << model->statistics().last_error;
+    std::copy(g.data(), g.data() + g.size(), gradient);
     return cost;
   };
   const double p0[5] = {2e5, 0.35, 0.004, 0.03, 0.05};
@@ -272,12 +278,20 @@ TEST_F(StarfishFitTest, BodyArmsRegionsGiveTheArmsTheirOwnYoungsModulus) {
   options.backward_rel_tolerance = 1e-11;
   auto model = starfish_.MakeModel(recording_, window_, options, MaterialParameters{2e5, 0.35, 400},
                                    StarfishActuation{0.004, 0.03, 0.05});
-  ASSERT_EQ(model->parameter_block_sizes(), (std::vector<int>{4, 3}));
+  ASSERT_EQ(model->num_blocks(), 2);
+  ASSERT_EQ(model->block(0).size(), 4);
+  ASSERT_EQ(model->block(1).size(), 3);
   auto loss = [&](const double* material, double* gradient) {
-    const double actuation[3] = {0.004, 0.03, 0.05};
-    const double* blocks[2] = {material, actuation};
+    VectorXd p(7), g;
+    p << material[0], material[1], material[2], material[3], 0.004, 0.03, 0.05;
+    if (!gradient) {
+      VectorXd value;
+      EXPECT_TRUE(model->Evaluate(p, {0}, &value, nullptr)) << model->statistics().last_error;
+      return value(0);
+    }
     double cost = 0;
-    EXPECT_TRUE(model->EvaluateLoss(blocks, {}, &cost, gradient)) << model->statistics().last_error;
+    EXPECT_TRUE(model->Gradient(p, VectorXd::Ones(1), &g, &cost)) << model->statistics().last_error;
+    std::copy(g.data(), g.data() + g.size(), gradient);
     return cost;
   };
   const double p0[4] = {2e5, 0.35, 1e5, 0.35};

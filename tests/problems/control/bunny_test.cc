@@ -28,8 +28,7 @@ SolverOptions Options(const Bunny& bunny, Method method, double rel_tolerance) {
 
 TEST(IpoptBunnyTest, DerivativeCheckerReportsNoError) {
   const Bunny bunny;
-  Simulator sim(bunny.MakeScene(InstanceSize::kSmall), Options(bunny, Method::kNewtonCholesky, 1e-11));
-  auto nlp = bunny.MakeNlp(&sim, InstanceSize::kSmall);
+  auto nlp = bunny.MakeNlp(Options(bunny, Method::kNewtonCholesky, 1e-11), InstanceSize::kSmall);
   IpoptOptions o;
   o.string_options = {{"derivative_test", "first-order"}};
   o.int_options = {{"max_iter", 0}};
@@ -40,8 +39,7 @@ TEST(IpoptBunnyTest, DerivativeCheckerReportsNoError) {
 
 TEST(IpoptBunnyTest, SmallInstanceLandsOnTargetAfterClearingTheWall) {
   const Bunny bunny;
-  Simulator sim(bunny.MakeScene(InstanceSize::kSmall), Options(bunny, Method::kNewtonCholesky, 1e-6));
-  auto nlp = bunny.MakeNlp(&sim, InstanceSize::kSmall);
+  auto nlp = bunny.MakeNlp(Options(bunny, Method::kNewtonCholesky, 1e-6), InstanceSize::kSmall);
   const IpoptSummary s = SolveWithIpopt(nlp, bunny.DefaultIpoptOptions(InstanceSize::kSmall));
   ASSERT_TRUE(s.succeeded()) << s.BriefReport() << "\n" << s.log;
   EXPECT_LE(s.constraint_violation, 1e-6);

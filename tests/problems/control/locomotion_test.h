@@ -24,8 +24,7 @@ inline SolverOptions LocomotionOptions(const Locomotion& problem, double rel_tol
 // `steps` steps (contact starts at once: the body is released 1 mm above the ground).
 inline void ExpectDerivativeCheckerPasses(Locomotion::Body body, int steps) {
   const Locomotion problem(body, steps);
-  Simulator sim(problem.MakeScene(InstanceSize::kSmall), LocomotionOptions(problem, 1e-10, 1e-12));
-  auto nlp = problem.MakeNlp(&sim, InstanceSize::kSmall);
+  auto nlp = problem.MakeNlp(LocomotionOptions(problem, 1e-10, 1e-12), InstanceSize::kSmall);
   solvers::IpoptOptions o;
   o.string_options = {{"derivative_test", "first-order"}};
   o.int_options = {{"max_iter", 0}};
@@ -42,8 +41,7 @@ inline void ExpectDerivativeCheckerPasses(Locomotion::Body body, int steps) {
 // (bounded activations, upright) and at least 0.2 cm more forward travel.
 inline void ExpectForwardProgress(Locomotion::Body body, int steps, int iterations) {
   const Locomotion problem(body, steps);
-  Simulator sim(problem.MakeScene(InstanceSize::kSmall), LocomotionOptions(problem, 1e-6, 1e-9));
-  auto nlp = problem.MakeNlp(&sim, InstanceSize::kSmall);
+  auto nlp = problem.MakeNlp(LocomotionOptions(problem, 1e-6, 1e-9), InstanceSize::kSmall);
   solvers::IpoptOptions o = problem.DefaultIpoptOptions(InstanceSize::kSmall);
   o.int_options.push_back({"max_iter", iterations});
   const solvers::IpoptSummary s = SolveWithIpopt(nlp, o);

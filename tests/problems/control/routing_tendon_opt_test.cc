@@ -23,8 +23,7 @@ SolverOptions Options(const RoutingTendonOpt& p, double rel_tolerance, double ab
 TEST(IpoptRoutingTendonTest, DerivativeCheckerReportsNoError) {
   const RoutingTendonOpt problem;
   // The objective is in mm^2: solve far below the checker's 1e-7 steps.
-  Simulator sim(problem.MakeScene(InstanceSize::kSmall), Options(problem, 1e-12, 1e-12));
-  auto nlp = problem.MakeNlp(&sim, InstanceSize::kSmall);
+  auto nlp = problem.MakeNlp(Options(problem, 1e-12, 1e-12), InstanceSize::kSmall);
   solvers::IpoptOptions o;
   o.string_options = {{"derivative_test", "first-order"}};
   o.int_options = {{"max_iter", 0}};
@@ -35,8 +34,7 @@ TEST(IpoptRoutingTendonTest, DerivativeCheckerReportsNoError) {
 
 TEST(IpoptRoutingTendonTest, SmallInstanceBringsTheTipToItsTargetWithBoundedActivations) {
   const RoutingTendonOpt problem;
-  Simulator sim(problem.MakeScene(InstanceSize::kSmall), Options(problem, 1e-6, 1e-9));
-  auto nlp = problem.MakeNlp(&sim, InstanceSize::kSmall);
+  auto nlp = problem.MakeNlp(Options(problem, 1e-6, 1e-9), InstanceSize::kSmall);
   const solvers::IpoptSummary s = SolveWithIpopt(nlp, problem.DefaultIpoptOptions(InstanceSize::kSmall));
   ASSERT_TRUE(s.succeeded()) << s.BriefReport() << "\n" << s.log;
   EXPECT_LE(s.constraint_violation, 1e-6);

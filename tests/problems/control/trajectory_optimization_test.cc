@@ -15,7 +15,9 @@
 #include "cli/commands.h"
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
-#include "solvers/ipopt_test_problems.h"
+#include "diffpd/solvers/core/initial_state_block.h"
+#include "diffpd/solvers/core/trajectory_function.h"
+#include "test_scenes.h"
 #include "util/temporary_directory.h"
 #include "util/expect_message.h"
 
@@ -60,18 +62,19 @@ class CubeThrow : public TrajectoryOptimizationProblem {
   }
   int steps(InstanceSize size) const override { return 5; }
   double time_step(InstanceSize size) const override { return 0.01; }
-  Ipopt::SmartPtr<solvers::RolloutNlp> MakeNlp(Simulator* sim, InstanceSize size) const override {
+  Ipopt::SmartPtr<solvers::RolloutNlp> MakeNlp(const SolverOptions& options, InstanceSize size) const override {
     using namespace solvers;
-    const int n = sim->scene().mesh.num_vertices();
+    Ipopt::SmartPtr<RolloutNlp> nlp =
+        new RolloutNlp(std::make_unique<RolloutFunction>(MakeScene(size), options, steps(size)));
+    const int n = nlp->function().scene().mesh.num_vertices();
     std::vector<int> all(n);
     for (int i = 0; i < n; ++i) all[i] = i;
-    Ipopt::SmartPtr<RolloutNlp> nlp = new RolloutNlp(sim, diffpd::testing::RestSetup(*sim, steps(size)));
-    auto v0 = std::make_unique<InitialStateVariables>(InitialStateVariables::kVelocity, all);
+    auto v0 = std::make_unique<InitialStateBlock>(InitialStateBlock::kVelocity, all);
     v0->SetBounds(-1.0, 1.0);
     v0->SetInitial(Vec3(0.0, 0.0, 0.2));
     nlp->AddVariables(std::move(v0));
-    const TrackedPoint com = CentreOfMass(sim->LumpedMass());
-    const Vec3 c0 = com.At(sim->RestState().x);
+    const TrackedPoint com = CentreOfMass(nlp->function().simulator().LumpedMass());
+    const Vec3 c0 = com.At(nlp->function().base().initial.x);
     nlp->AddObjective(
         std::make_unique<PointDistanceSquared>(com, kFinalState, c0 + Vec3(0.02, 0, 0), "travel", Vec3(1, 1, 0)), 1e4);
     nlp->AddConstraint(std::make_unique<PointCoordinate>(com, kFinalState, Vec3::UnitZ(), "rise"), c0.z() + rise_,
