@@ -16,6 +16,7 @@
 #include "cli/commands.h"
 #include "diffpd/csv_fields.h"
 #include "diffpd/error.h"
+#include "diffpd/input_file.h"
 #include "diffpd/simulator.h"
 #include "diffpd/solvers/core/least_squares_loss.h"
 #include "diffpd/solvers/core/marker_residuals.h"
@@ -227,8 +228,12 @@ double WindowTimeStep(const StarfishRecording& rec, const StarfishWindow& w, int
 
 }  // namespace
 
-std::vector<double> StarfishActivations(const std::vector<double>& c, double h, const StarfishActuation& act,
-                                        std::vector<std::array<double, 3>>* derivatives) {
+namespace {
+
+// StarfishActivations' recurrence after its checks of h and the actuation;
+// *first_negative is the first step with a < 0 (-1: none), where it stops.
+std::vector<double> Activations(const std::vector<double>& c, double h, const StarfishActuation& act,
+                                std::vector<std::array<double, 3>>* derivatives, int* first_negative) {
   if (!(std::isfinite(h) && h > 0)) throw InvalidInputError("time step = " + Num(h) + " is invalid: must be > 0 (s)");
   if (!(std::isfinite(act.slack) && act.slack >= 0))
     throw InvalidInputError("tendon slack = " + Num(act.slack) + " is invalid: must be finite and >= 0 (m)");
@@ -249,17 +254,36 @@ std::vector<double> StarfishActivations(const std::vector<double>& c, double h, 
     const double hinge = x <= 0 ? 0 : x < w ? x * x / (2 * w) : x - w / 2;
     const double slope = x <= 0 ? 0 : x < w ? x / w : 1;
     a[k] = 1 - hinge / L;
-    if (a[k] < 0)
-      throw InvalidInputError("tendon: activation " + Num(a[k]) + " < 0 at step " + std::to_string(k) + " (slack " +
-                              Num(act.slack) + " m, length " + Num(L) + " m)");
+    if (a[k] < 0) {
+      *first_negative = static_cast<int>(k);
+      return a;
+    }
     if (derivatives) (*derivatives)[k] = {slope / L, -slope * df / L, hinge / (L * L)};
   }
+  *first_negative = -1;
+  return a;
+}
+
+// "activation -0.2 < 0 (filtered tendon contraction 0.079 m, slack 0 m,
+// length 0.065 m)" of step k.
+std::string NegativeActivation(const std::vector<double>& a, int k, const StarfishActuation& act) {
+  return "activation " + Num(a[k]) + " < 0 (the filtered contraction exceeds slack + length: slack " + Num(act.slack) +
+         " m, length " + Num(act.length) + " m)";
+}
+
+}  // namespace
+
+std::vector<double> StarfishActivations(const std::vector<double>& c, double h, const StarfishActuation& act,
+                                        std::vector<std::array<double, 3>>* derivatives) {
+  int negative = -1;
+  std::vector<double> a = Activations(c, h, act, derivatives, &negative);
+  if (negative >= 0)
+    throw InvalidInputError("tendon: " + NegativeActivation(a, negative, act) + " at step " + std::to_string(negative));
   return a;
 }
 
 StarfishRecording ReadStarfishRecording(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InvalidInputError("cannot open '" + path + "'");
+  std::ifstream in = OpenInputFile(path);
   StarfishRecording rec;
   rec.path = path;
   std::string line;
@@ -292,9 +316,10 @@ StarfishRecording ReadStarfishRecording(const std::string& path) {
     if (std::isinf(v[1]))
       throw InvalidInputError(where + "tendon = " + Num(v[1]) + " is invalid: must be finite or NaN (mm)");
     for (int c = 2; c < 10; ++c)
-      if (!std::isfinite(v[c]))
+      if (!(std::isfinite(v[c]) && std::abs(v[c] * kMm) <= kMaxMarkerCoordinate))
         throw InvalidInputError(where + kColumns[c] + " = " + Num(v[c]) +
-                                " is invalid: marker coordinates must be finite (mm)");
+                                " is invalid: marker coordinates must be finite and within +-" +
+                                Num(kMaxMarkerCoordinate / kMm) + " (mm)");
     if (!rec.time.empty() && v[0] * kMm <= rec.time.back())
       throw InvalidInputError(where + "time " + Num(v[0]) + " ms is not after the previous row's " +
                               Num(rec.time.back() / kMm) + " ms (line " + std::to_string(rec.lines.back()) + ")");
@@ -469,8 +494,14 @@ std::vector<double> StarfishCalibration::WindowContractions(const StarfishRecord
 
 std::vector<StepInput> StarfishCalibration::WindowInputs(const StarfishRecording& rec, const StarfishWindow& w,
                                                          const StarfishActuation& actuation) const {
+  int negative = -1;
   const std::vector<double> a =
-      StarfishActivations(WindowContractions(rec, w), WindowTimeStep(rec, w, substeps_), actuation, nullptr);
+      Activations(WindowContractions(rec, w), WindowTimeStep(rec, w, substeps_), actuation, nullptr, &negative);
+  if (negative >= 0) {
+    const int row = w.first + negative / substeps_;
+    throw InvalidInputError(rec.path + ":" + std::to_string(rec.lines[row]) + ": tendon = " +
+                            Num(rec.tendon[row] / kMm) + " mm gives " + NegativeActivation(a, negative, actuation));
+  }
   std::vector<StepInput> inputs(a.size());
   for (size_t i = 0; i < a.size(); ++i) inputs[i].activation = VectorXd::Constant(4, a[i]);
   return inputs;
@@ -479,7 +510,12 @@ std::vector<StepInput> StarfishCalibration::WindowInputs(const StarfishRecording
 State StarfishCalibration::WindowInitialState(Simulator& sim, const StarfishRecording& rec, const StarfishWindow& w,
                                               const StarfishActuation& actuation) const {
   State s = sim.RestState();
-  const double a = StarfishActivations({rec.tendon[w.first]}, 1, actuation, nullptr)[0];
+  int negative = -1;
+  const std::vector<double> first = Activations({rec.tendon[w.first]}, 1, actuation, nullptr, &negative);
+  if (negative >= 0)
+    throw InvalidInputError(rec.path + ":" + std::to_string(rec.lines[w.first]) + ": tendon = " +
+                            Num(rec.tendon[w.first] / kMm) + " mm gives " + NegativeActivation(first, 0, actuation));
+  const double a = first[0];
   if (a == 1) return s;
   StepInput input;
   input.activation = VectorXd::Constant(4, a);
@@ -511,6 +547,7 @@ CapturedMotion StarfishCalibration::WindowMotion(const Mesh& mesh, const State& 
       motion.samples.push_back(s);
     }
   }
+  motion.Validate(rec.path);  // a problem names the recording's file and row
   return motion;
 }
 

@@ -58,12 +58,13 @@ struct StarfishRecording {
 
 // Reads a starfish recording. Throws InvalidInputError naming the file and
 // line:
-//   "cannot open '<path>'",
+//   "cannot open '<path>'", "cannot open '<path>': it is a directory, not a file",
 //   "<path>: empty file (expected a header row and data rows)",
 //   "<path>:1: expected a header row of 10 column labels, got 3 fields",
 //   "<path>:5: expected 10 fields (time ms, tendon mm, M1 x, M1 y, ..., M4 x, M4 y), got 9",
 //   "<path>:5: M2 y is not a number: 'abc'",
-//   "<path>:5: M2 y = nan is invalid: marker coordinates must be finite (mm)",
+//   "<path>:5: M2 y = nan is invalid: marker coordinates must be finite and within +-1e+09 (mm)"
+//   (kMaxMarkerCoordinate, captured_motion.h),
 //   "<path>:5: time = inf is invalid: must be finite (ms)",
 //   "<path>:5: tendon = inf is invalid: must be finite or NaN (mm)",
 //   "<path>:5: time 10 ms is not after the previous row's 16.6667 ms (line 4)",
@@ -117,8 +118,8 @@ struct StarfishActuation {
 // {da/dslack (1/m), da/dlag (1/s), da/dlength (1/m)}. Throws
 // InvalidInputError for h <= 0, a negative or non-finite slack or lag, or a
 // length <= 0 ("tendon lag = -1 is invalid: must be finite and >= 0 (s)"),
-// and for a negative activation ("tendon: activation -0.2 < 0 at step 7 (slack
-// 0 m, length 0.01 m)").
+// and for a negative activation ("tendon: activation -0.2 < 0 (the filtered
+// contraction exceeds slack + length: slack 0 m, length 0.01 m) at step 7").
 std::vector<double> StarfishActivations(const std::vector<double>& contraction, double h,
                                         const StarfishActuation& actuation,
                                         std::vector<std::array<double, 3>>* derivatives);
@@ -186,6 +187,10 @@ class StarfishCalibration : public Problem {
   // displacement (x from image x, z from minus image y, y the initial y with
   // weight 0), weights sqrt(w_m / (sum w * (frames - 1))) / 2 mm on x and z,
   // so that 1/2 |r|^2 = 1/2 weighted mean squared error / (2 mm)^2.
+  // WindowInputs throws what StarfishActivations throws, a negative
+  // activation naming the recording's file and row ("<path>:<line>: tendon =
+  // 80 mm gives activation -0.22 < 0 (...)"); WindowMotion what
+  // CapturedMotion::Validate throws, prefixed by "<path>:<line>: ".
   std::vector<StepInput> WindowInputs(const StarfishRecording& recording, const StarfishWindow& window,
                                       const StarfishActuation& actuation) const;
   // The tendon contraction of every step of a window (m, zero-order hold).
@@ -194,7 +199,8 @@ class StarfishCalibration : public Problem {
                               const StarfishWindow& window) const;
   // The window's initial state: rest if the activation of its first tendon
   // value (lag at steady state) is 1, else the quasi-static equilibrium
-  // under that activation.
+  // under that activation. A negative first activation names the row, as in
+  // WindowInputs.
   State WindowInitialState(Simulator& sim, const StarfishRecording& recording, const StarfishWindow& window,
                            const StarfishActuation& actuation) const;
   // Errors of a simulated window (states at every step, rollout from

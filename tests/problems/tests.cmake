@@ -19,6 +19,7 @@ if(TARGET diffpd_ipopt)
   diffpd_add_test(routing_tendon_opt_test ${_dir}/control/routing_tendon_opt_test.cc LIBS diffpd_problems)
   diffpd_add_test(trajectory_optimization_test ${_dir}/control/trajectory_optimization_test.cc LIBS diffpd_problems)
 endif()
+diffpd_add_test(command_line_test ${_dir}/cli/command_line_test.cc LIBS diffpd_problems)
 # Closed-loop swimming (Adam needs neither adapter).
 diffpd_add_test(adam_test ${_dir}/control/adam_test.cc LIBS diffpd_problems)
 diffpd_add_test(swimmer_scenes_test ${_dir}/control/swimmer_scenes_test.cc LIBS diffpd_problems)

@@ -16,3 +16,5 @@ diffpd_add_test(thread_count_test ${CMAKE_CURRENT_LIST_DIR}/thread_count_test.cc
 diffpd_add_test(rigid_mode_correction_test ${CMAKE_CURRENT_LIST_DIR}/rigid_mode_correction_test.cc)
 diffpd_add_test(rollout_test ${CMAKE_CURRENT_LIST_DIR}/rollout_test.cc)
 diffpd_add_test(closed_loop_gradient_test ${CMAKE_CURRENT_LIST_DIR}/closed_loop_gradient_test.cc)
+diffpd_add_test(rollout_checks_test ${CMAKE_CURRENT_LIST_DIR}/rollout_checks_test.cc)
+diffpd_add_test(simulator_test ${CMAKE_CURRENT_LIST_DIR}/simulator_test.cc)

@@ -55,27 +55,39 @@ TEST(CalibrateStarfishTest, ReadsTheRealRecordingsInSiUnits) {
   EXPECT_NEAR(r2.tendon[0], 1.1938052e-3, 1e-12);  // the pre-tension
 }
 
+// A malformed recording's text and the message after "<path>".
+struct BadRecording {
+  std::string text;
+  std::string message;
+};
+
 TEST(CalibrateStarfishTest, RejectsMalformedFilesNamingFileAndLine) {
   const std::string missing = Scratch().File("starfish_missing.csv");
   EXPECT_EQ(ReadError(missing), "cannot open '" + missing + "'");
-  std::string p = WriteTemp("starfish_empty.csv", "");
-  EXPECT_EQ(ReadError(p), p + ": empty file (expected a header row and data rows)");
-  p = WriteTemp("starfish_header.csv", "a,b,c\n" + kRow0);
-  EXPECT_EQ(ReadError(p), p + ":1: expected a header row of 10 column labels, got 3 fields");
-  p = WriteTemp("starfish_noheader.csv", kRow0 + kRow0);
-  EXPECT_EQ(ReadError(p), p + ":1: expected a header row of column labels, got the number '0'");
-  p = WriteTemp("starfish_columns.csv", kHeader + kRow0 + "16.7,0,1,2,3,4,5,6,7\n");
-  EXPECT_EQ(ReadError(p), p + ":3: expected 10 fields (time ms, tendon mm, M1 x, M1 y, ..., M4 x, M4 y), got 9");
-  p = WriteTemp("starfish_text.csv", kHeader + kRow0 + "16.7,0,1,2,3,abc,5,6,7,8\n");
-  EXPECT_EQ(ReadError(p), p + ":3: M2 y is not a number: 'abc'");
-  p = WriteTemp("starfish_nan_marker.csv", kHeader + kRow0 + "16.7,0,1,2,3,4,NaN,6,7,8\n");
-  EXPECT_EQ(ReadError(p), p + ":3: M3 x = nan is invalid: marker coordinates must be finite (mm)");
-  p = WriteTemp("starfish_inf_tendon.csv", kHeader + kRow0 + "16.7,inf,1,2,3,4,5,6,7,8\n");
-  EXPECT_EQ(ReadError(p), p + ":3: tendon = inf is invalid: must be finite or NaN (mm)");
-  p = WriteTemp("starfish_time.csv", kHeader + kRow0 + "16.5,0,1,2,3,4,5,6,7,8\n10,0,1,2,3,4,5,6,7,8\n");
-  EXPECT_EQ(ReadError(p), p + ":4: time 10 ms is not after the previous row's 16.5 ms (line 3)");
-  p = WriteTemp("starfish_rows.csv", kHeader);
-  EXPECT_EQ(ReadError(p), p + ": no data rows");
+  const std::string folder = Scratch().File("starfish_folder.csv");
+  std::filesystem::create_directories(folder);
+  EXPECT_EQ(ReadError(folder), "cannot open '" + folder + "': it is a directory, not a file");
+  const BadRecording cases[] = {
+      {"", ": empty file (expected a header row and data rows)"},
+      {"a,b,c\n" + kRow0, ":1: expected a header row of 10 column labels, got 3 fields"},
+      {kRow0 + kRow0, ":1: expected a header row of column labels, got the number '0'"},
+      {kHeader + kRow0 + "16.7,0,1,2,3,4,5,6,7\n",
+       ":3: expected 10 fields (time ms, tendon mm, M1 x, M1 y, ..., M4 x, M4 y), got 9"},
+      {kHeader + kRow0 + "16.7,0,1,2,3,abc,5,6,7,8\n", ":3: M2 y is not a number: 'abc'"},
+      {kHeader + kRow0 + "16.7,0,1,2,3,4,NaN,6,7,8\n",
+       ":3: M3 x = nan is invalid: marker coordinates must be finite and within +-1e+09 (mm)"},
+      {kHeader + kRow0 + "16.7,0,1,2,3,4,5,6,7,1e300\n",
+       ":3: M4 y = 1e+300 is invalid: marker coordinates must be finite and within +-1e+09 (mm)"},
+      {kHeader + kRow0 + "16.7,inf,1,2,3,4,5,6,7,8\n", ":3: tendon = inf is invalid: must be finite or NaN (mm)"},
+      {kHeader + kRow0 + "16.5,0,1,2,3,4,5,6,7,8\n10,0,1,2,3,4,5,6,7,8\n",
+       ":4: time 10 ms is not after the previous row's 16.5 ms (line 3)"},
+      {kHeader, ": no data rows"},
+  };
+  for (const BadRecording& c : cases) {
+    const std::string p = WriteTemp("starfish_bad.csv", c.text);
+    EXPECT_EQ(ReadError(p), p + c.message) << c.text;
+  }
+  std::string p;
   // A NaN tendon is accepted by the reader, and the window stops before it.
   p = WriteTemp("starfish_nan_tendon.csv", kHeader + kRow0 + "16.5,1,1,2,3,4,5,6,7,8\n33,NaN,1,2,3,4,5,6,7,8\n");
   const StarfishRecording r = ReadStarfishRecording(p);
@@ -204,8 +216,24 @@ TEST(StarfishActivationsTest, SlackLagAndLengthShapeTheActivation) {
   EXPECT_GT(largest[2], 1);    // 1/m
   EXPECT_THROW_MESSAGE(StarfishActivations(c, h, StarfishActuation{0, -1, 0.065}, nullptr), InvalidInputError,
                        "tendon lag = -1 is invalid: must be finite and >= 0 (s)");
-  EXPECT_THROW_MESSAGE(StarfishActivations({0.0, 0.0105}, h, StarfishActuation{0, 0, 0.005}, nullptr),
-                       InvalidInputError, "tendon: activation -1 < 0 at step 1 (slack 0 m, length 0.005 m)");
+  EXPECT_THROW_MESSAGE(
+      StarfishActivations({0.0, 0.0105}, h, StarfishActuation{0, 0, 0.005}, nullptr), InvalidInputError,
+      "tendon: activation -1 < 0 (the filtered contraction exceeds slack + length: slack 0 m, length 0.005 m) "
+      "at step 1");
+}
+
+// A tendon contraction the tendon cannot take names the recording's file and
+// row (the window's inputs are where a recording meets the actuation).
+TEST(CalibrateStarfishTest, WindowInputsNameTheRowOfANegativeActivation) {
+  const std::string p =
+      WriteTemp("starfish_long_tendon.csv",
+                kHeader + kRow0 + "16.5,1,1,2,3,4,5,6,7,8\n33,80,1,2,3,4,5,6,7,8\n50,0,1,2,3,4,5,6,7,8\n");
+  const StarfishRecording r = ReadStarfishRecording(p);
+  StarfishCalibration starfish;
+  EXPECT_THROW_MESSAGE(
+      starfish.WindowInputs(r, MakeStarfishWindow(r, 0, 10), StarfishActuation{}), InvalidInputError,
+      p + ":4: tendon = 80 mm gives activation -0.223077 < 0 (the filtered contraction exceeds slack + length: "
+          "slack 0 m, length 0.065 m)");
 }
 
 // The window of the gradient and fit tests: 0.15 s from 1.15 s of cyclic1
