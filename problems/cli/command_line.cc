@@ -67,6 +67,9 @@ int RunCommandLine(const std::vector<std::string>& argv) {
       ->check(IntegerIn("--evaluations", 1, CommandArgs::kMaxEvaluations));
   run->add_option("--seed", run_args.seed, "control problems: seed of the network's initial weights (default 42)")
       ->check(IntegerIn("--seed", 0, CommandArgs::kMaxSeed));
+  run->add_option(
+      "--optimizer", run_args.optimizer,
+      "control problems: adam (the original's settings), lbfgs (Ceres), ipopt (limited-memory Hessian) or all");
   run->add_option("--data", run_args.data_file,
                   "calibration problems: captured-motion CSV (default: the problem's in data/)");
   run->add_option("--methods", run_args.methods,

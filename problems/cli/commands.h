@@ -43,6 +43,7 @@ struct CommandArgs {
   static constexpr long kMaxSeed = 2147483647;
   int evaluations = -1;
   long long seed = -1;
+  std::string optimizer;  // "": adam; adam, lbfgs or ipopt
   // Calibration problems (calibrate-*): the captured-motion file (default:
   // the problem's file in data/), the methods to fit with and compare
   // (default: the problem's), a cap on Ceres iterations (-1: the problem's);
@@ -75,7 +76,7 @@ Subcommand AddStressCommand(CLI::App* parent);    // stress_command.cc
 Subcommand AddSynthCommand(CLI::App* parent);     // synth_command.cc
 
 // `diffpd run`'s options that only some kinds of problem read (--small,
-// --no-compare, --ipopt: optimisation; --evaluations, --seed: control
+// --no-compare, --ipopt: optimisation; --evaluations, --seed, --optimizer: control
 // (--small, --no-compare too); --data, --methods, --max-iterations:
 // calibration; --calibrate, --predict, --seconds, --regions: the starfish):
 // throws InvalidInputError for one given to a problem that would ignore it,

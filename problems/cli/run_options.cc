@@ -57,6 +57,7 @@ void RefuseUnusedRunOptions(const CommandArgs& args, const Problem& problem) {
       {"--ipopt", !args.ipopt_options.empty(), kOptimisation, "the optimisation problems"},
       {"--evaluations", args.evaluations != defaults.evaluations, kControl, "the control problems"},
       {"--seed", args.seed != defaults.seed, kControl, "the control problems"},
+      {"--optimizer", !args.optimizer.empty(), kControl, "the control problems"},
       {"--data", !args.data_file.empty(), kCalibration, "calibrate-plant and calibrate-bouncing-ball"},
       {"--methods", !args.methods.empty(), kCalibration | kStarfish, "the calibration problems"},
       {"--max-iterations", args.max_iterations != defaults.max_iterations, kCalibration | kStarfish,

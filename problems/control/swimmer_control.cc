@@ -8,7 +8,9 @@
 #include <sstream>
 
 #include "cli/commands.h"
+#include "control/swimmer_optimizers.h"
 #include "diffpd/error.h"
+#include "diffpd/solvers/core/controller_block.h"
 #include "diffpd/vtk_writer.h"
 #include "shared_data.h"
 
@@ -34,31 +36,6 @@ std::string GnuplotQuoted(const std::string& s) {
 
 }  // namespace
 
-double SwimLoss::Evaluate(const Rollout& rollout, LossGradient* grad) const {
-  DIFFPD_CHECK(!nodes.empty(), "SwimLoss: no nodes");
-  const int steps = rollout.num_steps();
-  const int n = static_cast<int>(rollout.states[0].v.size());
-  if (grad) *grad = LossGradient(steps);
-  const double share = 1.0 / static_cast<double>(nodes.size());
-  double loss = 0;
-  for (int k = 1; k <= steps; ++k) {
-    const VectorXd& v = rollout.states[k].v;
-    Vec3 mean = Vec3::Zero();
-    for (const int i : nodes) mean += v.segment<3>(3 * i);
-    mean *= share;
-    const double forward = direction.dot(mean);
-    const Vec3 side = mean - forward * direction;
-    loss += -forward + side_weight * side.squaredNorm();
-    if (!grad) continue;
-    // dL/dvbar = -d + 2 w (I - d d^T) side = -d + 2 w side.
-    const Vec3 g_mean = -direction + 2 * side_weight * side;
-    VectorXd& dv = grad->dv[k];
-    dv = VectorXd::Zero(n);
-    for (const int i : nodes) dv.segment<3>(3 * i) += share * g_mean;
-  }
-  return loss;
-}
-
 StripNetworkController MakeSwimmerController(const Swimmer& swimmer, std::uint64_t seed) {
   std::vector<int> widths = {swimmer.observation.size()};
   widths.insert(widths.end(), swimmer.hidden_widths.begin(), swimmer.hidden_widths.end());
@@ -74,8 +51,30 @@ const char* ToString(ControlOptimizer optimizer) {
   switch (optimizer) {
     case ControlOptimizer::kAdam:
       return "adam";
+    case ControlOptimizer::kLbfgs:
+      return "lbfgs";
+    case ControlOptimizer::kIpopt:
+      return "ipopt";
   }
   return "";
+}
+
+ControlOptimizer ParseControlOptimizer(const std::string& name) {
+  for (const ControlOptimizer o : {ControlOptimizer::kAdam, ControlOptimizer::kLbfgs, ControlOptimizer::kIpopt})
+    if (name == ToString(o)) return o;
+  throw InvalidInputError("optimizer '" + name + "' is unknown: valid optimizers are adam, lbfgs, ipopt");
+}
+
+bool ControlOptimizerAvailable(ControlOptimizer optimizer) {
+  switch (optimizer) {
+    case ControlOptimizer::kAdam:
+      return true;
+    case ControlOptimizer::kLbfgs:
+      return DIFFPD_WITH_CERES;
+    case ControlOptimizer::kIpopt:
+      return DIFFPD_WITH_IPOPT;
+  }
+  return false;
 }
 
 double TrainingResult::best_reward() const {
@@ -106,56 +105,69 @@ double TrainingResult::mean_backward_seconds() const {
   return count ? sum / count : 0.0;
 }
 
-TrainingResult TrainSwimmer(const Swimmer& swimmer, const SolverOptions& options_in, const TrainingSettings& settings) {
-  if (settings.evaluations < 1) {
-    std::ostringstream msg;
-    msg << "evaluations = " << settings.evaluations << " is invalid: must be >= 1";
-    throw InvalidInputError(msg.str());
-  }
+std::unique_ptr<solvers::RolloutFunction> MakeSwimmerFunction(const Swimmer& swimmer, const SolverOptions& options_in,
+                                                              std::uint64_t seed) {
   SolverOptions options = options_in;
   options.time_step = swimmer.time_step;
-  Simulator sim(swimmer.scene, options);
-  StripNetworkController controller = MakeSwimmerController(swimmer, settings.seed);
-  Adam adam(settings.adam, controller.num_parameters());
-  const State initial = sim.RestState();
+  auto function = std::make_unique<solvers::RolloutFunction>(swimmer.scene, options, swimmer.steps);
+  function->AddBlock(std::make_unique<solvers::ControllerBlock>(MakeSwimmerController(swimmer, seed)));
+  function->AddFunctional(std::make_unique<SwimLossFunction>(swimmer.loss));
+  return function;
+}
+
+TrainingResult TrainSwimmer(const Swimmer& swimmer, const SolverOptions& options, const TrainingSettings& settings) {
+  if (!ControlOptimizerAvailable(settings.optimizer))
+    throw InvalidInputError(std::string("optimizer '") + ToString(settings.optimizer) + "' needs the " +
+                            (settings.optimizer == ControlOptimizer::kLbfgs ? "Ceres" : "Ipopt") +
+                            " adapter, which this build lacks");
+  std::unique_ptr<solvers::RolloutFunction> function = MakeSwimmerFunction(swimmer, options, settings.seed);
+  EvaluationBudget budget(function.get(), settings.evaluations, swimmer.steps, settings.log);
+  constexpr int kLoss = 0;
 
   TrainingResult result;
   result.optimizer = ToString(settings.optimizer);
   result.method = options.method;
-  result.dofs = sim.num_dofs();
+  result.dofs = swimmer.scene.mesh.num_dofs();
   result.steps = swimmer.steps;
-  result.parameters = controller.num_parameters();
+  result.parameters = function->num_parameters();
   result.time_step = swimmer.time_step;
-  result.initial_parameters = controller.parameters();
+  result.initial_parameters = function->initial_parameters();
   const auto start = Clock::now();
-  VectorXd theta = controller.parameters();
-  for (int e = 0; e <= settings.evaluations; ++e) {
-    controller.SetParameters(theta);
-    TrainingEvaluation row;
-    row.evaluation = e;
-    row.simulated_steps = static_cast<long>(e) * swimmer.steps;
-    auto t0 = Clock::now();
-    Rollout rollout = sim.Simulate(initial, controller, swimmer.steps);
-    row.forward_seconds = Seconds(t0);
-    LossGradient loss_grad;
-    const bool last = e == settings.evaluations;
-    row.reward = -swimmer.loss.Evaluate(rollout, last ? nullptr : &loss_grad);
-    if (!last) {
-      t0 = Clock::now();
-      const RolloutGradient g = sim.Backward(rollout, loss_grad, controller);
-      row.backward_seconds = Seconds(t0);
-      row.gradient_norm = g.controller_parameters.norm();
-      adam.Step(g.controller_parameters, &theta);
-    } else {
-      result.final_rollout = std::move(rollout);
-    }
-    if (settings.log)
-      std::fprintf(settings.log, "%5d %9ld %14.6f %10.3f %10.3f %12.4e\n", row.evaluation, row.simulated_steps,
-                   row.reward, row.forward_seconds, row.backward_seconds, row.gradient_norm);
-    if (settings.log) std::fflush(settings.log);
-    result.history.push_back(row);
+  switch (settings.optimizer) {
+    case ControlOptimizer::kAdam:
+      result.final_parameters = MinimizeWithAdam(function.get(), kLoss, settings.adam, &budget);
+      break;
+    case ControlOptimizer::kLbfgs:
+#if DIFFPD_WITH_CERES
+      result.final_parameters = MinimizeWithLbfgs(function.get(), kLoss, &budget, &result.optimizer_report);
+#endif
+      break;
+    case ControlOptimizer::kIpopt:
+#if DIFFPD_WITH_IPOPT
+      // The NLP takes the function over; the final controller gets a new one.
+      result.final_parameters = MinimizeWithIpopt(std::move(function), kLoss, &budget, &result.optimizer_report);
+      function = MakeSwimmerFunction(swimmer, options, settings.seed);
+#endif
+      break;
   }
-  result.final_parameters = theta;
+  budget.Finish();
+  result.history = budget.history();
+  result.failed_evaluations = budget.failed();
+  // The final controller (a cache hit where the optimiser ended at a point it evaluated).
+  TrainingEvaluation last;
+  last.evaluation = static_cast<int>(result.history.size());
+  last.simulated_steps = static_cast<long>(budget.used()) * swimmer.steps;
+  const auto t0 = Clock::now();
+  VectorXd value;
+  if (!function->Evaluate(result.final_parameters, function->RowsOf(kLoss), &value, nullptr))
+    throw SolverError(SolverStatus::kNonFinite, "the final controller's rollout: " + function->statistics().last_error);
+  last.forward_seconds = Seconds(t0);
+  last.reward = -value(0);
+  if (settings.log)
+    std::fprintf(settings.log, "%5d %9ld %14.6f %10.3f %10.3f %12s\n", last.evaluation, last.simulated_steps,
+                 last.reward, last.forward_seconds, 0.0, "final");
+  result.history.push_back(last);
+  result.final_rollout = *function->RolloutAt(result.final_parameters);
   result.total_seconds = Seconds(start);
   return result;
 }
@@ -222,9 +234,9 @@ ReferenceCurve ReadReferenceCurve(const std::string& path, const std::string& la
   return curve;
 }
 
-std::vector<std::string> PlotLearningCurve(const std::string& dir, const std::string& title,
-                                           const TrainingResult& result,
-                                           const std::vector<ReferenceCurve>& references) {
+std::vector<std::string> PlotLearningCurves(const std::string& dir, const std::string& title,
+                                            const std::vector<const TrainingResult*>& results,
+                                            const std::vector<ReferenceCurve>& references) {
   std::filesystem::create_directories(dir);
   std::vector<std::string> files;
   std::vector<std::pair<std::string, std::string>> series;  // (label, .dat)
@@ -239,10 +251,12 @@ std::vector<std::string> PlotLearningCurve(const std::string& dir, const std::st
     files.push_back(path);
     return path;
   };
-  std::vector<std::pair<double, double>> own;
-  for (const TrainingEvaluation& e : result.history) own.emplace_back(e.simulated_steps, e.reward);
-  series.emplace_back("this library, " + result.optimizer + " + " + ToString(result.method),
-                      write("learning_curve", own));
+  for (const TrainingResult* result : results) {
+    std::vector<std::pair<double, double>> own;
+    for (const TrainingEvaluation& e : result->history) own.emplace_back(e.simulated_steps, e.reward);
+    series.emplace_back("this library, " + result->optimizer + " + " + ToString(result->method),
+                        write(results.size() == 1 ? "learning_curve" : "learning_curve_" + result->optimizer, own));
+  }
   for (size_t r = 0; r < references.size(); ++r)
     series.emplace_back(references[r].label, write("reference_" + std::to_string(r), references[r].points));
   const std::string png = (std::filesystem::path(dir) / "learning_curve.png").string();
@@ -257,7 +271,7 @@ std::vector<std::string> PlotLearningCurve(const std::string& dir, const std::st
   std::fprintf(gp, "set logscale x\nset key bottom right\nplot ");
   for (size_t i = 0; i < series.size(); ++i)
     std::fprintf(gp, "%s%s using 1:2 with lines lw %d title %s", i ? ", " : "", GnuplotQuoted(series[i].second).c_str(),
-                 i == 0 ? 3 : 1, GnuplotQuoted(series[i].first).c_str());
+                 i < results.size() ? 3 : 1, GnuplotQuoted(series[i].first).c_str());
   std::fprintf(gp, "\n");
   const int status = pclose(gp);
   if (status != 0 || !std::filesystem::exists(png)) {
@@ -291,6 +305,8 @@ nlohmann::json TrainingJson(const TrainingResult& r) {
                      {"backward_s", e.backward_seconds},
                      {"gradient_norm", e.gradient_norm}});
   return {{"optimizer", r.optimizer},
+          {"optimizer_report", r.optimizer_report},
+          {"failed_evaluations", r.failed_evaluations},
           {"method", ToString(r.method)},
           {"dofs", r.dofs},
           {"steps", r.steps},
@@ -335,6 +351,14 @@ int SwimmerControl::Run(const CommandArgs& args) const {
     throw InvalidInputError("--steps and --dt are fixed by the control problem '" + name() +
                             "'; use --small for the reduced instance");
   const bool small = args.small;
+  std::vector<ControlOptimizer> optimizers = {ControlOptimizer::kAdam};
+  if (args.optimizer == "all") {
+    optimizers.clear();
+    for (const ControlOptimizer o : {ControlOptimizer::kAdam, ControlOptimizer::kLbfgs, ControlOptimizer::kIpopt})
+      if (ControlOptimizerAvailable(o)) optimizers.push_back(o);
+  } else if (!args.optimizer.empty()) {
+    optimizers = {ParseControlOptimizer(args.optimizer)};
+  }
   const Swimmer swimmer = MakeSwimmer(small);
   SolverOptions options = BaseOptions(small);
   options.method = args.method;
@@ -349,33 +373,46 @@ int SwimmerControl::Run(const CommandArgs& args) const {
   if (args.seed >= 0) settings.seed = static_cast<std::uint64_t>(args.seed);
   FILE* text = args.json ? stderr : stdout;
   settings.log = text;
-  std::fprintf(text, "# %s%s: %d DoFs, %zu muscles in %zu strips, %d steps of %g s, method %s, %s, %d evaluations\n",
-               name().c_str(), small ? " (small)" : "", swimmer.scene.mesh.num_dofs(), swimmer.scene.muscles.size(),
-               swimmer.strips.size(), swimmer.steps, swimmer.time_step, ToString(options.method),
-               ToString(settings.optimizer), settings.evaluations);
-  std::fprintf(text, "%5s %9s %14s %10s %10s %12s\n", "eval", "steps", "reward", "forward_s", "backward_s",
-               "|dL/dtheta|");
-  const TrainingResult result = TrainSwimmer(swimmer, options, settings);
-  std::fprintf(text,
-               "# reward %.6f -> %.6f (best %.6f); %.3f s forward + %.3f s backward per evaluation, %.1f s total\n",
-               result.initial_reward(), result.final_reward(), result.best_reward(), result.mean_forward_seconds(),
-               result.mean_backward_seconds(), result.total_seconds);
 
-  nlohmann::json summary = TrainingJson(result);
+  std::vector<TrainingResult> results;
+  nlohmann::json runs = nlohmann::json::array();
+  for (const ControlOptimizer optimizer : optimizers) {
+    settings.optimizer = optimizer;
+    std::fprintf(text, "# %s%s: %d DoFs, %zu muscles in %zu strips, %d steps of %g s, method %s, %s, %d evaluations\n",
+                 name().c_str(), small ? " (small)" : "", swimmer.scene.mesh.num_dofs(), swimmer.scene.muscles.size(),
+                 swimmer.strips.size(), swimmer.steps, swimmer.time_step, ToString(options.method),
+                 ToString(settings.optimizer), settings.evaluations);
+    std::fprintf(text, "%5s %9s %14s %10s %10s %12s\n", "eval", "steps", "reward", "forward_s", "backward_s",
+                 "|dL/dtheta|");
+    results.push_back(TrainSwimmer(swimmer, options, settings));
+    const TrainingResult& result = results.back();
+    std::fprintf(text,
+                 "# %s: reward %.6f -> %.6f (best %.6f); %.3f s forward + %.3f s backward per evaluation, %.1f s "
+                 "total\n",
+                 result.optimizer.c_str(), result.initial_reward(), result.final_reward(), result.best_reward(),
+                 result.mean_forward_seconds(), result.mean_backward_seconds(), result.total_seconds);
+    if (!result.optimizer_report.empty()) std::fprintf(text, "# %s\n", result.optimizer_report.c_str());
+    runs.push_back(TrainingJson(result));
+  }
+
+  nlohmann::json summary = runs.size() == 1 ? runs[0] : nlohmann::json{{"runs", runs}};
   summary["problem"] = name();
   summary["instance"] = small ? "small" : "full";
   summary["seed"] = settings.seed;
-  if (args.compare_newton && options.method != Method::kNewtonCholesky) {
+  if (args.compare_newton && options.method != Method::kNewtonCholesky && options.method != Method::kNewtonPcg) {
     const int repeats = small ? 1 : 3;
-    const std::vector<EvaluationTiming> timings =
-        TimeEvaluations(swimmer, options, {options.method, Method::kNewtonCholesky}, repeats, settings.seed);
-    const double ratio = (timings[1].forward_seconds + timings[1].backward_seconds) /
-                         (timings[0].forward_seconds + timings[0].backward_seconds);
+    const std::vector<EvaluationTiming> timings = TimeEvaluations(
+        swimmer, options, {options.method, Method::kNewtonCholesky, Method::kNewtonPcg}, repeats, settings.seed);
+    const auto seconds = [](const EvaluationTiming& t) { return t.forward_seconds + t.backward_seconds; };
+    const EvaluationTiming& best_newton = seconds(timings[1]) <= seconds(timings[2]) ? timings[1] : timings[2];
+    const double ratio = seconds(best_newton) / seconds(timings[0]);
     for (const EvaluationTiming& t : timings)
       std::fprintf(text, "# %s: %.3f s forward + %.3f s backward per evaluation (median of %d), reward %.6f\n",
                    ToString(t.method), t.forward_seconds, t.backward_seconds, t.repeats, t.reward);
-    std::fprintf(text, "# newton-cholesky / %s time per evaluation: %.2f\n", ToString(options.method), ratio);
+    std::fprintf(text, "# best Newton (%s) / %s time per evaluation: %.2f\n", ToString(best_newton.method),
+                 ToString(options.method), ratio);
     summary["timings"] = TimingJson(timings);
+    summary["best_newton"] = ToString(best_newton.method);
     summary["newton_time_ratio"] = ratio;
   }
   const std::string dir = args.out_dir.empty() ? (std::filesystem::path("out") / name()).string() : args.out_dir;
@@ -389,16 +426,23 @@ int SwimmerControl::Run(const CommandArgs& args) const {
       std::fprintf(stderr, "diffpd: no reference curve: %s\n", e.what());
     }
   }
-  for (const std::string& f : PlotLearningCurve(dir, name() + ": reward per simulated step", result, references))
+  std::vector<const TrainingResult*> curves;
+  for (const TrainingResult& r : results) curves.push_back(&r);
+  for (const std::string& f : PlotLearningCurves(dir, name() + ": reward per simulated step", curves, references))
     files.push_back(f);
-  files.push_back(WriteRolloutFrames((std::filesystem::path(dir) / "frames").string(), name(), swimmer.scene.mesh,
-                                     result.final_rollout));
+  for (const TrainingResult& r : results) {
+    const std::string frames = results.size() == 1 ? "frames" : "frames_" + r.optimizer;
+    files.push_back(WriteRolloutFrames((std::filesystem::path(dir) / frames).string(), name(), swimmer.scene.mesh,
+                                       r.final_rollout));
+  }
   const std::string json_path = (std::filesystem::path(dir) / "summary.json").string();
   std::ofstream(json_path) << summary.dump(2) << "\n";
   files.push_back(json_path);
   for (const std::string& f : files) std::fprintf(text, "# wrote %s\n", f.c_str());
   if (args.json) std::printf("%s\n", summary.dump(2).c_str());
-  return result.final_reward() > result.initial_reward() ? 0 : 5;
+  bool improved = true;
+  for (const TrainingResult& r : results) improved = improved && r.final_reward() > r.initial_reward();
+  return improved ? 0 : 5;
 }
 
 }  // namespace diffpd::problems

@@ -3,38 +3,32 @@
 // strips driven through a per-element delay line by a neural network that
 // observes the state every step (strip_network_controller.h). The network's
 // weights are trained through the differentiable simulation: every
-// evaluation is one closed-loop rollout and its reverse pass
-// (Simulator::Backward with the controller).
+// evaluation is one closed-loop rollout and its reverse pass, made by the
+// rollout core (solvers/core: a RolloutFunction with a ControllerBlock and
+// the swim loss), and the optimisers (swimmer_optimizers.h) are Adam, Ceres'
+// L-BFGS and Ipopt through their adapters.
 //
 // Computing and reporting are apart: TrainSwimmer returns a TrainingResult;
-// TrainingJson, PlotLearningCurve and WriteRolloutFrames report it.
+// TrainingJson, PlotLearningCurves and WriteRolloutFrames report it.
 #pragma once
 
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "control/adam.h"
+#include "control/evaluation_budget.h"
+#include "control/swim_loss.h"
 #include "diffpd/simulator.h"
+#include "diffpd/solvers/core/rollout_function.h"
 #include "diffpd/strip_network_controller.h"
 #include "problem.h"
 
 namespace diffpd::problems {
-
-// The original swimmers' loss, summed over the steps k = 1..K:
-//   L = sum_k [ -d . vbar_k + side_weight |vbar_k - (d . vbar_k) d|^2 ],
-// vbar_k the mean velocity of `nodes` after step k (m/s), d the unit swim
-// direction; the reward is -L.
-struct SwimLoss {
-  std::vector<int> nodes;
-  Vec3 direction = Vec3::UnitZ();
-  double side_weight = 1.0;
-  // L of a rollout; fills grad->dv (and sizes *grad) when not nullptr.
-  double Evaluate(const Rollout& rollout, LossGradient* grad) const;
-};
 
 // A swimmer: its scene (muscles of the strips, quad hydrodynamics), the
 // strips' muscles (root to tip) and drives, what the network observes and
@@ -56,9 +50,16 @@ struct Swimmer {
 // (the original's initialisation; its torch draws are not reproduced).
 StripNetworkController MakeSwimmerController(const Swimmer& swimmer, std::uint64_t seed);
 
-// The optimiser that trains the weights.
-enum class ControlOptimizer { kAdam };
+// The optimiser that trains the weights (swimmer_optimizers.h): Adam with
+// the original's settings, Ceres' L-BFGS (needs the Ceres adapter), Ipopt
+// with a limited-memory Hessian (needs the Ipopt adapter).
+enum class ControlOptimizer { kAdam, kLbfgs, kIpopt };
+// "adam", "lbfgs", "ipopt".
 const char* ToString(ControlOptimizer optimizer);
+// Throws InvalidInputError: "optimizer 'sgd' is unknown: valid optimizers are adam, lbfgs, ipopt".
+ControlOptimizer ParseControlOptimizer(const std::string& name);
+// Whether this build has the optimiser's adapter.
+bool ControlOptimizerAvailable(ControlOptimizer optimizer);
 
 struct TrainingSettings {
   int evaluations = 100;  // rollouts with a reverse pass (Adam: epochs); >= 1
@@ -68,25 +69,19 @@ struct TrainingSettings {
   FILE* log = nullptr;      // one line per evaluation (nullptr: silent); not owned
 };
 
-// One evaluation: the reward of the rollout at the parameters before the
-// update, and what it cost.
-struct TrainingEvaluation {
-  int evaluation = 0;        // 0, 1, ...
-  long simulated_steps = 0;  // steps simulated before this rollout (the learning curve's x)
-  double reward = 0;         // -L
-  double forward_seconds = 0;
-  double backward_seconds = 0;  // 0 for the final evaluation (no gradient)
-  double gradient_norm = 0;     // |dL/dtheta| (0 for the final evaluation)
-};
-
 struct TrainingResult {
   std::string optimizer;
+  // How the optimiser ended (Ceres' brief report, Ipopt's status; Adam: empty).
+  std::string optimizer_report;
   Method method = Method::kPdLbfgs;
   int dofs = 0, steps = 0, parameters = 0;
   double time_step = 0;
-  // evaluations + 1 entries: the last is the final controller, evaluated
-  // without a gradient.
+  // One entry per evaluation the optimiser made (at most the budget; a
+  // failed rollout has none) and a last one for the final controller
+  // (re-evaluated without a gradient where the optimiser had not evaluated
+  // it; its simulated_steps are those of the whole training).
   std::vector<TrainingEvaluation> history;
+  int failed_evaluations = 0;
   VectorXd initial_parameters, final_parameters;
   Rollout final_rollout;     // the final controller's
   double total_seconds = 0;  // wall time of the whole training
@@ -99,10 +94,17 @@ struct TrainingResult {
   double mean_backward_seconds() const;
 };
 
+// The swimmer's training as a rollout function (solvers/core): one
+// ControllerBlock with MakeSwimmerController(swimmer, seed) and the swim loss
+// as functional 0; `options`' time step is replaced by the swimmer's.
+std::unique_ptr<solvers::RolloutFunction> MakeSwimmerFunction(const Swimmer& swimmer, const SolverOptions& options,
+                                                              std::uint64_t seed);
+
 // Trains the swimmer's controller from MakeSwimmerController(swimmer, seed)
 // with `options` (method, tolerances, threads; the time step is the
-// swimmer's). Throws InvalidInputError for bad settings, SolverError when a
-// rollout fails.
+// swimmer's) and settings.optimizer within settings.evaluations rollouts.
+// Throws InvalidInputError for bad settings or an optimiser this build
+// lacks, SolverError when an Adam rollout or the final one fails.
 TrainingResult TrainSwimmer(const Swimmer& swimmer, const SolverOptions& options, const TrainingSettings& settings);
 
 // Seconds per evaluation (closed-loop rollout + reverse pass) with each
@@ -128,11 +130,14 @@ struct ReferenceCurve {
 // Reads "x,y" rows. Throws InvalidInputError naming the file and line.
 ReferenceCurve ReadReferenceCurve(const std::string& path, const std::string& label);
 
-// Writes <dir>/learning_curve.dat and, with gnuplot, <dir>/learning_curve.png:
-// reward against simulated steps (log x) of the run and of the reference
-// curves. Returns the written paths (the PNG only if gnuplot succeeded).
-std::vector<std::string> PlotLearningCurve(const std::string& dir, const std::string& title,
-                                           const TrainingResult& result, const std::vector<ReferenceCurve>& references);
+// Writes the runs' curves (<dir>/learning_curve.dat for one run,
+// learning_curve_<optimizer>.dat for several), the reference curves
+// (reference_<i>.dat) and, with gnuplot, <dir>/learning_curve.png: reward
+// against simulated steps (log x), all on the same axes. Returns the written
+// paths (the PNG only if gnuplot succeeded).
+std::vector<std::string> PlotLearningCurves(const std::string& dir, const std::string& title,
+                                            const std::vector<const TrainingResult*>& results,
+                                            const std::vector<ReferenceCurve>& references);
 // Writes the final rollout as <dir>/<name>.pvd and its frames (with the
 // velocity as point data); returns the .pvd path.
 std::string WriteRolloutFrames(const std::string& dir, const std::string& name, const Mesh& mesh,
@@ -160,14 +165,17 @@ class SwimmerControl : public Problem {
   double default_time_step() const override { return MakeSwimmer(false).time_step; }
 
   // `diffpd run <problem> [--small] [--method M] [--threads T]
-  // [--evaluations E] [--seed S] [--no-compare] [--out DIR] [--json]`:
-  // trains with Adam (the original's settings) for E evaluations (default
+  // [--evaluations E] [--seed S] [--optimizer O] [--no-compare] [--out DIR]
+  // [--json]`: trains with O (adam, the original's settings, by default;
+  // lbfgs; ipopt; all: each available one in turn, from the same seed) for E
+  // evaluations (default
   // 100; small: small_evaluations()), then (unless --no-compare) times a
   // few evaluations with newton-cholesky and the method; prints a line per
   // evaluation and a summary, writes the learning curve (.dat, .png), the
   // final controller's rollout (.pvd) and summary.json into DIR (default
-  // out/<problem>). Exit code 0 when the final reward is above the initial
-  // one, 5 otherwise.
+  // out/<problem>; with several optimisers, frames_<optimizer>/ and
+  // summary.json's "runs"). Exit code 0 when every final reward is above
+  // its initial one, 5 otherwise.
   int Run(const CommandArgs& args) const override;
 };
 

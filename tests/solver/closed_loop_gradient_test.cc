@@ -121,6 +121,7 @@ double LossOf(const Rollout& r, const LossGradient& loss) {
 class ScheduleController : public Controller {
  public:
   ScheduleController(int steps, int muscles, VectorXd theta) : steps_(steps), muscles_(muscles), theta_(theta) {}
+  std::unique_ptr<Controller> Clone() const override { return std::make_unique<ScheduleController>(*this); }
   int num_parameters() const override { return steps_ * muscles_; }
   VectorXd parameters() const override { return theta_; }
   void SetParameters(const VectorXd& p) override { theta_ = p; }
@@ -270,6 +271,7 @@ class FaultyController : public Controller {
  public:
   enum class Fault { kActivationSize, kNegativeActivation, kForceSize, kMemorySize, kNonFiniteMemory };
   explicit FaultyController(Fault fault) : fault_(fault) {}
+  std::unique_ptr<Controller> Clone() const override { return std::make_unique<FaultyController>(*this); }
   int num_parameters() const override { return 1; }
   VectorXd parameters() const override { return VectorXd::Constant(1, theta_); }
   void SetParameters(const VectorXd& p) override { theta_ = p(0); }

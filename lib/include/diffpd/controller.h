@@ -19,6 +19,8 @@
 // and returns dL/dtheta and dL/dm_0 (RolloutGradient).
 #pragma once
 
+#include <memory>
+
 #include "diffpd/rollout.h"
 #include "diffpd/types.h"
 
@@ -38,6 +40,9 @@ struct ControlAction {
 class Controller {
  public:
   virtual ~Controller() = default;
+  // A copy with the same parameters (rollouts at other parameters keep their
+  // own copies, solvers/core/controller_block.h).
+  virtual std::unique_ptr<Controller> Clone() const = 0;
 
   // theta: the parameters (num_parameters() entries).
   virtual int num_parameters() const = 0;

@@ -15,6 +15,8 @@
 // zero at the start), the parameters the network's.
 #pragma once
 
+#include <memory>
+
 #include <vector>
 
 #include "diffpd/controller.h"
@@ -52,6 +54,7 @@ class StripNetworkController : public Controller {
   // The observation o of a state (observation().size() values).
   VectorXd Observe(const State& state) const;
 
+  std::unique_ptr<Controller> Clone() const override { return std::make_unique<StripNetworkController>(*this); }
   int num_parameters() const override { return network_.num_parameters(); }
   VectorXd parameters() const override { return network_.parameters(); }
   void SetParameters(const VectorXd& parameters) override { network_.SetParameters(parameters); }
