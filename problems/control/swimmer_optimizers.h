@@ -25,8 +25,7 @@ VectorXd MinimizeWithAdam(solvers::RolloutFunction* function, int loss, const Ad
 // with strong Wolfe conditions) through solvers/ceres' RolloutLossFunction.
 // Returns Ceres' final point and sets *report to Ceres' one-line report.
 // Defined with the Ceres adapter only.
-VectorXd MinimizeWithLbfgs(solvers::RolloutFunction* function, int loss, EvaluationBudget* budget,
-                           std::string* report);
+VectorXd MinimizeWithLbfgs(solvers::RolloutFunction* function, int loss, EvaluationBudget* budget, std::string* report);
 
 // Ipopt with a limited-memory Hessian through solvers/ipopt's RolloutNlp
 // (which takes the function over). Returns Ipopt's final point (or the best

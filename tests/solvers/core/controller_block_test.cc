@@ -75,8 +75,8 @@ SolverOptions Options() {
 
 // How far the bar's tip nodes travel along z.
 std::unique_ptr<TrajectoryFunction> TipTravel(const Scene& scene) {
-  return std::make_unique<PointTravel>(MeanOf(scene.mesh.num_vertices(), {4, 9, 14}), 0, kFinalState,
-                                       Vec3::UnitZ(), "tip_travel");
+  return std::make_unique<PointTravel>(MeanOf(scene.mesh.num_vertices(), {4, 9, 14}), 0, kFinalState, Vec3::UnitZ(),
+                                       "tip_travel");
 }
 
 TEST(ControllerBlockTest, GradientIsTheSimulatorsClosedLoopReversePassBitForBit) {
@@ -87,8 +87,7 @@ TEST(ControllerBlockTest, GradientIsTheSimulatorsClosedLoopReversePassBitForBit)
   f.AddFunctional(TipTravel(bar.scene));
   VectorXd gradient;
   double value = 0;
-  ASSERT_TRUE(f.Gradient(f.initial_parameters(), VectorXd::Ones(1), &gradient, &value))
-      << f.statistics().last_error;
+  ASSERT_TRUE(f.Gradient(f.initial_parameters(), VectorXd::Ones(1), &gradient, &value)) << f.statistics().last_error;
 
   Simulator sim(bar.scene, Options());
   const Rollout rollout = sim.Simulate(sim.RestState(), controller, kSteps);
