@@ -269,7 +269,7 @@ INSTANTIATE_TEST_SUITE_P(Methods, ClosedLoopGradientTest, ::testing::Values(Meth
 // A controller whose action or memory has the wrong size or values.
 class FaultyController : public Controller {
  public:
-  enum class Fault { kActivationSize, kNegativeActivation, kForceSize, kMemorySize, kNonFiniteMemory };
+  enum class Fault { kActivationSize, kNonFiniteActivation, kForceSize, kMemorySize, kNonFiniteMemory };
   explicit FaultyController(Fault fault) : fault_(fault) {}
   std::unique_ptr<Controller> Clone() const override { return std::make_unique<FaultyController>(*this); }
   int num_parameters() const override { return 1; }
@@ -284,8 +284,8 @@ class FaultyController : public Controller {
       case Fault::kActivationSize:
         action->activation = VectorXd::Ones(3);
         break;
-      case Fault::kNegativeActivation:
-        action->activation(1) = -0.5;
+      case Fault::kNonFiniteActivation:
+        action->activation(1) = INFINITY;
         break;
       case Fault::kForceSize:
         action->external_force = VectorXd::Zero(5);
@@ -316,9 +316,8 @@ TEST(ClosedLoopInputTest, SimulateRefusesInvalidActionsMemoriesAndStepCounts) {
   EXPECT_THROW_MESSAGE(sim.Simulate(start, FaultyController(F::kActivationSize), 3), InvalidInputError,
                        "Simulate: the controller's action at step 1: activation has 3 entries, expected 8 (one per "
                        "muscle)");
-  EXPECT_THROW_MESSAGE(sim.Simulate(start, FaultyController(F::kNegativeActivation), 3), InvalidInputError,
-                       "Simulate: the controller's action at step 1: activation[1] = -0.5 is invalid: must be finite "
-                       "and >= 0");
+  EXPECT_THROW_MESSAGE(sim.Simulate(start, FaultyController(F::kNonFiniteActivation), 3), InvalidInputError,
+                       "Simulate: the controller's action at step 1: activation[1] = inf is invalid: must be finite");
   EXPECT_THROW_MESSAGE(sim.Simulate(start, FaultyController(F::kForceSize), 3), InvalidInputError,
                        "Simulate: the controller's action at step 1: external_force has 5 entries, expected 90 (3 x "
                        "number of nodes)");

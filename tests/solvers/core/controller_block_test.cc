@@ -91,11 +91,11 @@ TEST(ControllerBlockTest, GradientIsTheSimulatorsClosedLoopReversePassBitForBit)
 
   Simulator sim(bar.scene, Options());
   const Rollout rollout = sim.Simulate(sim.RestState(), controller, kSteps);
-  const TrajectoryFunction& travel = *TipTravel(bar.scene);
+  const std::unique_ptr<TrajectoryFunction> travel = TipTravel(bar.scene);
   LossGradient loss(kSteps);
-  travel.AddGradient(rollout, 1.0, &loss);
+  travel->AddGradient(rollout, 1.0, &loss);
   const RolloutGradient g = sim.Backward(rollout, loss, controller);
-  EXPECT_EQ(value, travel.Value(rollout));
+  EXPECT_EQ(value, travel->Value(rollout));
   ASSERT_EQ(gradient.size(), g.controller_parameters.size());
   EXPECT_TRUE(gradient == g.controller_parameters);
   EXPECT_GT(gradient.norm(), 0.0);
