@@ -1,5 +1,7 @@
 #include "problem_registry.h"
 
+#include "control/shark_control.h"
+#include "control/starfish_control.h"
 #include "diffpd/error.h"
 #include "scenes/bouncing_ball.h"
 #include "scenes/cantilever.h"
@@ -37,6 +39,8 @@ std::vector<std::unique_ptr<Problem>> AllProblems() {
 #else
   all.push_back(std::make_unique<RoutingTendon>());  // the forward scene only
 #endif
+  all.push_back(std::make_unique<StarfishControl>());
+  all.push_back(std::make_unique<SharkControl>());
 #if DIFFPD_WITH_CERES
   all.push_back(std::make_unique<CantileverCalibration>());
   all.push_back(std::make_unique<PlantCalibration>());

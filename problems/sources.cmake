@@ -12,6 +12,14 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/scenes/rolling_sphere.cc
   ${CMAKE_CURRENT_LIST_DIR}/scenes/bouncing_ball.cc
   ${CMAKE_CURRENT_LIST_DIR}/scenes/routing_tendon.cc
+  # control: closed-loop swimming, controllers trained through the simulation
+  ${CMAKE_CURRENT_LIST_DIR}/control/adam.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/swim_loss.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/evaluation_budget.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_adam.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_control.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/starfish_control.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/shark_control.cc
   # paper: the DiffPD paper's table rows as data
   ${CMAKE_CURRENT_LIST_DIR}/paper/numpy_random.cc
   ${CMAKE_CURRENT_LIST_DIR}/paper/paper_meshes.cc
@@ -58,14 +66,18 @@ set(DIFFPD_PROBLEMS_CALIBRATION_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_cantilever.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_plant.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_bouncing_ball.cc
-  ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_starfish.cc)
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_starfish.cc
+  # the swimmers' L-BFGS training
+  ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_lbfgs.cc)
 # control: trajectory and control optimisation with Ipopt
 set(DIFFPD_PROBLEMS_CONTROL_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/control/trajectory_optimization.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/bunny.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/routing_tendon_opt.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/locomotion.cc
-  ${CMAKE_CURRENT_LIST_DIR}/paper/row_optimisation.cc)
+  ${CMAKE_CURRENT_LIST_DIR}/paper/row_optimisation.cc
+  # the swimmers' Ipopt training
+  ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_ipopt.cc)
 get_filename_component(DIFFPD_DEFAULT_SHARED_DATA_DIR "${CMAKE_CURRENT_LIST_DIR}/../../shared/data" ABSOLUTE)
 set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/shared_data.cc PROPERTIES
   COMPILE_DEFINITIONS "DIFFPD_SHARED_DATA_DIR=\"${DIFFPD_DEFAULT_SHARED_DATA_DIR}\"")

@@ -62,6 +62,14 @@ int RunCommandLine(const std::vector<std::string>& argv) {
   run->add_flag("!--no-compare", run_args.compare_newton,
                 "optimisation problems: skip the repeat with newton-cholesky");
   run->add_option("--ipopt", run_args.ipopt_options, "optimisation problems: Ipopt option name=value (repeatable)");
+  run->add_option("--evaluations", run_args.evaluations,
+                  "control problems: training evaluations (rollouts; default 100, --small fewer)")
+      ->check(IntegerIn("--evaluations", 1, CommandArgs::kMaxEvaluations));
+  run->add_option("--seed", run_args.seed, "control problems: seed of the network's initial weights (default 42)")
+      ->check(IntegerIn("--seed", 0, CommandArgs::kMaxSeed));
+  run->add_option(
+      "--optimizer", run_args.optimizer,
+      "control problems: adam (the original's settings), lbfgs (Ceres), ipopt (limited-memory Hessian) or all");
   run->add_option("--data", run_args.data_file,
                   "calibration problems: captured-motion CSV (default: the problem's in data/)");
   run->add_option("--methods", run_args.methods,

@@ -37,6 +37,14 @@ struct CommandArgs {
   bool small = false;
   bool compare_newton = true;
   std::vector<std::string> ipopt_options;
+  // Control problems (starfish-control, shark-control): training
+  // evaluations (-1: the problem's; at most kMaxEvaluations) and the
+  // network's seed (-1: the problem's; at most kMaxSeed).
+  static constexpr int kMaxEvaluations = 100000;
+  static constexpr long kMaxSeed = 2147483647;
+  int evaluations = -1;
+  long long seed = -1;
+  std::string optimizer;  // "": adam; adam, lbfgs or ipopt
   // Calibration problems (calibrate-*): the captured-motion file (default:
   // the problem's file in data/), the methods to fit with and compare
   // (default: the problem's), a cap on Ceres iterations (-1: the problem's);
@@ -72,7 +80,8 @@ Subcommand AddSynthCommand(CLI::App* parent);     // synth_command.cc
 Subcommand AddTableCommand(CLI::App* parent);     // table_command.cc
 
 // `diffpd run`'s options that only some kinds of problem read (--small,
-// --no-compare, --ipopt: optimisation; --data, --methods, --max-iterations:
+// --no-compare, --ipopt: optimisation; --evaluations, --seed, --optimizer: control
+// (--small, --no-compare too); --data, --methods, --max-iterations:
 // calibration; --calibrate, --predict, --seconds, --regions: the starfish):
 // throws InvalidInputError for one given to a problem that would ignore it,
 // "--ipopt is not used by the simulation problem 'cantilever' (only the

@@ -6,13 +6,14 @@
 #include "calibration/calibrate_problem.h"
 #include "calibration/calibrate_starfish.h"
 #include "cli/commands.h"
+#include "control/swimmer_control.h"
 #include "control/trajectory_optimization.h"
 #include "diffpd/error.h"
 
 namespace diffpd::problems {
 namespace {
 
-enum Kind { kSimulation = 1, kOptimisation = 2, kCalibration = 4, kStarfish = 8 };
+enum Kind { kSimulation = 1, kOptimisation = 2, kCalibration = 4, kStarfish = 8, kControl = 16 };
 
 const char* KindName(int kind) {
   switch (kind) {
@@ -22,6 +23,8 @@ const char* KindName(int kind) {
       return "calibration problem";
     case kStarfish:
       return "starfish calibration";
+    case kControl:
+      return "control problem";
     default:
       return "simulation problem";
   }
@@ -31,6 +34,7 @@ int KindOf(const Problem& problem) {
   if (dynamic_cast<const TrajectoryOptimizationProblem*>(&problem)) return kOptimisation;
   if (dynamic_cast<const CalibrationProblem*>(&problem)) return kCalibration;
   if (dynamic_cast<const StarfishCalibration*>(&problem)) return kStarfish;
+  if (dynamic_cast<const SwimmerControl*>(&problem)) return kControl;
   return kSimulation;
 }
 
@@ -47,10 +51,13 @@ struct RunOption {
 void RefuseUnusedRunOptions(const CommandArgs& args, const Problem& problem) {
   const CommandArgs defaults;
   const RunOption options[] = {
-      {"--small", args.small, kOptimisation, "the optimisation problems"},
-      {"--no-compare", args.compare_newton != defaults.compare_newton, kOptimisation | kCalibration,
-       "the optimisation and calibration problems"},
+      {"--small", args.small, kOptimisation | kControl, "the optimisation and control problems"},
+      {"--no-compare", args.compare_newton != defaults.compare_newton, kOptimisation | kCalibration | kControl,
+       "the optimisation, calibration and control problems"},
       {"--ipopt", !args.ipopt_options.empty(), kOptimisation, "the optimisation problems"},
+      {"--evaluations", args.evaluations != defaults.evaluations, kControl, "the control problems"},
+      {"--seed", args.seed != defaults.seed, kControl, "the control problems"},
+      {"--optimizer", !args.optimizer.empty(), kControl, "the control problems"},
       {"--data", !args.data_file.empty(), kCalibration, "calibrate-plant and calibrate-bouncing-ball"},
       {"--methods", !args.methods.empty(), kCalibration | kStarfish, "the calibration problems"},
       {"--max-iterations", args.max_iterations != defaults.max_iterations, kCalibration | kStarfish,

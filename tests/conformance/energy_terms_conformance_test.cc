@@ -9,9 +9,10 @@
 // surfaces' projections, the body energies (elastic per energy set and
 // element type, including the fused PD hexahedron kernel; muscles; penalty
 // contact; the auxiliary energies together), the muscle force with its
-// activation derivative, the drag and thrust on one triangle, and the state
-// forces (damping, hydrodynamics, penalty friction, all together) with their
-// mass and parameter derivatives. A new term adds a row.
+// activation derivative, the drag and thrust on one triangle and on one
+// one-sided quad, and the state forces (damping, hydrodynamics on triangles
+// and on quads, penalty friction, all together) with their mass and parameter
+// derivatives. A new term adds a row.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -33,6 +34,7 @@
 #include "fem/muscle_forces.h"
 #include "fem/penalty_contact_energy.h"
 #include "forces/hydrodynamic_force.h"
+#include "forces/quad_hydrodynamic_force.h"
 #include "forces/state_forces.h"
 #include "material/density_kernels.h"
 #include "material/projections.h"
@@ -664,6 +666,139 @@ Symmetry RotationAboutZ() {
           }};
 }
 
+// Drag and thrust on one one-sided quad, y = (corners p_0..p_3 (12), relative
+// velocity u (3), fluid_density, drag_curve (4), thrust_curve (4)). The
+// states have the face moving into the water (n . u < 0, away from the
+// switch at n . u = 0, where the force jumps).
+ForceTerm QuadDrag() {
+  const auto params = [](const VectorXd& y) {
+    QuadHydrodynamics p;
+    p.fluid_density = y(15);
+    p.drag_curve = y.segment<4>(16);
+    p.thrust_curve = y.segment<4>(20);
+    return p;
+  };
+  const auto corners = [](const VectorXd& y) {
+    return std::array<Vec3, 4>{y.segment<3>(0), y.segment<3>(3), y.segment<3>(6), y.segment<3>(9)};
+  };
+  ForceTerm t;
+  t.name = "drag and thrust on a one-sided quad";
+  t.force = [params, corners](const VectorXd& y) -> VectorXd {
+    return internal::QuadHydrodynamicForce(params(y), corners(y), y.segment<3>(12));
+  };
+  t.vjp = [params, corners](const VectorXd& y, const VectorXd& w) {
+    std::array<Vec3, 4> g_corners;
+    Vec3 g_u;
+    QuadHydrodynamicsGradient grad;
+    internal::QuadHydrodynamicForceVjp(params(y), corners(y), y.segment<3>(12), w, &g_corners, &g_u, &grad);
+    VectorXd out(24);
+    out << g_corners[0], g_corners[1], g_corners[2], g_corners[3], g_u, grad.fluid_density, grad.drag_curve,
+        grad.thrust_curve;
+    return out;
+  };
+  t.random_state = [](std::mt19937_64* rng) {
+    std::normal_distribution<double> normal;
+    VectorXd y(24);
+    // A warped 0.1 m square in the xy plane (normal +z).
+    const double square[4][2] = {{0, 0}, {0.1, 0}, {0.1, 0.1}, {0, 0.1}};
+    for (int c = 0; c < 4; ++c)
+      y.segment<3>(3 * c) = Vec3(square[c][0], square[c][1], 0) + 0.01 * Vec3(normal(*rng), normal(*rng), normal(*rng));
+    Vec3 u;
+    do {
+      u = Vec3(normal(*rng), normal(*rng), normal(*rng));
+      if (u.z() > 0) u.z() = -u.z();
+    } while (u.z() > -0.2 * u.norm());  // n . d < -0.2
+    y.segment<3>(12) = u;
+    y(15) = 1000 * (0.5 + std::abs(normal(*rng)));
+    for (int i = 0; i < 8; ++i) y(16 + i) = normal(*rng);
+    return y;
+  };
+  VectorXd rest = VectorXd::Zero(24);
+  rest.segment<3>(3) = Vec3(0.1, 0, 0);
+  rest.segment<3>(6) = Vec3(0.1, 0.1, 0);
+  rest.segment<3>(9) = Vec3(0, 0.1, 0);
+  rest(15) = 1000;
+  rest.segment<4>(16) = QuadHydrodynamics().drag_curve;
+  rest.segment<4>(20) = QuadHydrodynamics().thrust_curve;  // u = 0: no force
+  t.rest = rest;
+  t.symmetries = {{"frame rotation",
+                   [](const VectorXd& y, const Mat3& q) {
+                     VectorXd out = y;
+                     for (int b = 0; b < 5; ++b) out.segment<3>(3 * b) = q * y.segment<3>(3 * b);
+                     return out;
+                   },
+                   [](const VectorXd& f, const Mat3& q) -> VectorXd { return q * f; },
+                   {}}};
+  // The corners' warp (0.01 m) is the smallest scale the force changes over.
+  t.scales.input = [](const VectorXd&) { return 0.01; };
+  return t;
+}
+
+// The quad hydrodynamics of a scene as a state force on y = (x, v,
+// fluid_density, flow_velocity (3), drag_curve (4), thrust_curve (4)):
+// the corner shares of StateForces::Add and their products in AddVjp.
+ForceTerm QuadStateForceTerm() {
+  Scene scene = SwimmerBox();
+  QuadHydrodynamics water;
+  water.quads = BoundaryQuads(scene.mesh);
+  scene.quad_hydrodynamics = water;
+  const int n = scene.mesh.num_dofs(), p = 12;
+  const auto scene_of = [scene, n](const VectorXd& y) {
+    Scene s = scene;
+    s.quad_hydrodynamics->fluid_density = y(2 * n);
+    s.quad_hydrodynamics->flow_velocity = y.segment<3>(2 * n + 1);
+    s.quad_hydrodynamics->drag_curve = y.segment<4>(2 * n + 4);
+    s.quad_hydrodynamics->thrust_curve = y.segment<4>(2 * n + 8);
+    return s;
+  };
+  const VectorXd mass = VectorXd::Ones(n);  // quad hydrodynamics does not depend on the mass
+  ForceTerm t;
+  t.name = "state forces, drag and thrust on one-sided quads";
+  t.force = [scene_of, n, mass](const VectorXd& y) {
+    VectorXd f = VectorXd::Zero(n);
+    internal::StateForces(scene_of(y)).Add(y.segment(0, n), y.segment(n, n), mass, &f);
+    return f;
+  };
+  t.vjp = [scene_of, n, p, mass](const VectorXd& y, const VectorXd& w) {
+    VectorXd gx = VectorXd::Zero(n), gv = VectorXd::Zero(n), dmass = VectorXd::Zero(n);
+    StateForceGradient grad;
+    internal::StateForces(scene_of(y)).AddVjp(y.segment(0, n), y.segment(n, n), mass, w, &gx, &gv, &grad, &dmass);
+    EXPECT_EQ(dmass.norm(), 0.0);
+    const QuadHydrodynamicsGradient& q = grad.quad_hydrodynamics;
+    VectorXd out(2 * n + p);
+    out << gx, gv, q.fluid_density, q.flow_velocity, q.drag_curve, q.thrust_curve;
+    return out;
+  };
+  const auto mesh = std::make_shared<Mesh>(scene.mesh);
+  const auto state = [n, water](const VectorXd& x, const VectorXd& v, const Vec3& flow) {
+    VectorXd y(2 * n + 12);
+    y << x, v, water.fluid_density, flow, water.drag_curve, water.thrust_curve;
+    return y;
+  };
+  t.random_state = [mesh, state, n](std::mt19937_64* rng) {
+    std::normal_distribution<double> position(0.0, 0.003), velocity(0.0, 0.2);
+    VectorXd x = RestPositions(*mesh), v(n);
+    for (int i = 0; i < n; ++i) {
+      x(i) += position(*rng);
+      v(i) = velocity(*rng);
+    }
+    return state(x, v, Vec3(0.1, -0.05, 0.02));
+  };
+  t.rest = state(RestPositions(*mesh), VectorXd::Zero(n), Vec3::Zero());  // at rest in still water
+  t.symmetries = {{"frame rotation",
+                   [n](const VectorXd& y, const Mat3& q) {
+                     VectorXd out = y;
+                     out.segment(0, n) = testing::RotateEach3(y.segment(0, n), q);
+                     out.segment(n, n) = testing::RotateEach3(y.segment(n, n), q);
+                     out.segment<3>(2 * n + 1) = q * y.segment<3>(2 * n + 1);
+                     return out;
+                   },
+                   testing::RotateEach3,
+                   {}}};
+  t.scales.input = [](const VectorXd&) { return 0.02; };  // positions: the element size
+  return t;
+}
+
 // ---- the table ---------------------------------------------------------
 
 struct Row {
@@ -753,6 +888,8 @@ std::vector<Row> Rows() {
       ForceRow("hydrodynamics", [] { return StateForceTerm("drag and thrust", Swimming(), {AnyRotation()}); }));
   rows.push_back(
       ForceRow("penalty_friction", [] { return StateForceTerm("penalty friction", Sliding(), {RotationAboutZ()}); }));
+  rows.push_back(ForceRow("quad_drag", [] { return QuadDrag(); }));
+  rows.push_back(ForceRow("quad_hydrodynamics", [] { return QuadStateForceTerm(); }));
   rows.push_back(ForceRow("all_state_forces", [] {
     return StateForceTerm("damping, drag, thrust and friction", AllStateForces(), {RotationAboutZ()});
   }));

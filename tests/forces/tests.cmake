@@ -1,3 +1,4 @@
 diffpd_add_test(hydrodynamic_force_test ${CMAKE_CURRENT_LIST_DIR}/hydrodynamic_force_test.cc)
 diffpd_add_test(state_forces_test ${CMAKE_CURRENT_LIST_DIR}/state_forces_test.cc LIBS diffpd_problems)
 diffpd_add_test(optional_terms_validation_test ${CMAKE_CURRENT_LIST_DIR}/optional_terms_validation_test.cc)
+diffpd_add_test(quad_hydrodynamics_test ${CMAKE_CURRENT_LIST_DIR}/quad_hydrodynamics_test.cc)

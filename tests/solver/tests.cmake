@@ -19,6 +19,7 @@ diffpd_add_test(adjoint_cost_model_test ${CMAKE_CURRENT_LIST_DIR}/adjoint_cost_m
 diffpd_add_test(hessian_assembly_test ${CMAKE_CURRENT_LIST_DIR}/hessian_assembly_test.cc)
 diffpd_add_test(adjoint_tolerance_test ${CMAKE_CURRENT_LIST_DIR}/adjoint_tolerance_test.cc)
 diffpd_add_test(rollout_test ${CMAKE_CURRENT_LIST_DIR}/rollout_test.cc)
+diffpd_add_test(closed_loop_gradient_test ${CMAKE_CURRENT_LIST_DIR}/closed_loop_gradient_test.cc)
 diffpd_add_test(rollout_checks_test ${CMAKE_CURRENT_LIST_DIR}/rollout_checks_test.cc)
 diffpd_add_test(simulator_test ${CMAKE_CURRENT_LIST_DIR}/simulator_test.cc)
 diffpd_add_test(tolerance_reference_test ${CMAKE_CURRENT_LIST_DIR}/tolerance_reference_test.cc)

@@ -62,12 +62,19 @@ struct Rollout {
   // One per Scene::material_regions entry, in order (empty without regions).
   std::vector<MaterialParameters> region_materials;
   SolverOptions options;
+  // Closed loop (Simulator::Simulate with a Controller, controller.h): the
+  // controller's memory m_0..m_K and the parameters it acted with; `inputs`
+  // hold its actions. Both empty for an open-loop rollout.
+  std::vector<VectorXd> controller_memory;
+  VectorXd controller_parameters;
 
   int num_steps() const { return static_cast<int>(inputs.size()); }
+  bool closed_loop() const { return !controller_memory.empty(); }
   double forward_seconds() const;
   // The rollout truncated after `num_steps` steps: states[0..num_steps],
   // inputs[0..num_steps), the reports of those steps (as many as there are),
-  // the same materials and options. Simulator::Backward on it gives the
+  // the same materials and options (closed loop: controller_memory[0..num_steps]
+  // and the controller's parameters). Simulator::Backward on it gives the
   // gradient of a loss that reads states 0..num_steps only, at num_steps
   // adjoint steps instead of K; its per-step gradients then have num_steps
   // entries. Throws InvalidInputError unless 0 <= num_steps <= K
@@ -109,6 +116,12 @@ struct RolloutGradient {
   // One per Scene::material_regions entry, in order (empty without regions):
   // dL/dE_r (per Pa), dL/dnu_r, dL/drho_r (per kg/m^3) of region r.
   std::vector<MaterialComponents> region_materials;
+  // Closed loop (Backward with the rollout's controller): dL/dtheta of the
+  // controller's parameters and dL/dm_0 of its initial memory; empty
+  // otherwise. `activation` and `external_force` then hold dL/du_k, the
+  // gradients w.r.t. the recorded actions.
+  VectorXd controller_parameters;
+  VectorXd controller_memory;
   BackwardReport report;
 };
 

@@ -61,6 +61,9 @@ struct Scene {
   // State forces (state_forces.h): drag and thrust on surface triangles, and
   // mass-proportional damping f = -c M v (c in 1/s).
   std::optional<Hydrodynamics> hydrodynamics;
+  // The original DiffPD swimmers' drag and thrust on one-sided quads with
+  // Bezier coefficient curves (quad_hydrodynamics.h).
+  std::optional<QuadHydrodynamics> quad_hydrodynamics;
   std::optional<double> linear_damping;
 
   // Throws InvalidInputError naming the first problem: invalid mesh or

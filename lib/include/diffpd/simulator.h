@@ -13,6 +13,7 @@
 #include <memory>
 #include <vector>
 
+#include "diffpd/controller.h"
 #include "diffpd/rollout.h"
 #include "diffpd/scene.h"
 #include "diffpd/solver_options.h"
@@ -62,6 +63,16 @@ class Simulator {
   State Step(const State& state, const StepInput& input, StepReport* report = nullptr);
   // K = inputs.size() steps from `initial`, recorded for Backward().
   Rollout Simulate(const State& initial, const std::vector<StepInput>& inputs);
+  // Closed loop (controller.h): `steps` steps from `initial`, each driven by
+  // the action the controller chooses from the step's state and its memory.
+  // The rollout records the actions as its inputs, the memory and the
+  // controller's parameters. Throws InvalidInputError for steps < 0, an
+  // action of the wrong size or with an invalid entry ("Simulate: the
+  // controller's action at step 3: activation[1] = -0.5 is invalid: must be
+  // finite and >= 0") or a memory of the wrong size or non-finite ("Simulate:
+  // the controller's memory after step 0 has 3 entries, expected 4"); the
+  // step's own exceptions otherwise.
+  Rollout Simulate(const State& initial, const Controller& controller, int steps);
   // Reverse mode: gradients of a loss L(x_0..x_K, v_0..v_K) w.r.t. every
   // differentiable input, given dL/dx_k and dL/dv_k (material parameters:
   // the base material's and, per region, RolloutGradient::region_materials).
@@ -73,7 +84,17 @@ class Simulator {
   // other settings, a frictional-contact rollout without its reports (e.g.
   // "Backward: the rollout's state 1 has x with 24 entries, expected 48 (3 x
   // number of nodes)"), or a loss gradient of the wrong shape.
+  // A closed-loop rollout's actions count here as given inputs (the
+  // gradients w.r.t. them are `activation` and `external_force`).
   RolloutGradient Backward(const Rollout& rollout, const LossGradient& loss);
+  // Closed loop: Backward through the controller that made the rollout
+  // (controller.h), which also fills RolloutGradient::controller_parameters
+  // and controller_memory. Throws InvalidInputError, besides the above, for
+  // an open-loop rollout ("Backward: the rollout is open-loop (made without
+  // a controller)") or a controller whose parameters or memory size differ
+  // from the rollout's ("Backward: the controller's parameters differ from
+  // those the rollout was made with").
+  RolloutGradient Backward(const Rollout& rollout, const LossGradient& loss, const Controller& controller);
   // Forward mode: tangents of every state of the rollout along each of the
   // P directions (tangent_rollout.h), all P solved together per step with the
   // step's exact Hessian H (PD: the forward factor of A, A z = b + dA z or
@@ -82,6 +103,7 @@ class Simulator {
   //   dv_{i+1} = (dx_{i+1} - dx_i) / h.
   // Same preconditions and exceptions as Backward; InvalidInputError also for
   // no direction or a direction with wrongly sized or non-finite entries.
+  // A closed-loop rollout's actions are held fixed (open-loop tangents).
   TangentRollout Tangents(const Rollout& rollout, const std::vector<InputDirection>& directions);
 
   // Equilibrium under the declared forces (gravity, `input.external_force`)
@@ -98,6 +120,10 @@ class Simulator {
   double pd_factorization_seconds() const;
 
  private:
+  // Backward after the rollout's checks, with an optional controller
+  // (nullptr: open loop).
+  RolloutGradient CheckedBackward(const Rollout& rollout, const LossGradient& loss, const Controller* controller);
+
   std::unique_ptr<internal::SimulatorImpl> impl_;
 };
 

@@ -39,6 +39,7 @@
 #include <Eigen/Core>
 
 #include "diffpd/mesh.h"
+#include "diffpd/quad_hydrodynamics.h"
 #include "diffpd/types.h"
 
 namespace diffpd {
@@ -60,8 +61,9 @@ struct StateForceGradient {
   double drag_tangential = 0;
   double drag_normal = 0;
   double thrust = 0;
-  Vec3 flow_velocity = Vec3::Zero();     // per m/s
-  std::vector<double> penalty_friction;  // per Scene::penalty_contacts entry, dL/dmu
+  Vec3 flow_velocity = Vec3::Zero();             // per m/s
+  std::vector<double> penalty_friction;          // per Scene::penalty_contacts entry, dL/dmu
+  QuadHydrodynamicsGradient quad_hydrodynamics;  // Scene::quad_hydrodynamics (quad_hydrodynamics.h)
 };
 
 // Boundary faces of a mesh as outward triangles (3 x t node indices): faces

@@ -52,12 +52,27 @@ class MuscleForces {
   double Activation(const VectorXd& activation, int muscle) const;
   Vec3 Feature(const VectorXd& x, size_t s) const;
   const double* coefficients(size_t s) const { return coefficients_.data() + s * k_; }
+  const int* nodes(size_t s) const { return nodes_.data() + s * k_; }
+  // The loops over samples for K nodes per element (K = 4, 8: unrolled;
+  // 0: any).
+  template <int K>
+  double EnergyAndGradientImpl(const VectorXd& x, const VectorXd& activation, VectorXd* grad) const;
+  template <int K>
+  void HessianProductImpl(const VectorXd& x, const VectorXd& activation, const VectorXd& z, VectorXd* out) const;
+  // Hexahedra (8 nodes, 8 samples per element): a muscle element's 8
+  // features at once, U = X C (X 3 x 8 node values, C 8 x 8 coefficients),
+  // and the forces back as F C^T.
+  double HexEnergyAndGradient(const VectorXd& x, const VectorXd& activation, VectorXd* grad) const;
+  void HexHessianProduct(const VectorXd& x, const VectorXd& activation, const VectorXd& z, VectorXd* out) const;
+  bool hex_groups() const { return k_ == 8 && q_ == 8; }
 
   const FemModel& fem_;
   int k_ = 0;
+  int q_ = 0;  // samples per element; a muscle element's samples are consecutive
   int num_muscles_ = 0;
   std::vector<Sample> samples_;
   std::vector<double> coefficients_;  // K per sample: c_a
+  std::vector<int> nodes_;            // K per sample: the element's nodes
 };
 
 }  // namespace diffpd::internal

@@ -1,4 +1,5 @@
-// Boundary faces of tetrahedral and hexahedral meshes (see state_forces.h).
+// Boundary faces of tetrahedral and hexahedral meshes (see state_forces.h and
+// quad_hydrodynamics.h).
 #include <algorithm>
 #include <array>
 #include <map>
@@ -6,6 +7,8 @@
 
 #include <Eigen/Geometry>
 
+#include "diffpd/error.h"
+#include "diffpd/quad_hydrodynamics.h"
 #include "diffpd/state_forces.h"
 
 namespace diffpd {
@@ -75,6 +78,17 @@ Eigen::Matrix3Xi BoundaryTriangles(const Mesh& mesh) {
   Eigen::Matrix3Xi out(3, static_cast<Eigen::Index>(tris.size()));
   for (size_t t = 0; t < tris.size(); ++t)
     for (int c = 0; c < 3; ++c) out(c, static_cast<Eigen::Index>(t)) = tris[t][c];
+  return out;
+}
+
+Eigen::Matrix4Xi BoundaryQuads(const Mesh& mesh) {
+  if (mesh.type != ElementType::kHex8)
+    throw InvalidInputError(std::string("BoundaryQuads: the mesh has ") + ToString(mesh.type) +
+                            " elements; quads need hex8");
+  const std::vector<BoundaryFace> faces = Faces(mesh);
+  Eigen::Matrix4Xi out(4, static_cast<Eigen::Index>(faces.size()));
+  for (size_t f = 0; f < faces.size(); ++f)
+    for (int c = 0; c < 4; ++c) out(c, static_cast<Eigen::Index>(f)) = faces[f].nodes[c];
   return out;
 }
 

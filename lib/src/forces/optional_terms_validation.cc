@@ -168,6 +168,29 @@ void ValidateStateForces(const Scene& scene) {
     if (!hydro.flow_velocity.allFinite())
       Invalid("hydrodynamics.flow_velocity", Format(hydro.flow_velocity), "finite (m/s)");
   }
+  if (scene.quad_hydrodynamics) {
+    const QuadHydrodynamics& quad = *scene.quad_hydrodynamics;
+    for (int f = 0; f < quad.quads.cols(); ++f)
+      for (int c = 0; c < 4; ++c) {
+        const int i = quad.quads(c, f);
+        if (i < 0 || i >= n) {
+          std::ostringstream s;
+          s << "scene: quad_hydrodynamics.quads(" << c << ", " << f << ") = " << i << " is out of range [0, " << n
+            << ") (no such node)";
+          throw InvalidInputError(s.str());
+        }
+      }
+    CheckNonNegative("quad_hydrodynamics.fluid_density", quad.fluid_density, " (kg/m^3)");
+    if (!quad.flow_velocity.allFinite())
+      Invalid("quad_hydrodynamics.flow_velocity", Format(quad.flow_velocity), "finite (m/s)");
+    for (const auto& [name, curve] : {std::pair{"quad_hydrodynamics.drag_curve", quad.drag_curve},
+                                      {"quad_hydrodynamics.thrust_curve", quad.thrust_curve}})
+      if (!curve.allFinite()) {
+        std::ostringstream s;
+        s << "(" << curve(0) << ", " << curve(1) << ", " << curve(2) << ", " << curve(3) << ")";
+        Invalid(name, s.str(), "finite");
+      }
+  }
   if (scene.linear_damping) CheckNonNegative("linear_damping", *scene.linear_damping, " (1/s)");
 }
 

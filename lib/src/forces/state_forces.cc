@@ -1,10 +1,12 @@
 #include "forces/state_forces.h"
 
+#include <array>
 #include <cmath>
 
 #include <Eigen/Geometry>
 
 #include "forces/hydrodynamic_force.h"
+#include "forces/quad_hydrodynamic_force.h"
 
 namespace diffpd::internal {
 namespace {
@@ -18,11 +20,23 @@ Vec3 MeanVelocity(const VectorXd& v, int a, int b, int c) {
   return (v.segment<3>(3 * a) + v.segment<3>(3 * b) + v.segment<3>(3 * c)) / 3.0;
 }
 
+// Corner positions of quad f and the water's velocity relative to it.
+std::array<Vec3, 4> QuadCorners(const VectorXd& x, const Eigen::Matrix4Xi& quads, int f) {
+  return {x.segment<3>(3 * quads(0, f)), x.segment<3>(3 * quads(1, f)), x.segment<3>(3 * quads(2, f)),
+          x.segment<3>(3 * quads(3, f))};
+}
+Vec3 QuadRelativeVelocity(const VectorXd& v, const QuadHydrodynamics& q, int f) {
+  Vec3 mean = Vec3::Zero();
+  for (int c = 0; c < 4; ++c) mean += v.segment<3>(3 * q.quads(c, f));
+  return q.flow_velocity - mean / 4.0;
+}
+
 }  // namespace
 
 StateForces::StateForces(const Scene& scene)
     : damping_(scene.linear_damping),
       hydro_(scene.hydrodynamics),
+      quad_hydro_(scene.quad_hydrodynamics),
       num_penalty_contacts_(static_cast<int>(scene.penalty_contacts.size())) {
   for (size_t c = 0; c < scene.penalty_contacts.size(); ++c) {
     const PenaltyContact& pc = scene.penalty_contacts[c];
@@ -45,6 +59,14 @@ void StateForces::Add(const VectorXd& x, const VectorXd& v, const VectorXd& mass
       f->segment<3>(3 * a) += share;
       f->segment<3>(3 * b) += share;
       f->segment<3>(3 * c) += share;
+    }
+  }
+  if (quad_hydro_) {
+    for (int q = 0; q < quad_hydro_->quads.cols(); ++q) {
+      const Vec3 share = internal::QuadHydrodynamicForce(*quad_hydro_, QuadCorners(x, quad_hydro_->quads, q),
+                                                         QuadRelativeVelocity(v, *quad_hydro_, q)) /
+                         4.0;
+      for (int c = 0; c < 4; ++c) f->segment<3>(3 * quad_hydro_->quads(c, q)) += share;
     }
   }
   for (const FrictionNode& fn : friction_) {
@@ -83,6 +105,24 @@ void StateForces::AddVjp(const VectorXd& x, const VectorXd& v, const VectorXd& m
       gx->segment<3>(3 * c) += gc;
       for (const int i : {a, b, c}) gv->segment<3>(3 * i) += g_u / 3.0;
       grad->flow_velocity -= g_u;
+    }
+  }
+  if (quad_hydro_) {
+    const Eigen::Matrix4Xi& quads = quad_hydro_->quads;
+    std::array<Vec3, 4> g_corners;
+    Vec3 g_u;
+    for (int q = 0; q < quads.cols(); ++q) {
+      Vec3 wq = Vec3::Zero();
+      for (int c = 0; c < 4; ++c) wq += w.segment<3>(3 * quads(c, q));
+      wq /= 4.0;
+      internal::QuadHydrodynamicForceVjp(*quad_hydro_, QuadCorners(x, quads, q),
+                                         QuadRelativeVelocity(v, *quad_hydro_, q), wq, &g_corners, &g_u,
+                                         &grad->quad_hydrodynamics);
+      for (int c = 0; c < 4; ++c) {
+        gx->segment<3>(3 * quads(c, q)) += g_corners[c];
+        gv->segment<3>(3 * quads(c, q)) -= g_u / 4.0;
+      }
+      grad->quad_hydrodynamics.flow_velocity += g_u;
     }
   }
   if (!friction_.empty() && static_cast<int>(grad->penalty_friction.size()) != num_penalty_contacts_)

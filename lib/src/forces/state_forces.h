@@ -1,6 +1,7 @@
 // Explicit forces that depend on the state at the start of a step (internal):
-// linear damping, hydrodynamic drag and thrust, penalty-contact friction (see
-// diffpd/state_forces.h and diffpd/contact.h for the models). Evaluated once
+// linear damping, hydrodynamic drag and thrust (on triangles and on one-sided
+// quads), penalty-contact friction (see diffpd/state_forces.h,
+// diffpd/quad_hydrodynamics.h and diffpd/contact.h for the models). Evaluated once
 // per step at (x_i, v_i); the backward pass needs their vector-Jacobian
 // products. Every method returns at once when nothing is declared.
 #pragma once
@@ -19,7 +20,7 @@ class StateForces {
   // The scene must be valid. Copies what it needs.
   explicit StateForces(const Scene& scene);
 
-  bool empty() const { return !damping_ && !hydro_ && friction_.empty(); }
+  bool empty() const { return !damping_ && !hydro_ && !quad_hydro_ && friction_.empty(); }
 
   // *f += F(x, v; M) (3n) for the lumped mass M (3n, kg; enters damping's
   // -c M v).
@@ -39,6 +40,7 @@ class StateForces {
   };
   std::optional<double> damping_;
   std::optional<Hydrodynamics> hydro_;
+  std::optional<QuadHydrodynamics> quad_hydro_;
   std::vector<FrictionNode> friction_;
   int num_penalty_contacts_ = 0;
 };

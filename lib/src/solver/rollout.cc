@@ -27,6 +27,11 @@ Rollout Rollout::Truncated(int num_steps) const {
   out.material = material;
   out.region_materials = region_materials;
   out.options = options;
+  if (closed_loop()) {
+    out.controller_memory.assign(controller_memory.begin(),
+                                 controller_memory.begin() + std::min<size_t>(num_steps + 1, controller_memory.size()));
+    out.controller_parameters = controller_parameters;
+  }
   return out;
 }
 

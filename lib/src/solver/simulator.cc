@@ -194,10 +194,65 @@ Rollout Simulator::Simulate(const State& initial, const std::vector<StepInput>& 
   return r;
 }
 
+Rollout Simulator::Simulate(const State& initial, const Controller& controller, int steps) {
+  if (steps < 0) {
+    std::ostringstream msg;
+    msg << "Simulate: steps = " << steps << " is invalid: must be >= 0";
+    throw InvalidInputError(msg.str());
+  }
+  const int n = impl_->num_dofs();
+  const int memory_size = controller.memory_size();
+  Rollout r;
+  r.material = impl_->scene.material;
+  for (const MaterialRegion& region : impl_->scene.material_regions) r.region_materials.push_back(region.material);
+  r.options = impl_->options;
+  r.controller_parameters = controller.parameters();
+  r.states.reserve(steps + 1);
+  r.inputs.reserve(steps);
+  r.controller_memory.reserve(steps + 1);
+  r.reports.resize(steps);
+  r.states.push_back(initial);
+  r.controller_memory.push_back(controller.InitialMemory());
+  auto check_memory = [memory_size](const VectorXd& m, const std::string& when) {
+    if (m.size() != memory_size) {
+      std::ostringstream msg;
+      msg << "Simulate: the controller's memory " << when << " has " << m.size() << " entries, expected "
+          << memory_size;
+      throw InvalidInputError(msg.str());
+    }
+    if (!m.allFinite())
+      throw InvalidInputError("Simulate: the controller's memory " + when + " has a non-finite entry");
+  };
+  check_memory(r.controller_memory[0], "before step 0");
+  for (int k = 0; k < steps; ++k) {
+    ControlAction action;
+    VectorXd next_memory;
+    controller.Act(k, r.states.back(), r.controller_memory.back(), &action, &next_memory);
+    StepInput input;
+    input.activation = std::move(action.activation);
+    input.external_force = std::move(action.external_force);
+    try {
+      CheckVector(input.external_force, n, "external_force", true);
+      internal::CheckActivation(input.activation, impl_->aux.num_muscles());
+    } catch (const InvalidInputError& e) {
+      std::ostringstream msg;
+      msg << "Simulate: the controller's action at step " << k << ": " << e.what();
+      throw InvalidInputError(msg.str());
+    }
+    check_memory(next_memory, "after step " + std::to_string(k));
+    r.states.push_back(Step(r.states.back(), input, &r.reports[k]));
+    r.inputs.push_back(std::move(input));
+    r.controller_memory.push_back(std::move(next_memory));
+  }
+  return r;
+}
+
 namespace {
 
-// Backward's pass over the steps, given a checked rollout.
-RolloutGradient BackwardPass(SimulatorImpl& sim, const Rollout& rollout, const LossGradient& loss) {
+// Backward's pass over the steps, given a checked rollout (and, closed
+// loop, the controller that made it).
+RolloutGradient BackwardPass(SimulatorImpl& sim, const Rollout& rollout, const LossGradient& loss,
+                             const Controller* controller) {
   const auto start = Clock::now();
   const int n = sim.num_dofs();
   const int steps = rollout.num_steps();
@@ -219,6 +274,8 @@ RolloutGradient BackwardPass(SimulatorImpl& sim, const Rollout& rollout, const L
   out.activation.assign(steps, VectorXd());
   VectorXd gx = loss.dx[steps].size() ? loss.dx[steps] : VectorXd::Zero(n);
   VectorXd gv = loss.dv[steps].size() ? loss.dv[steps] : VectorXd::Zero(n);
+  VectorXd g_memory;  // dL/dm_{i+1} of the controller (empty: zero)
+  if (controller) out.controller_parameters = VectorXd::Zero(controller->num_parameters());
   // Material adjoints per part (0: base, r + 1: region r): Lame parameters,
   // and dL/dM (3n), turned into densities at the end (M = sum_p rho_p m_p).
   const int parts = sim.num_parts();
@@ -289,6 +346,14 @@ RolloutGradient BackwardPass(SimulatorImpl& sim, const Rollout& rollout, const L
     }
     // Explicit state forces f(x_i, v_i; M): dL/df = out.external_force[i].
     sim.state_forces.AddVjp(s0.x, s0.v, mass, out.external_force[i], &gx_prev, &gv_prev, &out.state_forces, &dmass);
+    if (controller) {
+      // The action u_i = pi(x_i, v_i, m_i): dL/du_i flows into the state and memory.
+      const ControlAction g_action{out.activation[i], out.external_force[i]};
+      VectorXd g_memory_prev;
+      controller->ActVjp(i, s0, rollout.controller_memory[i], g_action, g_memory, &gx_prev, &gv_prev, &g_memory_prev,
+                         &out.controller_parameters);
+      g_memory = std::move(g_memory_prev);
+    }
     if (loss.dx[i].size()) gx_prev += loss.dx[i];
     if (loss.dv[i].size()) gv_prev += loss.dv[i];
     gx = std::move(gx_prev);
@@ -296,6 +361,7 @@ RolloutGradient BackwardPass(SimulatorImpl& sim, const Rollout& rollout, const L
   }
   out.x0 = gx;
   out.v0 = gv;
+  if (controller) out.controller_memory = g_memory.size() ? g_memory : VectorXd::Zero(controller->memory_size());
   const VectorXd drho = sim.mass_model.DensityGradient(dmass);
   for (int p = 0; p < parts; ++p) {
     double dmu_dE, dmu_dnu, dl_dE, dl_dnu;
@@ -325,10 +391,32 @@ RolloutGradient BackwardPass(SimulatorImpl& sim, const Rollout& rollout, const L
 }  // namespace
 
 RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& loss) {
+  return CheckedBackward(rollout, loss, nullptr);
+}
+
+RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& loss, const Controller& controller) {
+  if (!rollout.closed_loop()) throw InvalidInputError("Backward: the rollout is open-loop (made without a controller)");
+  if (static_cast<int>(rollout.controller_memory.size()) != rollout.num_steps() + 1)
+    throw InvalidInputError("Backward: the rollout has inconsistent controller memory and inputs");
+  const VectorXd theta = controller.parameters();
+  if (theta.size() != rollout.controller_parameters.size() || theta != rollout.controller_parameters)
+    throw InvalidInputError("Backward: the controller's parameters differ from those the rollout was made with");
+  for (const VectorXd& m : rollout.controller_memory)
+    if (m.size() != controller.memory_size()) {
+      std::ostringstream msg;
+      msg << "Backward: the rollout's controller memory has " << m.size() << " entries, the controller's "
+          << controller.memory_size();
+      throw InvalidInputError(msg.str());
+    }
+  return CheckedBackward(rollout, loss, &controller);
+}
+
+RolloutGradient Simulator::CheckedBackward(const Rollout& rollout, const LossGradient& loss,
+                                           const Controller* controller) {
   internal::CheckRolloutForDerivatives(*impl_, rollout, "Backward");
   // The rollout is finite: a non-finite value on the way is an overflow.
   try {
-    return BackwardPass(*impl_, rollout, loss);
+    return BackwardPass(*impl_, rollout, loss, controller);
   } catch (const SolverError& e) {
     if (e.status() != SolverStatus::kNonFinite) throw;
     throw SolverError(SolverStatus::kNonFinite, std::string(ToString(impl_->options.method)) +

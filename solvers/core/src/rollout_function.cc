@@ -276,7 +276,8 @@ bool RolloutFunction::EvaluateLocked(const Eigen::Ref<const VectorXd>& p) {
       }
     c.setup = SetupAt(p);
     PrepareSimulator(c.setup);
-    c.rollout = sim_->Simulate(c.setup.initial, c.setup.inputs);
+    c.rollout = c.setup.controller ? sim_->Simulate(c.setup.initial, *c.setup.controller, num_steps())
+                                   : sim_->Simulate(c.setup.initial, c.setup.inputs);
   } catch (...) {
     stats_.forward_seconds += Seconds(start);
     ++stats_.failed_rollouts;
@@ -440,7 +441,7 @@ VectorXd RolloutFunction::PullBack(const Rollout& rollout, LossGradient loss, in
   const auto start = Clock::now();
   RolloutGradient grad;
   try {
-    grad = sim_->Backward(rollout, loss);
+    grad = c.setup.controller ? sim_->Backward(rollout, loss, *c.setup.controller) : sim_->Backward(rollout, loss);
   } catch (...) {
     stats_.backward_seconds += Seconds(start);
     ++stats_.adjoint_passes;

@@ -80,6 +80,27 @@ TEST(CommandLineTest, RefusesOutOfRangeValuesOfTheSimulatingCommands) {
       {{"run", "calibrate-plant", "--max-iterations", "-5"},
        2,
        Invalid("--max-iterations = -5 is invalid: must be an integer >= 1")},
+      {{"run", "starfish-control", "--evaluations", "0"},
+       2,
+       Invalid("--evaluations = 0 is invalid: must be an integer in [1, 100000]")},
+      {{"run", "starfish-control", "--evaluations", "-3"},
+       2,
+       Invalid("--evaluations = -3 is invalid: must be an integer in [1, 100000]")},
+      {{"run", "starfish-control", "--evaluations", "2.5"},
+       2,
+       Invalid("--evaluations = 2.5 is invalid: must be an integer in [1, 100000]")},
+      {{"run", "shark-control", "--evaluations", "1e9"},
+       2,
+       Invalid("--evaluations = 1e9 is invalid: must be an integer in [1, 100000]")},
+      {{"run", "starfish-control", "--seed", "-1"},
+       2,
+       Invalid("--seed = -1 is invalid: must be an integer in [0, 2147483647]")},
+      {{"run", "starfish-control", "--seed", "99999999999999999999"},
+       2,
+       Invalid("--seed = 99999999999999999999 is invalid: must be an integer in [0, 2147483647]")},
+      {{"run", "starfish-control", "--optimizer", "sgd"},
+       2,
+       Invalid("optimizer 'sgd' is unknown: valid optimizers are adam, lbfgs, ipopt")},
       {{"run", "calibrate-starfish", "--seconds", "-1"},
        2,
        Invalid("--seconds = -1 is invalid: must be finite and > 0 (s)")},
@@ -100,8 +121,8 @@ TEST(CommandLineTest, RefusesOptionsTheProblemWouldIgnore) {
                "calibrate-bouncing-ball read it)")},
       {{"run", "falling-cube", "--small"},
        2,
-       Invalid("--small is not used by the simulation problem 'falling-cube' (only the optimisation problems read "
-               "it)")},
+       Invalid("--small is not used by the simulation problem 'falling-cube' (only the optimisation and control "
+               "problems read it)")},
       {{"run", "rolling-sphere", "--max-iterations", "3"},
        2,
        Invalid("--max-iterations is not used by the simulation problem 'rolling-sphere' (only the calibration "
@@ -119,8 +140,25 @@ TEST(CommandLineTest, RefusesOptionsTheProblemWouldIgnore) {
        Invalid("--seconds is not used by the calibration problem 'calibrate-plant' (only calibrate-starfish read it)")},
       {{"run", "calibrate-starfish", "--small"},
        2,
-       Invalid("--small is not used by the starfish calibration 'calibrate-starfish' (only the optimisation problems "
-               "read it)")},
+       Invalid("--small is not used by the starfish calibration 'calibrate-starfish' (only the optimisation and "
+               "control problems read it)")},
+      {{"run", "cantilever", "--evaluations", "5"},
+       2,
+       Invalid("--evaluations is not used by the simulation problem 'cantilever' (only the control problems read it)")},
+      {{"run", "cantilever", "--optimizer", "adam"},
+       2,
+       Invalid("--optimizer is not used by the simulation problem 'cantilever' (only the control problems read it)")},
+      {{"run", "bunny", "--seed", "3"},
+       2,
+       Invalid("--seed is not used by the optimisation problem 'bunny' (only the control problems read it)")},
+      {{"run", "starfish-control", "--ipopt", "tol=1e-3"},
+       2,
+       Invalid("--ipopt is not used by the control problem 'starfish-control' (only the optimisation problems read "
+               "it)")},
+      {{"run", "shark-control", "--steps", "5"},
+       2,
+       Invalid("--steps and --dt are fixed by the control problem 'shark-control'; use --small for the reduced "
+               "instance")},
   });
 }
 

@@ -10,11 +10,11 @@
 // The blocks of the library: InitialStateBlock, LinearInputBlock,
 // ExternalForceBlock, ActivationBlock (per-step and signal-parametrised
 // inputs), MaterialBlock (base and per-region E, nu, rho), StateForceBlock
-// (damping, hydrodynamics, penalty friction). A new kind of input (an
-// actuation model mapping a few parameters to activations, controller
-// weights) is a new subclass: Apply writes the setup, PullBack applies the
-// transpose of d(setup)/d(values) to the simulator's RolloutGradient,
-// PushForward applies d(setup)/d(values) to a unit vector.
+// (damping, hydrodynamics, penalty friction), ControllerBlock (a closed-loop
+// controller's weights). A new kind of input (an actuation model mapping a
+// few parameters to activations) is a new subclass: Apply writes the setup,
+// PullBack applies the transpose of d(setup)/d(values) to the simulator's
+// RolloutGradient, PushForward applies d(setup)/d(values) to a unit vector.
 #pragma once
 
 #include <limits>

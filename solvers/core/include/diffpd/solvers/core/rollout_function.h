@@ -18,7 +18,9 @@
 // functional (AddFunctional returns each functional's index; RowsOf its rows).
 //
 // The setup at p is the base setup (SetInitialState, SetInputs; materials and
-// state forces from the scene) with every block applied in order. Its
+// state forces from the scene) with every block applied in order. A setup
+// with a controller (ControllerBlock, controller_block.h) is simulated in
+// closed loop and differentiated through the controller. Its
 // materials are set on the simulator when they change; changed state-force
 // parameters rebuild the simulator.
 //

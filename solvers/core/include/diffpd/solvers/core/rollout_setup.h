@@ -4,8 +4,10 @@
 // (rollout_function.h) simulates it.
 #pragma once
 
+#include <memory>
 #include <vector>
 
+#include "diffpd/controller.h"
 #include "diffpd/material.h"
 #include "diffpd/rollout.h"
 #include "diffpd/scene.h"
@@ -45,6 +47,10 @@ struct RolloutSetup {
   // One per Scene::material_regions entry, in order.
   std::vector<MaterialParameters> region_materials;
   StateForceParameters state_forces;
+  // Closed loop (controller_block.h): the controller that chooses every
+  // step's action from the state; its actions replace `inputs`. nullptr:
+  // open loop.
+  std::shared_ptr<const Controller> controller;
 };
 
 }  // namespace diffpd::solvers
