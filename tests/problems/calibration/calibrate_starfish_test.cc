@@ -208,6 +208,35 @@ TEST(StarfishActivationsTest, SlackLagAndLengthShapeTheActivation) {
                        InvalidInputError, "tendon: activation -1 < 0 at step 1 (slack 0 m, length 0.005 m)");
 }
 
+// The errors of the recording against itself are zero; a common x shift of
+// every marker leaves the arm-relative error; the zero-motion baseline is the
+// RMS displacement and the mean-displacement one is never worse (the mean is
+// the best constant per marker).
+TEST(StarfishMetricsTest, ErrorsAndBaselinesOfTheRealRecording) {
+  const StarfishRecording r = ReadStarfishRecording(kCyclic2);
+  const StarfishWindow w = MakeStarfishWindow(r, 0, 5);
+  const StarfishDisplacements cap = CapturedDisplacements(r, w);
+  ASSERT_EQ(static_cast<int>(cap.size()), w.num_frames());
+  EXPECT_EQ(CompareDisplacements(cap, cap).rmse, 0.0);
+  StarfishDisplacements shifted = cap;
+  double sum = 0;
+  for (size_t j = 1; j < cap.size(); ++j)
+    for (int m = 0; m < 4; ++m) {
+      shifted[j][m](0) += 0.003 * j / cap.size();
+      sum += cap[j][m].squaredNorm();
+    }
+  const StarfishErrors e = CompareDisplacements(shifted, cap);
+  EXPECT_GT(e.rmse, 1e-4);
+  EXPECT_NEAR(e.arm_relative_rmse, 0, 1e-15);
+  const StarfishBaselines b = BaselineErrors(cap);
+  EXPECT_NEAR(b.zero_motion.rmse, std::sqrt(sum / (4.0 * (cap.size() - 1))), 1e-15);
+  EXPECT_LT(b.mean_displacement.rmse, b.zero_motion.rmse);
+  EXPECT_EQ(b.zero_motion.frames, w.num_frames() - 1);
+  EXPECT_THROW_MESSAGE(
+      CompareDisplacements(StarfishDisplacements(3), cap), InvalidInputError,
+      "CompareDisplacements: 3 predicted frames against " + std::to_string(cap.size()) + " captured ones");
+}
+
 // The window of the gradient and fit tests: 0.15 s from 1.15 s of cyclic1
 // (the tendon first moves at 1.18 s), one step per frame.
 class StarfishFitTest : public ::testing::Test {
@@ -319,29 +348,35 @@ TEST_F(StarfishFitTest, BodyArmsRegionsGiveTheArmsTheirOwnYoungsModulus) {
   EXPECT_EQ(fit.statistics.failures, 0) << fit.statistics.last_error;
 }
 
-TEST_F(StarfishFitTest, CoordinatesMapIntoTheBoundsAndBack) {
-  double u[2];
-  StarfishCalibration::ToCoordinates(MaterialParameters{5e5, 0.4, 400}, u);
-  const MaterialParameters m = StarfishCalibration::FromCoordinates(u, 400);
-  EXPECT_NEAR(m.youngs_modulus, 5e5, 1e-6);
-  EXPECT_NEAR(m.poissons_ratio, 0.4, 1e-12);
-  const double far[2] = {-60, 60};
-  const MaterialParameters edge = StarfishCalibration::FromCoordinates(far, 400);
-  EXPECT_NEAR(edge.youngs_modulus, 1e4, 1e-6);
-  EXPECT_NEAR(edge.poissons_ratio, 0.45, 1e-12);
-  EXPECT_THROW(StarfishCalibration::ToCoordinates(MaterialParameters{6e6, 0.4, 400}, u), InvalidInputError);
-  double v[3];
-  StarfishCalibration::ActuationToCoordinates(StarfishActuation{0.003, 0.05, 0.065}, v);
-  const StarfishActuation a = StarfishCalibration::ActuationFromCoordinates(v);
-  EXPECT_NEAR(a.slack, 0.003, 1e-15);
-  EXPECT_NEAR(a.lag, 0.05, 1e-15);
-  EXPECT_NEAR(a.length, 0.065, 1e-15);
-  const double ends[3] = {-60, 60, -60};
-  const StarfishActuation edge_a = StarfishCalibration::ActuationFromCoordinates(ends);
-  EXPECT_NEAR(edge_a.slack, 0, 1e-15);
-  EXPECT_NEAR(edge_a.lag, 0.5, 1e-12);
-  EXPECT_NEAR(edge_a.length, 0.03, 1e-12);
-  EXPECT_THROW_MESSAGE(StarfishCalibration::ActuationToCoordinates(StarfishActuation{0.02, 0.05, 0.065}, v),
+// The fit's bounds are the manifold's: a huge step stays inside them, E,
+// nu, lag and length move relatively, and a start outside is refused.
+TEST_F(StarfishFitTest, FitCoordinatesKeepTheBoundsAndRefuseStartsOutside) {
+  const std::vector<double> x =
+      StarfishFitStart(MaterialParameters{5e5, 0.4, 400}, StarfishActuation{0.003, 0.05, 0.065}, false);
+  ASSERT_EQ(x, (std::vector<double>{5e5, 0.4, 0.003, 0.05, 0.065}));
+  const solvers::CoordinateManifold manifold(StarfishFitCoordinates(false));
+  ASSERT_EQ(manifold.AmbientSize(), 5);
+  const double low[5] = {-60, 60, -60, 60, -60}, high[5] = {60, -60, 60, -60, 60};
+  double y[5];
+  ASSERT_TRUE(manifold.Plus(x.data(), low, y));
+  EXPECT_NEAR(y[0], 1e4, 1e-6);
+  EXPECT_NEAR(y[1], 0.45, 1e-12);
+  EXPECT_NEAR(y[2], 0, 1e-15);
+  EXPECT_NEAR(y[3], 0.5, 1e-12);
+  EXPECT_NEAR(y[4], 0.03, 1e-12);
+  ASSERT_TRUE(manifold.Plus(x.data(), high, y));
+  EXPECT_NEAR(y[0], 5e6, 1e-3);
+  EXPECT_NEAR(y[1], 0.2, 1e-12);
+  EXPECT_NEAR(y[2], 0.015, 1e-15);
+  EXPECT_NEAR(y[3], 1e-3, 1e-12);
+  EXPECT_NEAR(y[4], 0.13, 1e-12);
+  EXPECT_EQ(StarfishFitCoordinates(true).size(), 6u);
+  EXPECT_EQ(StarfishFitStart(MaterialParameters{5e5, 0.4, 400}, StarfishActuation{0.003, 0.05, 0.065}, true).back(),
+            5e5);
+  EXPECT_THROW_MESSAGE(
+      StarfishFitStart(MaterialParameters{6e6, 0.4, 400}, StarfishActuation{0.003, 0.05, 0.065}, false),
+      InvalidInputError, "youngs_modulus = 6e+06 is outside the fit's interval (1e4, 5e6) Pa");
+  EXPECT_THROW_MESSAGE(StarfishFitStart(MaterialParameters{5e5, 0.4, 400}, StarfishActuation{0.02, 0.05, 0.065}, false),
                        InvalidInputError, "tendon slack = 0.02 is outside the fit's interval (0, 0.015) m");
 }
 

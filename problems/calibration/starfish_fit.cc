@@ -1,0 +1,151 @@
+#include "calibration/starfish_fit.h"
+
+#include <cmath>
+#include <sstream>
+
+#include <ceres/gradient_problem.h>
+#include <ceres/gradient_problem_solver.h>
+
+#include "diffpd/error.h"
+
+namespace diffpd::problems {
+namespace {
+
+constexpr double kMm = 1e-3;
+constexpr double kMinE = 1e4, kMaxE = 5e6, kMinNu = 0.2, kMaxNu = 0.45;
+constexpr double kMaxSlack = 0.015;                     // m
+constexpr double kMinLag = 1e-3, kMaxLag = 0.5;         // s
+constexpr double kMinLength = 0.03, kMaxLength = 0.13;  // m
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// The model's parameters of the fitted values x (file comment): x0, x1
+// (and x5, x1 for the arms' region), then x2..x4.
+VectorXd ModelParameters(const double* x, bool arms) {
+  VectorXd p(arms ? 7 : 5);
+  if (arms)
+    p << x[0], x[1], x[5], x[1], x[2], x[3], x[4];
+  else
+    p << x[0], x[1], x[2], x[3], x[4];
+  return p;
+}
+
+// The model's loss as a function of the fitted values (the tie of the arms'
+// nu to the body's is the only change of variables; the bounds are the
+// manifold's).
+class StarfishLoss : public ceres::FirstOrderFunction {
+ public:
+  StarfishLoss(solvers::RolloutFunction* model, bool arms) : model_(model), arms_(arms) {}
+  bool Evaluate(const double* x, double* cost, double* gradient) const override {
+    const VectorXd p = ModelParameters(x, arms_);
+    if (gradient) {
+      VectorXd g;
+      if (!model_->Gradient(p, VectorXd::Ones(1), &g, cost)) return false;
+      const int a = arms_ ? 4 : 2;  // the actuation block's first entry
+      gradient[0] = g(0);
+      gradient[1] = arms_ ? g(1) + g(3) : g(1);
+      for (int j = 0; j < 3; ++j) gradient[2 + j] = g(a + j);
+      if (arms_) gradient[5] = g(2);
+    } else {
+      VectorXd value;
+      if (!model_->Evaluate(p, {0}, &value, nullptr)) return false;
+      *cost = value(0);
+    }
+    return std::isfinite(*cost);
+  }
+  int NumParameters() const override { return arms_ ? 6 : 5; }
+
+ private:
+  solvers::RolloutFunction* model_;
+  bool arms_;
+};
+
+class FitTable : public ceres::IterationCallback {
+ public:
+  FitTable(FILE* log, const double* x, bool arms) : log_(log), x_(x), arms_(arms) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    if (s.iteration == 0) {
+      std::fprintf(log_, "%4s %13s %11s %11s %9s %14s %14s %9s %9s %9s", "iter", "loss", "loss_change", "|gradient|",
+                   "total_t", "youngs_modulus", "poissons_ratio", "slack_mm", "lag_s", "length_mm");
+      std::fprintf(log_, arms_ ? " %14s\n" : "\n", "arms_youngs_modulus");
+    }
+    std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %9.2f %14.6g %14.6g %9.4f %9.4f %9.3f", s.iteration, s.cost,
+                 s.cost_change, s.gradient_max_norm, s.cumulative_time_in_seconds, x_[0], x_[1], x_[2] / kMm, x_[3],
+                 x_[4] / kMm);
+    if (arms_) std::fprintf(log_, " %14.6g", x_[5]);
+    std::fprintf(log_, "\n");
+    std::fflush(log_);
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  FILE* log_;
+  const double* x_;
+  bool arms_;
+};
+
+}  // namespace
+
+std::vector<solvers::CoordinateMap> StarfishFitCoordinates(bool arms) {
+  using solvers::CoordinateMap;
+  std::vector<CoordinateMap> maps = {CoordinateMap::LogLogit(kMinE, kMaxE), CoordinateMap::LogLogit(kMinNu, kMaxNu),
+                                     CoordinateMap::Logit(0, kMaxSlack), CoordinateMap::LogLogit(kMinLag, kMaxLag),
+                                     CoordinateMap::LogLogit(kMinLength, kMaxLength)};
+  if (arms) maps.push_back(CoordinateMap::LogLogit(kMinE, kMaxE));
+  return maps;
+}
+
+std::vector<double> StarfishFitStart(const MaterialParameters& m, const StarfishActuation& a, bool arms) {
+  if (!(m.youngs_modulus > kMinE && m.youngs_modulus < kMaxE))
+    throw InvalidInputError("youngs_modulus = " + Num(m.youngs_modulus) +
+                            " is outside the fit's interval (1e4, 5e6) Pa");
+  if (!(m.poissons_ratio > kMinNu && m.poissons_ratio < kMaxNu))
+    throw InvalidInputError("poissons_ratio = " + Num(m.poissons_ratio) + " is outside the fit's interval (0.2, 0.45)");
+  if (!(a.slack > 0 && a.slack < kMaxSlack))
+    throw InvalidInputError("tendon slack = " + Num(a.slack) + " is outside the fit's interval (0, 0.015) m");
+  if (!(a.lag > kMinLag && a.lag < kMaxLag))
+    throw InvalidInputError("tendon lag = " + Num(a.lag) + " is outside the fit's interval (0.001, 0.5) s");
+  if (!(a.length > kMinLength && a.length < kMaxLength))
+    throw InvalidInputError("tendon length = " + Num(a.length) + " is outside the fit's interval (0.03, 0.13) m");
+  std::vector<double> x = {m.youngs_modulus, m.poissons_ratio, a.slack, a.lag, a.length};
+  if (arms) x.push_back(m.youngs_modulus);
+  return x;
+}
+
+StarfishFit FitStarfishLoss(solvers::RolloutFunction* model, bool arms, const MaterialParameters& guess,
+                            const StarfishActuation& actuation_guess, int max_iterations, FILE* log) {
+  std::vector<double> x = StarfishFitStart(guess, actuation_guess, arms);
+  ceres::GradientProblem problem(new StarfishLoss(model, arms), new solvers::CoordinateManifold(StarfishFitCoordinates(arms)));
+  ceres::GradientProblemSolver::Options options;
+  options.line_search_direction_type = ceres::LBFGS;
+  // Scale L-BFGS' initial inverse Hessian by the observed curvature: the
+  // first step is the gradient's length, the later ones Newton-like.
+  options.use_approximate_eigenvalue_bfgs_scaling = true;
+  options.max_num_iterations = max_iterations;
+  options.function_tolerance = 1e-5;
+  options.gradient_tolerance = 1e-8;
+  options.parameter_tolerance = 1e-5;
+  options.logging_type = ceres::SILENT;
+  options.update_state_every_iteration = true;
+  FitTable table(log, x.data(), arms);
+  if (log) options.callbacks.push_back(&table);
+  ceres::GradientProblemSolver::Summary summary;
+  ceres::Solve(options, problem, x.data(), &summary);
+  StarfishFit fit;
+  fit.material = MaterialParameters{x[0], x[1], guess.density};
+  fit.actuation = StarfishActuation{x[2], x[3], x[4]};
+  if (arms) fit.region_materials = {MaterialParameters{x[5], x[1], guess.density}};
+  fit.initial_cost = summary.initial_cost;
+  fit.final_cost = summary.final_cost;
+  fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  fit.usable = summary.IsSolutionUsable();
+  fit.termination = summary.message;
+  fit.statistics = model->statistics();
+  return fit;
+}
+
+}  // namespace diffpd::problems
