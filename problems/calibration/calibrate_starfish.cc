@@ -146,15 +146,24 @@ std::unique_ptr<solvers::RolloutFunction> StarfishCalibration::MakeModel(const S
   model->AddBlock(std::make_unique<solvers::MaterialBlock>(fitted, scene));
   model->AddBlock(std::make_unique<TendonActuationBlock>(WindowContractions(rec, w), solver.time_step,
                                                          static_cast<int>(scene.muscles.size()), actuation));
-  model->AddFunctional(std::make_unique<solvers::LeastSquaresLoss>(std::make_unique<solvers::MarkerResiduals>(
-      WindowMotion(scene.mesh, initial, rec, w), scene.mesh, solver.time_step, steps)));
+  auto residuals = std::make_unique<solvers::MarkerResiduals>(WindowMotion(scene.mesh, initial, rec, w), scene.mesh,
+                                                              solver.time_step, steps);
+  if (fit_method_ == StarfishFitMethod::kLbfgs)
+    model->AddFunctional(std::make_unique<solvers::LeastSquaresLoss>(std::move(residuals)));
+  else
+    model->AddFunctional(std::move(residuals));
   return model;
 }
 
 StarfishFit StarfishCalibration::Fit(const StarfishRecording& rec, const StarfishWindow& w,
                                      const SolverOptions& options, const MaterialParameters& guess,
                                      const StarfishActuation& actuation_guess, int max_iterations, FILE* log) const {
+  const bool arms = regions_ == StarfishRegions::kBodyArms;
+  if (arms && fit_method_ == StarfishFitMethod::kLevenbergMarquardt)
+    throw InvalidInputError("the lm fit has no tied arms' nu: fit body-arms regions with --fit lbfgs");
   std::unique_ptr<solvers::RolloutFunction> model = MakeModel(rec, w, options, guess, actuation_guess);
+  if (fit_method_ == StarfishFitMethod::kLevenbergMarquardt)
+    return FitStarfishLeastSquares(model.get(), 0, guess, actuation_guess, max_iterations, log);
   return FitStarfishLoss(model.get(), regions_ == StarfishRegions::kBodyArms, guess, actuation_guess, max_iterations,
                          log);
 }
@@ -182,12 +191,14 @@ StarfishCalibration::Prediction StarfishCalibration::Predict(const StarfishRecor
 
 int StarfishCalibration::Run(const CommandArgs& args) const {
   RefuseSimulatorTuning(args, name());
-  if (!args.regions.empty()) {  // a copy with the regions, run without the option
-    StarfishCalibration with_regions = *this;
-    with_regions.set_regions(ParseStarfishRegions(args.regions));
+  if (!args.regions.empty() || !args.fit.empty()) {  // a copy with the settings, run without the options
+    StarfishCalibration with = *this;
+    if (!args.regions.empty()) with.set_regions(ParseStarfishRegions(args.regions));
+    if (!args.fit.empty()) with.set_fit_method(ParseStarfishFitMethod(args.fit));
     CommandArgs rest = args;
     rest.regions.clear();
-    return with_regions.Run(rest);
+    rest.fit.clear();
+    return with.Run(rest);
   }
   if (args.steps > 0 || args.dt > 0)
     throw InvalidInputError("--steps and --dt are fixed by the recordings of " + name() + " (60 Hz camera frames, " +
@@ -218,7 +229,12 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
   const StarfishRecording calibration = ReadStarfishRecording(calibrate_path);
   std::vector<StarfishRecording> predictions;
   for (const std::string& p : predict_paths) predictions.push_back(ReadStarfishRecording(p));
-  const StarfishWindow fit_window = MakeStarfishWindow(calibration, kFitStart, kFitSeconds);
+  if (args.fit_start != -1 && !(args.fit_start >= 0))
+    throw InvalidInputError("--fit-start = " + Num(args.fit_start) + " is invalid: must be >= 0 (s)");
+  if (args.fit_seconds != -1 && !(args.fit_seconds > 0))
+    throw InvalidInputError("--fit-seconds = " + Num(args.fit_seconds) + " is invalid: must be > 0 (s)");
+  const StarfishWindow fit_window = MakeStarfishWindow(calibration, args.fit_start >= 0 ? args.fit_start : kFitStart,
+                                                       args.fit_seconds > 0 ? args.fit_seconds : kFitSeconds);
   std::vector<StarfishWindow> windows;
   for (const StarfishRecording& r : predictions) windows.push_back(MakeStarfishWindow(r, 0, seconds));
 
@@ -241,12 +257,14 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
   // The fit.
   const MaterialParameters guess = scene.material;
   const StarfishActuation actuation_guess = ActuationGuess();
-  std::fprintf(
-      log,
-      "# fit: Ceres L-BFGS on (log E, log nu, slack, log lag, log length%s) mapped into E in [1e4, 5e6] "
-      "Pa, nu in [0.2, 0.45], tendon slack in [0, 15] mm, servo lag in [1, 500] ms, tendon length in [30, 130] mm; "
-      "loss = 1/2 weighted mean squared marker error / (2 mm)^2\n",
-      regions_ == StarfishRegions::kBodyArms ? ", log E_arms" : "");
+  std::fprintf(log,
+               "# fit: %s on E in (1e4, 5e6) Pa, nu in (0.2, 0.45), tendon slack in (0, 15) mm, servo lag in (1, 500) "
+               "ms, tendon length in (30, 130) mm%s (CoordinateManifold, log-logit but slack logit); "
+               "cost = 1/2 weighted mean squared marker error / (2 mm)^2\n",
+               fit_method_ == StarfishFitMethod::kLbfgs
+                   ? "Ceres L-BFGS on the scalar loss"
+                   : "Ceres Levenberg-Marquardt on per-frame marker residuals with forward-mode Jacobians",
+               regions_ == StarfishRegions::kBodyArms ? ", E_arms like E" : "");
   if (regions_ == StarfishRegions::kBodyArms)
     std::fprintf(log,
                  "# regions: body-arms: E of the %zu arm elements (centroid beyond |y|, |z| < 18 mm) fitted apart "
@@ -263,8 +281,27 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                "length = %.2f mm; loss %.6e -> %.6e\n",
                fit.termination.c_str(), fit.iterations, fitted.youngs_modulus, fitted.poissons_ratio,
                actuation.slack / kMm, actuation.lag, actuation.length / kMm, fit.initial_cost, fit.final_cost);
-  std::fprintf(log, "# fit: %ld rollouts (%.2f s forward), %ld gradients (%.2f s backward), %ld failed\n",
-               stats.rollouts, stats.forward_seconds, stats.gradients, stats.backward_seconds, stats.failures);
+  std::fprintf(log,
+               "# fit: %ld rollouts (%.2f s forward), %ld gradients, %ld tangent passes (%.2f s derivatives), %ld "
+               "failed\n",
+               stats.rollouts, stats.forward_seconds, stats.gradients, stats.tangent_passes, stats.backward_seconds,
+               stats.failures);
+  const char* const kFitNames[5] = {"youngs_modulus", "poissons_ratio", "tendon_slack", "tendon_lag", "tendon_length"};
+  const double fit_values[5] = {fitted.youngs_modulus, fitted.poissons_ratio, actuation.slack, actuation.lag,
+                                actuation.length};
+  if (!fit.standard_deviation.empty()) {
+    std::fprintf(log, "# uncertainty (ceres::Covariance, %d residuals, noise fitted): value, standard deviation\n",
+                 fit.residuals);
+    for (int i = 0; i < 5; ++i)
+      std::fprintf(log, "#   %-15s %12.6g +- %-12.4g%s\n", kFitNames[i], fit_values[i], fit.standard_deviation[i],
+                   fit.at_bound[i] ? " (at a bound: the interval is not meaningful)" : "");
+    std::fprintf(log, "# correlation:\n");
+    for (int i = 0; i < 5; ++i) {
+      std::fprintf(log, "#   %-15s", kFitNames[i]);
+      for (int j = 0; j < 5; ++j) std::fprintf(log, " %6.3f", fit.correlation[5 * i + j]);
+      std::fprintf(log, "\n");
+    }
+  }
   if (!fit.region_materials.empty())
     std::fprintf(log, "# fit: arms E = %.6g Pa (body E = %.6g Pa, ratio %.3g)\n",
                  fit.region_materials[0].youngs_modulus, fitted.youngs_modulus,
@@ -350,6 +387,17 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                           {"files", files},
                           {"total_seconds", total}};
     out["regions"] = ToString(regions_);
+    out["fit"] = ToString(fit_method_);
+    if (!fit.standard_deviation.empty()) {
+      nlohmann::json sd, bound;
+      for (int i = 0; i < 5; ++i) {
+        sd[kFitNames[i]] = fit.standard_deviation[i];
+        bound[kFitNames[i]] = static_cast<bool>(fit.at_bound[i]);
+      }
+      out["standard_deviation"] = sd;
+      out["at_bound"] = bound;
+      out["correlation"] = fit.correlation;
+    }
     if (!fit.region_materials.empty()) out["arms_youngs_modulus"] = fit.region_materials[0].youngs_modulus;
     std::printf("%s\n", out.dump(2).c_str());
   }

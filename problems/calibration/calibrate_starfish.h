@@ -55,6 +55,10 @@ class StarfishCalibration : public Problem {
   StarfishRegions regions() const { return regions_; }
   void set_regions(StarfishRegions regions) { regions_ = regions; }
 
+  // How Fit minimises (default kLevenbergMarquardt).
+  StarfishFitMethod fit_method() const { return fit_method_; }
+  void set_fit_method(StarfishFitMethod method) { fit_method_ = method; }
+
   // Vertices of M1..M4 (StarfishMarkerVertices).
   static std::array<int, 4> MarkerVertices(const Mesh& mesh) { return StarfishMarkerVertices(mesh); }
 
@@ -90,9 +94,11 @@ class StarfishCalibration : public Problem {
   // The rollout function of a window at `material` and `actuation`: blocks
   // {E, nu} (Pa, 1; with kBodyArms {E, nu, E_arms, nu_arms}, the arms region
   // starting at `material` too) and {slack, lag, length} (m, s, m; the tendon
-  // actuation model, which writes every step's activations), and one row, the
-  // scalar loss 1/2 |r|^2 of the marker residuals (LeastSquaresLoss; its
-  // gradient is one adjoint). The initial state is WindowInitialState at
+  // actuation model, which writes every step's activations), and functional
+  // 0: with fit_method() kLbfgs one row, the scalar loss 1/2 |r|^2 of the
+  // marker residuals (LeastSquaresLoss; its gradient is one adjoint), with
+  // kLevenbergMarquardt the marker residuals r themselves (MarkerResiduals,
+  // 3 rows per marker and frame, y unweighted). The initial state is WindowInitialState at
   // `actuation` and is held fixed, so the gradient is exact when the window
   // starts with the tendon slack (a = 1, as in the default fit window from rest).
   std::unique_ptr<solvers::RolloutFunction> MakeModel(const StarfishRecording& recording, const StarfishWindow& window,
@@ -100,10 +106,13 @@ class StarfishCalibration : public Problem {
                                                       const StarfishActuation& actuation) const;
 
   // Fits E, nu, slack, lag and length (with kBodyArms also the arms' E) on
-  // a window: FitStarfishLoss on MakeModel's loss, starting from `guess`
-  // (both regions) and `actuation_guess`, at most `max_iterations`
-  // iterations; the iteration table goes to `log` (nullptr: silent). Throws
-  // what MakeModel and StarfishFitStart throw.
+  // a window: FitStarfishLeastSquares or FitStarfishLoss (fit_method()) on
+  // MakeModel's functional, starting from `guess` (both regions) and
+  // `actuation_guess`, at most `max_iterations` iterations; the iteration
+  // table goes to `log` (nullptr: silent). Throws what MakeModel and
+  // StarfishFitStart throw, and InvalidInputError for kBodyArms with
+  // kLevenbergMarquardt ("the lm fit has no tied arms' nu: fit body-arms
+  // regions with --fit lbfgs").
   StarfishFit Fit(const StarfishRecording& recording, const StarfishWindow& window, const SolverOptions& options,
                   const MaterialParameters& guess, const StarfishActuation& actuation_guess, int max_iterations,
                   FILE* log) const;
@@ -146,6 +155,7 @@ class StarfishCalibration : public Problem {
  private:
   int substeps_ = 2;
   StarfishRegions regions_ = StarfishRegions::kNone;
+  StarfishFitMethod fit_method_ = StarfishFitMethod::kLevenbergMarquardt;
 };
 
 }  // namespace diffpd::problems

@@ -16,7 +16,9 @@ std::string Num(double v) {
   return s.str();
 }
 
-StarfishActuation At(const Eigen::Ref<const VectorXd>& values) { return StarfishActuation{values(0), values(1), values(2)}; }
+StarfishActuation At(const Eigen::Ref<const VectorXd>& values) {
+  return StarfishActuation{values(0), values(1), values(2)};
+}
 
 }  // namespace
 

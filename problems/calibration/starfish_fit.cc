@@ -3,10 +3,15 @@
 #include <cmath>
 #include <sstream>
 
+#include <ceres/covariance.h>
 #include <ceres/gradient_problem.h>
 #include <ceres/gradient_problem_solver.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
 
 #include "diffpd/error.h"
+#include "diffpd/solvers/ceres/rollout_cost_function.h"
+#include "diffpd/solvers/ceres/rollout_evaluation_callback.h"
 
 namespace diffpd::problems {
 namespace {
@@ -88,7 +93,57 @@ class FitTable : public ceres::IterationCallback {
   bool arms_;
 };
 
+// The iteration table of the least-squares fit (values in the two blocks).
+class LeastSquaresTable : public ceres::IterationCallback {
+ public:
+  LeastSquaresTable(FILE* log, const double* material, const double* actuation)
+      : log_(log), material_(material), actuation_(actuation) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    if (s.iteration == 0)
+      std::fprintf(log_, "%4s %13s %11s %11s %9s %14s %14s %9s %9s %9s\n", "iter", "cost", "cost_change", "|gradient|",
+                   "total_t", "youngs_modulus", "poissons_ratio", "slack_mm", "lag_s", "length_mm");
+    std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %9.2f %14.6g %14.6g %9.4f %9.4f %9.3f\n", s.iteration, s.cost,
+                 s.cost_change, s.gradient_max_norm, s.cumulative_time_in_seconds, material_[0], material_[1],
+                 actuation_[0] / kMm, actuation_[1], actuation_[2] / kMm);
+    std::fflush(log_);
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  FILE* log_;
+  const double* material_;
+  const double* actuation_;
+};
+
+// The tangent coordinate of x under `map` (0 for linear and log maps).
+double BoundCoordinate(const solvers::CoordinateMap& map, double x) {
+  if (map.kind == solvers::CoordinateMap::Kind::kLogit) {
+    return std::log((x - map.lower) / (map.upper - x));
+  }
+  if (map.kind == solvers::CoordinateMap::Kind::kLogLogit) {
+    const double s = std::log(x / map.lower) / std::log(map.upper / map.lower);
+    return std::log(s / (1 - s));
+  }
+  return 0;
+}
+
 }  // namespace
+
+const char* ToString(StarfishFitMethod method) {
+  switch (method) {
+    case StarfishFitMethod::kLbfgs:
+      return "lbfgs";
+    case StarfishFitMethod::kLevenbergMarquardt:
+      return "lm";
+  }
+  return "unknown";
+}
+
+StarfishFitMethod ParseStarfishFitMethod(const std::string& name) {
+  if (name == "lbfgs") return StarfishFitMethod::kLbfgs;
+  if (name == "lm") return StarfishFitMethod::kLevenbergMarquardt;
+  throw InvalidInputError("--fit = '" + name + "' is invalid: calibrate-starfish fits with 'lm' or 'lbfgs'");
+}
 
 std::vector<solvers::CoordinateMap> StarfishFitCoordinates(bool arms) {
   using solvers::CoordinateMap;
@@ -119,7 +174,8 @@ std::vector<double> StarfishFitStart(const MaterialParameters& m, const Starfish
 StarfishFit FitStarfishLoss(solvers::RolloutFunction* model, bool arms, const MaterialParameters& guess,
                             const StarfishActuation& actuation_guess, int max_iterations, FILE* log) {
   std::vector<double> x = StarfishFitStart(guess, actuation_guess, arms);
-  ceres::GradientProblem problem(new StarfishLoss(model, arms), new solvers::CoordinateManifold(StarfishFitCoordinates(arms)));
+  ceres::GradientProblem problem(new StarfishLoss(model, arms),
+                                 new solvers::CoordinateManifold(StarfishFitCoordinates(arms)));
   ceres::GradientProblemSolver::Options options;
   options.line_search_direction_type = ceres::LBFGS;
   // Scale L-BFGS' initial inverse Hessian by the observed curvature: the
@@ -144,6 +200,90 @@ StarfishFit FitStarfishLoss(solvers::RolloutFunction* model, bool arms, const Ma
   fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
   fit.usable = summary.IsSolutionUsable();
   fit.termination = summary.message;
+  fit.statistics = model->statistics();
+  return fit;
+}
+
+StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residual_functional,
+                                    const MaterialParameters& guess, const StarfishActuation& actuation_guess,
+                                    int max_iterations, FILE* log) {
+  const std::vector<double> start = StarfishFitStart(guess, actuation_guess, false);
+  const std::vector<solvers::CoordinateMap> maps = StarfishFitCoordinates(false);
+  double material[2] = {start[0], start[1]};
+  double actuation[3] = {start[2], start[3], start[4]};
+  solvers::RolloutEvaluationCallback callback(model, {material, actuation});
+  ceres::Problem::Options problem_options;
+  problem_options.evaluation_callback = &callback;
+  ceres::Problem problem(problem_options);
+  solvers::AddMarkerResidualBlocks(&problem, model, residual_functional, {material, actuation});
+  problem.SetManifold(material, new solvers::CoordinateManifold({maps[0], maps[1]}));
+  problem.SetManifold(actuation, new solvers::CoordinateManifold({maps[2], maps[3], maps[4]}));
+
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  // The marker error is far from quadratic over Ceres' default first trust
+  // region (1e4): start with steps of order 1 in the tangent coordinates.
+  options.initial_trust_region_radius = 1;
+  options.max_num_iterations = max_iterations;
+  options.function_tolerance = 1e-6;
+  options.parameter_tolerance = 1e-6;
+  options.gradient_tolerance = 1e-12;
+  options.update_state_every_iteration = true;
+  options.logging_type = ceres::SILENT;
+  LeastSquaresTable table(log, material, actuation);
+  if (log) options.callbacks.push_back(&table);
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+
+  StarfishFit fit;
+  fit.material = MaterialParameters{material[0], material[1], guess.density};
+  fit.actuation = StarfishActuation{actuation[0], actuation[1], actuation[2]};
+  fit.initial_cost = summary.initial_cost;
+  fit.final_cost = summary.final_cost;
+  fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  fit.usable = summary.IsSolutionUsable() && summary.termination_type != ceres::FAILURE;
+  fit.termination = summary.message;
+
+  // Rows with a weight (the markers' unobserved y has none).
+  VectorXd r;
+  VectorXd point(5);
+  point << material[0], material[1], actuation[0], actuation[1], actuation[2];
+  const std::vector<int> rows = model->RowsOf(residual_functional);
+  if (fit.usable && model->Evaluate(point, rows, &r, nullptr)) {
+    MatrixXd j;
+    model->Evaluate(point, rows, nullptr, &j);
+    int used = 0;
+    for (int i = 0; i < j.rows(); ++i) used += j.row(i).squaredNorm() > 0 || r(i) != 0;
+    fit.residuals = used;
+    const double noise = r.squaredNorm() / std::max(1, used - 5);
+    ceres::Covariance::Options covariance_options;
+    covariance_options.algorithm_type = ceres::DENSE_SVD;
+    covariance_options.null_space_rank = -1;
+    ceres::Covariance covariance(covariance_options);
+    const std::vector<std::pair<const double*, const double*>> pairs = {
+        {material, material}, {material, actuation}, {actuation, actuation}};
+    if (covariance.Compute(pairs, &problem)) {
+      double c_mm[4], c_ma[6], c_aa[9];
+      covariance.GetCovarianceBlock(material, material, c_mm);
+      covariance.GetCovarianceBlock(material, actuation, c_ma);
+      covariance.GetCovarianceBlock(actuation, actuation, c_aa);
+      Eigen::Matrix<double, 5, 5> c;
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) c(a, b) = c_mm[2 * a + b];
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 3; ++b) c(a, 2 + b) = c(2 + b, a) = c_ma[3 * a + b];
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) c(2 + a, 2 + b) = c_aa[3 * a + b];
+      c *= noise;
+      for (int a = 0; a < 5; ++a) fit.standard_deviation.push_back(std::sqrt(std::max(0.0, c(a, a))));
+      for (int a = 0; a < 5; ++a)
+        for (int b = 0; b < 5; ++b) {
+          const double d = fit.standard_deviation[a] * fit.standard_deviation[b];
+          fit.correlation.push_back(d > 0 ? c(a, b) / d : 0.0);
+        }
+    }
+    for (int a = 0; a < 5; ++a) fit.at_bound.push_back(std::abs(BoundCoordinate(maps[a], point(a))) > 5);
+  }
   fit.statistics = model->statistics();
   return fit;
 }

@@ -24,6 +24,17 @@
 
 namespace diffpd::problems {
 
+// How a fit minimises the marker error.
+enum class StarfishFitMethod {
+  kLbfgs,               // FitStarfishLoss: L-BFGS on the scalar loss (one adjoint per gradient)
+  kLevenbergMarquardt,  // FitStarfishLeastSquares: per-frame residuals, forward-mode Jacobians
+};
+// "lbfgs", "lm".
+const char* ToString(StarfishFitMethod method);
+// Throws InvalidInputError for other names:
+//   "--fit = 'newton' is invalid: calibrate-starfish fits with 'lm' or 'lbfgs'".
+StarfishFitMethod ParseStarfishFitMethod(const std::string& name);
+
 // The outcome of a fit.
 struct StarfishFit {
   MaterialParameters material;  // fitted (the body's with kBodyArms)
@@ -37,6 +48,16 @@ struct StarfishFit {
   bool usable = false;                    // Ceres' solution is usable
   std::string termination;                // Ceres' message
   solvers::RolloutStatistics statistics;  // rollouts, gradients, timings
+  // FitStarfishLeastSquares only (empty otherwise): per fitted value x0..x4
+  // its standard deviation from ceres::Covariance (physical units; the
+  // residuals scaled by their fitted noise, s^2 = |r|^2 / (rows - 5)), the
+  // 5 x 5 correlation matrix (row-major), and whether the value lies at a
+  // bound of its interval (tangent coordinate |u| > 5: within 1% of an end),
+  // where the interval is not meaningful.
+  std::vector<double> standard_deviation;
+  std::vector<double> correlation;
+  std::vector<bool> at_bound;
+  int residuals = 0;  // rows of the least-squares problem with non-zero weight
 };
 
 // The coordinate maps of the fitted values (5, or 6 with `arms`).
@@ -56,5 +77,16 @@ std::vector<double> StarfishFitStart(const MaterialParameters& material, const S
 // counted in statistics). `density` of the result is guess.density.
 StarfishFit FitStarfishLoss(solvers::RolloutFunction* model, bool arms, const MaterialParameters& guess,
                             const StarfishActuation& actuation_guess, int max_iterations, FILE* log);
+
+// Fits `model` (blocks: material {E, nu}, then TendonActuationBlock;
+// functional `residual_functional`: a MarkerResiduals) by Levenberg-Marquardt
+// (ceres::Problem, one residual block per capture frame, Jacobians by the
+// rollout function: forward-mode tangents for 5 parameters) on the manifolds
+// of StarfishFitCoordinates(false), from `guess` and `actuation_guess`, at
+// most `max_iterations` iterations, then the parameters' covariance (see
+// StarfishFit). The iteration table goes to `log` (nullptr: silent).
+StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residual_functional,
+                                    const MaterialParameters& guess, const StarfishActuation& actuation_guess,
+                                    int max_iterations, FILE* log);
 
 }  // namespace diffpd::problems

@@ -17,8 +17,8 @@ namespace diffpd::problems {
 // `simulated` and `captured` have one entry per frame; `rollout` the frames'
 // inputs (substeps per frame). Returns the path. Throws InvalidInputError if
 // the file cannot be written ("cannot write '<path>'").
-std::string WriteStarfishTrace(const std::string& dir, const StarfishRecording& recording,
-                               const StarfishWindow& window, const Rollout& rollout, int substeps,
-                               const StarfishDisplacements& simulated, const StarfishDisplacements& captured);
+std::string WriteStarfishTrace(const std::string& dir, const StarfishRecording& recording, const StarfishWindow& window,
+                               const Rollout& rollout, int substeps, const StarfishDisplacements& simulated,
+                               const StarfishDisplacements& captured);
 
 }  // namespace diffpd::problems

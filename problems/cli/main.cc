@@ -66,6 +66,10 @@ int main(int argc, char** argv) {
   run->add_option("--seconds", run_args.seconds, "calibrate-starfish: seconds of each recording to evaluate");
   run->add_option("--regions", run_args.regions,
                   "calibrate-starfish: material regions, 'body-arms' (separate E for the body and the arms)");
+  run->add_option("--fit", run_args.fit,
+                  "calibrate-starfish: 'lm' (Levenberg-Marquardt on marker residuals, default) or 'lbfgs'");
+  run->add_option("--fit-start", run_args.fit_start, "calibrate-starfish: start of the fit window (s, default 1)");
+  run->add_option("--fit-seconds", run_args.fit_seconds, "calibrate-starfish: length of the fit window (s, default 2)");
 
   CLI::App* grad = app.add_subcommand("gradcheck", "compare rollout gradients with central finite differences");
   AddCommonOptions(grad, &grad_args, &grad_method);

@@ -7,6 +7,15 @@
 #include "diffpd/error.h"
 
 namespace diffpd::solvers {
+namespace {
+
+// x moved into the open interval of `m` (the logistic rounds to 0 or 1 for
+// large |u|): the nearest double inside.
+double Inside(const CoordinateMap& m, double x) {
+  return std::clamp(x, std::nextafter(m.lower, m.upper), std::nextafter(m.upper, m.lower));
+}
+
+}  // namespace
 
 CoordinateManifold::CoordinateManifold(std::vector<CoordinateMap> coordinates) : maps_(std::move(coordinates)) {
   if (maps_.empty()) throw InvalidInputError("CoordinateManifold: needs at least one coordinate");
@@ -67,12 +76,11 @@ double CoordinateManifold::FromTangent(int i, double u) const {
     case CoordinateMap::Kind::kLogit: {
       // Stable logistic: never exp of a large positive number.
       const double s = u >= 0 ? 1 / (1 + std::exp(-u)) : std::exp(u) / (1 + std::exp(u));
-      return m.lower + (m.upper - m.lower) * s;
+      return Inside(m, m.lower + (m.upper - m.lower) * s);
     }
     case CoordinateMap::Kind::kLogLogit: {
       const double s = u >= 0 ? 1 / (1 + std::exp(-u)) : std::exp(u) / (1 + std::exp(u));
-      // Clamped: exp(log(hi / lo)) may round above hi / lo.
-      return std::clamp(m.lower * std::exp(std::log(m.upper / m.lower) * s), m.lower, m.upper);
+      return Inside(m, m.lower * std::exp(std::log(m.upper / m.lower) * s));
     }
   }
   return u;

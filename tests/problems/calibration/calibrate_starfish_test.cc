@@ -250,6 +250,7 @@ class StarfishFitTest : public ::testing::Test {
 };
 
 TEST_F(StarfishFitTest, LossGradientMatchesCentralDifferences) {
+  starfish_.set_fit_method(StarfishFitMethod::kLbfgs);
   SolverOptions options = starfish_.Options(Method::kPdLbfgs, 1);
   options.rel_tolerance = 1e-10;
   options.abs_tolerance = 1e-10;
@@ -292,6 +293,7 @@ TEST_F(StarfishFitTest, BodyArmsRegionsGiveTheArmsTheirOwnYoungsModulus) {
   EXPECT_THROW_MESSAGE(ParseStarfishRegions("legs"), InvalidInputError,
                        "--regions = 'legs' is invalid: calibrate-starfish knows 'body-arms'");
   starfish_.set_regions(StarfishRegions::kBodyArms);
+  starfish_.set_fit_method(StarfishFitMethod::kLbfgs);
   const Scene scene = starfish_.MakeScene();
   ASSERT_EQ(scene.material_regions.size(), 1u);
   const size_t arms = scene.material_regions[0].elements.size();
@@ -381,6 +383,7 @@ TEST_F(StarfishFitTest, FitCoordinatesKeepTheBoundsAndRefuseStartsOutside) {
 }
 
 TEST_F(StarfishFitTest, ShortFitLowersTheLoss) {
+  starfish_.set_fit_method(StarfishFitMethod::kLbfgs);
   const StarfishFit fit =
       starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
                     StarfishCalibration::ActuationGuess(), 3, nullptr);
@@ -389,6 +392,61 @@ TEST_F(StarfishFitTest, ShortFitLowersTheLoss) {
   EXPECT_LT(fit.final_cost, 0.9 * fit.initial_cost);
   EXPECT_GT(fit.statistics.gradients, 0);
   EXPECT_EQ(fit.statistics.failures, 0) << fit.statistics.last_error;
+}
+
+// The least-squares model's residual Jacobian (forward-mode tangents through
+// the water's drag) against central differences of the residuals.
+TEST_F(StarfishFitTest, ResidualJacobianMatchesCentralDifferences) {
+  ASSERT_EQ(starfish_.fit_method(), StarfishFitMethod::kLevenbergMarquardt);
+  SolverOptions options = starfish_.Options(Method::kPdLbfgs, 1);
+  options.rel_tolerance = 1e-10;
+  options.abs_tolerance = 1e-10;
+  auto model = starfish_.MakeModel(recording_, window_, options, MaterialParameters{2e5, 0.35, 400},
+                                   StarfishActuation{0.004, 0.03, 0.05});
+  ASSERT_EQ(model->ResolvedMode(model->num_rows()), solvers::DerivativeMode::kForward);
+  VectorXd p0(5);
+  p0 << 2e5, 0.35, 0.004, 0.03, 0.05;
+  MatrixXd j;
+  ASSERT_TRUE(model->Evaluate(p0, model->AllRows(), nullptr, &j)) << model->statistics().last_error;
+  EXPECT_EQ(model->statistics().tangent_passes, 1);
+  const double step[5] = {2e5 * 1e-4, 1e-4, 1e-6, 1e-5, 1e-6};
+  for (int i = 0; i < 5; ++i) {
+    VectorXd plus = p0, minus = p0, rp, rm;
+    plus(i) += step[i];
+    minus(i) -= step[i];
+    ASSERT_TRUE(model->Evaluate(plus, model->AllRows(), &rp, nullptr));
+    ASSERT_TRUE(model->Evaluate(minus, model->AllRows(), &rm, nullptr));
+    const VectorXd fd = (rp - rm) / (2 * step[i]);
+    EXPECT_GT(fd.norm() * std::abs(p0(i)), 1e-3) << "column " << i << ": the residuals depend on it";
+    EXPECT_LT((j.col(i) - fd).norm(), 1e-4 * fd.norm()) << "column " << i;
+  }
+}
+
+// Levenberg-Marquardt lowers the cost and gives every parameter a finite
+// standard deviation and a symmetric correlation matrix with unit diagonal.
+TEST_F(StarfishFitTest, LeastSquaresFitLowersTheCostAndHasIntervals) {
+  const StarfishFit fit =
+      starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
+                    StarfishCalibration::ActuationGuess(), 3, nullptr);
+  EXPECT_TRUE(fit.usable) << fit.termination;
+  EXPECT_LT(fit.final_cost, 0.9 * fit.initial_cost);
+  EXPECT_GT(fit.statistics.tangent_passes, 0);
+  EXPECT_EQ(fit.statistics.adjoint_passes, 0);
+  EXPECT_EQ(fit.residuals, 8 * (window_.num_frames() - 1));
+  ASSERT_EQ(fit.standard_deviation.size(), 5u);
+  ASSERT_EQ(fit.correlation.size(), 25u);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_TRUE(std::isfinite(fit.standard_deviation[i]) && fit.standard_deviation[i] > 0) << i;
+    EXPECT_NEAR(fit.correlation[6 * i], 1, 1e-9);
+    for (int k = 0; k < 5; ++k) EXPECT_NEAR(fit.correlation[5 * i + k], fit.correlation[5 * k + i], 1e-12);
+  }
+  starfish_.set_regions(StarfishRegions::kBodyArms);
+  EXPECT_THROW_MESSAGE(
+      starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
+                    StarfishCalibration::ActuationGuess(), 3, nullptr),
+      InvalidInputError, "the lm fit has no tied arms' nu: fit body-arms regions with --fit lbfgs");
+  EXPECT_THROW_MESSAGE(ParseStarfishFitMethod("newton"), InvalidInputError,
+                       "--fit = 'newton' is invalid: calibrate-starfish fits with 'lm' or 'lbfgs'");
 }
 
 }  // namespace

@@ -49,8 +49,10 @@ class CoordinateManifold : public ceres::Manifold {
   int AmbientSize() const override { return static_cast<int>(maps_.size()); }
   int TangentSize() const override { return static_cast<int>(maps_.size()); }
   // All return false if a coordinate of x (or y) lies outside its map's
-  // domain. Plus may return the domain's bound itself (or +inf for log) for
-  // huge steps: Ceres probes Plus(x, -gradient) with raw gradients.
+  // domain. For huge steps (Ceres probes Plus(x, -gradient) with raw
+  // gradients) Plus returns +inf for log, and for logit and log-logit the
+  // nearest double inside the interval (where PlusJacobian is about 0: the
+  // coordinate is stuck at its bound, and Ceres may go on).
   bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;
   bool PlusJacobian(const double* x, double* jacobian) const override;
   bool Minus(const double* y, const double* x, double* y_minus_x) const override;
