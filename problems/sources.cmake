@@ -18,6 +18,9 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/tools/tradeoff.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/stress.cc
   # the diffpd program's subcommands (main.cc is the executable's)
+  ${CMAKE_CURRENT_LIST_DIR}/cli/command_line.cc
+  ${CMAKE_CURRENT_LIST_DIR}/cli/option_checks.cc
+  ${CMAKE_CURRENT_LIST_DIR}/cli/run_options.cc
   ${CMAKE_CURRENT_LIST_DIR}/cli/list_command.cc
   ${CMAKE_CURRENT_LIST_DIR}/cli/run_command.cc
   ${CMAKE_CURRENT_LIST_DIR}/cli/gradcheck_command.cc

@@ -302,6 +302,10 @@ CalibrationFit CalibrationProblem::Fit(const CapturedMotion& motion, Method meth
   fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
   fit.usable = summary.IsSolutionUsable() && summary.termination_type != ceres::FAILURE;
   fit.termination = summary.message;
+  if (!std::isfinite(summary.final_cost)) {  // Ceres "converges" on a cost that stays inf
+    fit.usable = false;
+    fit.termination += "; the cost is not finite";
+  }
   const Rollout* rollout = function.RolloutAt(Eigen::Map<const VectorXd>(block.data(), block.size()));
   if (rollout) {
     fit.rollout = *rollout;
@@ -433,9 +437,14 @@ int CalibrationProblem::Run(const CommandArgs& args) const {
     std::ofstream(std::filesystem::path(args.out_dir) / "calibration.json") << report.dump(2) << "\n";
   }
   if (args.json) std::printf("%s\n", report.dump(2).c_str());
+  int status = 0;
   for (const CalibrationFit& f : fits)
-    if (!f.usable) return 5;
-  return 0;
+    if (!f.usable) {
+      std::fprintf(stderr, "diffpd: %s: the %s fit is not usable (%s; final cost %g)\n", name().c_str(),
+                   ToString(f.method), f.termination.c_str(), f.final_cost);
+      status = 5;
+    }
+  return status;
 }
 
 }  // namespace diffpd::problems

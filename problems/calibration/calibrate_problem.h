@@ -38,7 +38,7 @@ struct CalibrationFit {
   int iterations = 0;                     // Ceres iterations
   solvers::RolloutStatistics statistics;  // evaluations (rollouts), timings
   double total_seconds = 0;
-  bool usable = false;      // Ceres' solution is usable
+  bool usable = false;      // Ceres' solution is usable and its final cost finite
   std::string termination;  // Ceres' message
   Rollout rollout;          // the fitted trajectory
 };
@@ -96,7 +96,8 @@ class CalibrationProblem : public Problem {
   // captured and simulated marker paths (markers.csv) and their plot
   // (markers.png, gnuplot) and calibration.json; with --json prints the
   // report as one JSON object on stdout (everything else on stderr).
-  // Returns 0 if every fit is usable, 5 otherwise.
+  // Returns 0 if every fit is usable (Ceres says so and the final cost is
+  // finite), 5 otherwise, with a line on stderr per unusable fit.
   int Run(const CommandArgs& args) const override;
 
   // The report of Run as JSON: fitted parameters of the first fit as

@@ -66,8 +66,14 @@ std::vector<double> StarfishCalibration::WindowContractions(const StarfishRecord
 
 std::vector<StepInput> StarfishCalibration::WindowInputs(const StarfishRecording& rec, const StarfishWindow& w,
                                                          const StarfishActuation& actuation) const {
-  const std::vector<double> a =
-      StarfishActivations(WindowContractions(rec, w), StarfishTimeStep(rec, w, substeps_), actuation, nullptr);
+  int negative = -1;
+  const std::vector<double> a = StarfishActivationsUntilNegative(
+      WindowContractions(rec, w), StarfishTimeStep(rec, w, substeps_), actuation, nullptr, &negative);
+  if (negative >= 0) {
+    const int row = w.first + negative / substeps_;
+    throw InvalidInputError(rec.path + ":" + std::to_string(rec.lines[row]) + ": tendon = " +
+                            Num(rec.tendon[row] / kMm) + " mm gives " + NegativeActivation(a, negative, actuation));
+  }
   std::vector<StepInput> inputs(a.size());
   for (size_t i = 0; i < a.size(); ++i) inputs[i].activation = VectorXd::Constant(4, a[i]);
   return inputs;
@@ -76,7 +82,13 @@ std::vector<StepInput> StarfishCalibration::WindowInputs(const StarfishRecording
 State StarfishCalibration::WindowInitialState(Simulator& sim, const StarfishRecording& rec, const StarfishWindow& w,
                                               const StarfishActuation& actuation) const {
   State s = sim.RestState();
-  const double a = StarfishActivations({rec.tendon[w.first]}, 1, actuation, nullptr)[0];
+  int negative = -1;
+  const std::vector<double> first =
+      StarfishActivationsUntilNegative({rec.tendon[w.first]}, 1, actuation, nullptr, &negative);
+  if (negative >= 0)
+    throw InvalidInputError(rec.path + ":" + std::to_string(rec.lines[w.first]) + ": tendon = " +
+                            Num(rec.tendon[w.first] / kMm) + " mm gives " + NegativeActivation(first, 0, actuation));
+  const double a = first[0];
   if (a == 1) return s;
   StepInput input;
   input.activation = VectorXd::Constant(4, a);
@@ -108,6 +120,7 @@ CapturedMotion StarfishCalibration::WindowMotion(const Mesh& mesh, const State& 
       motion.samples.push_back(s);
     }
   }
+  motion.Validate(rec.path);  // a problem names the recording's file and row
   return motion;
 }
 

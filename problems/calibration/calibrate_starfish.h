@@ -70,6 +70,10 @@ class StarfishCalibration : public Problem {
   // displacement (x from image x, z from minus image y, y the initial y with
   // weight 0), weights sqrt(w_m / (sum w * (frames - 1))) / 2 mm on x and z,
   // so that 1/2 |r|^2 = 1/2 weighted mean squared error / (2 mm)^2.
+  // WindowInputs throws what StarfishActivations throws, a negative
+  // activation naming the recording's file and row ("<path>:<line>: tendon =
+  // 80 mm gives activation -0.22 < 0 (...)"); WindowMotion what
+  // CapturedMotion::Validate throws, prefixed by "<path>:<line>: ".
   std::vector<StepInput> WindowInputs(const StarfishRecording& recording, const StarfishWindow& window,
                                       const StarfishActuation& actuation) const;
   // The tendon contraction of every step of a window (m, zero-order hold).
@@ -78,7 +82,8 @@ class StarfishCalibration : public Problem {
                               const StarfishWindow& window) const;
   // The window's initial state: rest if the activation of its first tendon
   // value (lag at steady state) is 1, else the quasi-static equilibrium
-  // under that activation.
+  // under that activation. A negative first activation names the row, as in
+  // WindowInputs.
   State WindowInitialState(Simulator& sim, const StarfishRecording& recording, const StarfishWindow& window,
                            const StarfishActuation& actuation) const;
   // Errors of a simulated window (states at every step, rollout from
@@ -136,20 +141,23 @@ class StarfishCalibration : public Problem {
 
   // `diffpd run calibrate-starfish [--calibrate FILE] [--predict FILE ...]
   // [--seconds S] [--json] [--threads T] [--max-iterations N] [--out DIR]
-  // [--regions body-arms]`:
+  // [--regions body-arms] [--fit lm|lbfgs] [--fit-start S] [--fit-seconds S]`:
   // fits E, nu, tendon slack, lag and length on the calibration file's window
-  // [1 s, 3 s] (the tendon first moves at 1.18 s in cyclic1) with Ceres'
-  // L-BFGS on the scalar loss (at most 10 iterations unless
-  // --max-iterations; 0: no fit, predict at the starting values), then
-  // simulates the first S seconds (default 10) of every --predict file
-  // (default: the calibration file and, when no --calibrate is given,
-  // cyclic2 too) with the fitted parameters and reports the errors.
-  // --out DIR writes DIR/<file stem>_trace.csv per predicted file: time,
-  // tendon (mm), activation, simulated and captured x, z displacement of
-  // M1..M4 (mm) per camera frame.
+  // (default [1 s, 3 s]: the tendon first moves at 1.18 s in cyclic1) by
+  // Levenberg-Marquardt on the marker residuals (--fit lbfgs: L-BFGS on the
+  // scalar loss; at most 10 iterations unless --max-iterations; 0: no fit,
+  // predict at the starting values), prints the parameters' standard
+  // deviations and correlations (lm), then simulates the first S seconds
+  // (default 10) of every --predict file (any recording in the fact sheet's
+  // format; default: the calibration file and, when no --calibrate is given,
+  // cyclic2 too) with the fitted parameters and reports per file the errors
+  // and the zero-motion and mean-displacement baselines.
+  // --out DIR writes DIR/<file stem>_trace.csv per predicted file
+  // (WriteStarfishTrace).
   // Method: pd-lbfgs, or the first of --methods, or a --method other than
   // the command line's default pd. --threads as for every problem.
-  // --regions body-arms fits the arms' E apart from the body's (kBodyArms).
+  // --regions body-arms fits the arms' E apart from the body's (kBodyArms,
+  // with --fit lbfgs).
   int Run(const CommandArgs& args) const override;
 
  private:

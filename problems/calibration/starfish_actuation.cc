@@ -22,8 +22,10 @@ StarfishActuation At(const Eigen::Ref<const VectorXd>& values) {
 
 }  // namespace
 
-std::vector<double> StarfishActivations(const std::vector<double>& c, double h, const StarfishActuation& act,
-                                        std::vector<std::array<double, 3>>* derivatives) {
+std::vector<double> StarfishActivationsUntilNegative(const std::vector<double>& c, double h,
+                                                     const StarfishActuation& act,
+                                                     std::vector<std::array<double, 3>>* derivatives,
+                                                     int* first_negative) {
   if (!(std::isfinite(h) && h > 0)) throw InvalidInputError("time step = " + Num(h) + " is invalid: must be > 0 (s)");
   if (!(std::isfinite(act.slack) && act.slack >= 0))
     throw InvalidInputError("tendon slack = " + Num(act.slack) + " is invalid: must be finite and >= 0 (m)");
@@ -44,11 +46,27 @@ std::vector<double> StarfishActivations(const std::vector<double>& c, double h, 
     const double hinge = x <= 0 ? 0 : x < w ? x * x / (2 * w) : x - w / 2;
     const double slope = x <= 0 ? 0 : x < w ? x / w : 1;
     a[k] = 1 - hinge / L;
-    if (a[k] < 0)
-      throw InvalidInputError("tendon: activation " + Num(a[k]) + " < 0 at step " + std::to_string(k) + " (slack " +
-                              Num(act.slack) + " m, length " + Num(L) + " m)");
+    if (a[k] < 0) {
+      *first_negative = static_cast<int>(k);
+      return a;
+    }
     if (derivatives) (*derivatives)[k] = {slope / L, -slope * df / L, hinge / (L * L)};
   }
+  *first_negative = -1;
+  return a;
+}
+
+std::string NegativeActivation(const std::vector<double>& a, int k, const StarfishActuation& act) {
+  return "activation " + Num(a[k]) + " < 0 (the filtered contraction exceeds slack + length: slack " + Num(act.slack) +
+         " m, length " + Num(act.length) + " m)";
+}
+
+std::vector<double> StarfishActivations(const std::vector<double>& c, double h, const StarfishActuation& act,
+                                        std::vector<std::array<double, 3>>* derivatives) {
+  int negative = -1;
+  std::vector<double> a = StarfishActivationsUntilNegative(c, h, act, derivatives, &negative);
+  if (negative >= 0)
+    throw InvalidInputError("tendon: " + NegativeActivation(a, negative, act) + " at step " + std::to_string(negative));
   return a;
 }
 

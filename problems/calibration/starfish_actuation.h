@@ -34,11 +34,21 @@ struct StarfishActuation {
 // {da/dslack (1/m), da/dlag (1/s), da/dlength (1/m)}. Throws
 // InvalidInputError for h <= 0, a negative or non-finite slack or lag, or a
 // length <= 0 ("tendon lag = -1 is invalid: must be finite and >= 0 (s)"),
-// and for a negative activation ("tendon: activation -0.2 < 0 at step 7 (slack
-// 0 m, length 0.01 m)").
+// and for a negative activation ("tendon: activation -0.2 < 0 (the filtered
+// contraction exceeds slack + length: slack 0 m, length 0.01 m) at step 7").
 std::vector<double> StarfishActivations(const std::vector<double>& contraction, double h,
                                         const StarfishActuation& actuation,
                                         std::vector<std::array<double, 3>>* derivatives);
+// StarfishActivations with its checks of h and the actuation, but without
+// the negative-activation one: *first_negative is the first step with a < 0
+// (-1: none), where the sequence stops (the steps after it are not computed).
+std::vector<double> StarfishActivationsUntilNegative(const std::vector<double>& contraction, double h,
+                                                     const StarfishActuation& actuation,
+                                                     std::vector<std::array<double, 3>>* derivatives,
+                                                     int* first_negative);
+// "activation -0.2 < 0 (the filtered contraction exceeds slack + length:
+// slack 0 m, length 0.065 m)" of step k of `activations`.
+std::string NegativeActivation(const std::vector<double>& activations, int k, const StarfishActuation& actuation);
 
 // StarfishActivations as a parameter block {slack, lag, length} (m, s, m):
 // it writes the same activation into every muscle at every step of a rollout

@@ -198,7 +198,7 @@ StarfishFit FitStarfishLoss(solvers::RolloutFunction* model, bool arms, const Ma
   fit.initial_cost = summary.initial_cost;
   fit.final_cost = summary.final_cost;
   fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
-  fit.usable = summary.IsSolutionUsable();
+  fit.usable = summary.IsSolutionUsable() && std::isfinite(summary.final_cost);
   fit.termination = summary.message;
   fit.statistics = model->statistics();
   return fit;
@@ -243,6 +243,10 @@ StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residua
   fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
   fit.usable = summary.IsSolutionUsable() && summary.termination_type != ceres::FAILURE;
   fit.termination = summary.message;
+  if (!std::isfinite(summary.final_cost)) {  // Ceres "converges" on a cost that stays inf
+    fit.usable = false;
+    fit.termination += "; the cost is not finite";
+  }
 
   // Rows with a weight (the markers' unobserved y has none).
   VectorXd r;

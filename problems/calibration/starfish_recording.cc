@@ -4,8 +4,10 @@
 #include <fstream>
 #include <sstream>
 
+#include "diffpd/captured_motion.h"
 #include "diffpd/csv_fields.h"
 #include "diffpd/error.h"
+#include "diffpd/input_file.h"
 
 namespace diffpd::problems {
 namespace {
@@ -22,8 +24,7 @@ std::string Num(double v) {
 }  // namespace
 
 StarfishRecording ReadStarfishRecording(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InvalidInputError("cannot open '" + path + "'");
+  std::ifstream in = OpenInputFile(path);
   StarfishRecording rec;
   rec.path = path;
   std::string line;
@@ -56,9 +57,10 @@ StarfishRecording ReadStarfishRecording(const std::string& path) {
     if (std::isinf(v[1]))
       throw InvalidInputError(where + "tendon = " + Num(v[1]) + " is invalid: must be finite or NaN (mm)");
     for (int c = 2; c < 10; ++c)
-      if (!std::isfinite(v[c]))
+      if (!(std::isfinite(v[c]) && std::abs(v[c] * kMm) <= kMaxMarkerCoordinate))
         throw InvalidInputError(where + kColumns[c] + " = " + Num(v[c]) +
-                                " is invalid: marker coordinates must be finite (mm)");
+                                " is invalid: marker coordinates must be finite and within +-" +
+                                Num(kMaxMarkerCoordinate / kMm) + " (mm)");
     if (!rec.time.empty() && v[0] * kMm <= rec.time.back())
       throw InvalidInputError(where + "time " + Num(v[0]) + " ms is not after the previous row's " +
                               Num(rec.time.back() / kMm) + " ms (line " + std::to_string(rec.lines.back()) + ")");

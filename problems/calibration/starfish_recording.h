@@ -26,12 +26,13 @@ struct StarfishRecording {
 
 // Reads a starfish recording. Throws InvalidInputError naming the file and
 // line:
-//   "cannot open '<path>'",
+//   "cannot open '<path>'", "cannot open '<path>': it is a directory, not a file",
 //   "<path>: empty file (expected a header row and data rows)",
 //   "<path>:1: expected a header row of 10 column labels, got 3 fields",
 //   "<path>:5: expected 10 fields (time ms, tendon mm, M1 x, M1 y, ..., M4 x, M4 y), got 9",
 //   "<path>:5: M2 y is not a number: 'abc'",
-//   "<path>:5: M2 y = nan is invalid: marker coordinates must be finite (mm)",
+//   "<path>:5: M2 y = nan is invalid: marker coordinates must be finite and within +-1e+09 (mm)"
+//   (kMaxMarkerCoordinate, captured_motion.h),
 //   "<path>:5: time = inf is invalid: must be finite (ms)",
 //   "<path>:5: tendon = inf is invalid: must be finite or NaN (mm)",
 //   "<path>:5: time 10 ms is not after the previous row's 16.6667 ms (line 4)",

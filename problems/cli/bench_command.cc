@@ -7,6 +7,7 @@
 
 #include "tools/bench.h"
 #include "cli/commands.h"
+#include "cli/option_checks.h"
 
 namespace diffpd::problems {
 namespace {
@@ -154,26 +155,32 @@ Subcommand AddBenchCommand(CLI::App* parent) {
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--threads", args->options.threads, "threads for element loops (0: OpenMP default)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(ThreadCount("--threads"));
   cmd->add_option("--repeat", args->options.repeat, "runs per method; times are medians")
-      ->check(CLI::PositiveNumber)
+      ->check(IntegerAtLeast("--repeat", 1))
       ->capture_default_str();
   cmd->add_option("--rtol", args->options.rel_tolerance, "relative tolerance of each step's solve")
+      ->check(Fraction("--rtol"))
       ->capture_default_str();
   cmd->add_option("--backward-rtol", args->options.backward_rel_tolerance,
-                  "relative tolerance of the adjoint solves (default: --rtol)");
+                  "relative tolerance of the adjoint solves (default: --rtol)")
+      ->check(Fraction("--backward-rtol"));
   cmd->add_option("--max-iterations", args->options.max_iterations, "iteration limit of each step's solve")
-      ->check(CLI::PositiveNumber)
+      ->check(IntegerAtLeast("--max-iterations", 1))
       ->capture_default_str();
   cmd->add_option("--lbfgs-scale", args->options.lbfgs_weight_scale,
                   "pd-lbfgs: elastic weight factor of its initial Hessian A, in (0, 1]")
+      ->check(Fraction("--lbfgs-scale", true))
       ->capture_default_str();
   cmd->add_flag("--no-rigid-correction{false}", args->options.rigid_mode_correction,
                 "pd-lbfgs and the PD backward: without the rigid modes' coarse correction");
-  cmd->add_option("--steps", args->options.steps, "number of time steps (default: the problem's)");
-  cmd->add_option("--dt", args->options.time_step, "time step in seconds (default: the problem's)");
+  cmd->add_option("--steps", args->options.steps, "number of time steps (default: the problem's)")
+      ->check(IntegerAtLeast("--steps", 1));
+  cmd->add_option("--dt", args->options.time_step, "time step in seconds (default: the problem's)")
+      ->check(Positive("--dt", "s"));
   cmd->add_option("--refine", args->options.refine,
                   "double the cells this many times (cycling x, y, z; negative halves); cantilever -9 = 4x1x1")
+      ->check(IntegerIn("--refine", kMinRefinement, kMaxRefinement))
       ->capture_default_str();
   cmd->add_option("--seed", args->options.seed, "seed of the loss vectors")->capture_default_str();
   cmd->add_flag("--json", args->json, "print one JSON document (a list) on stdout");

@@ -15,6 +15,8 @@ class App;
 
 namespace diffpd::problems {
 
+class Problem;  // problem.h
+
 // Settings shared by the subcommands that simulate a problem.
 struct CommandArgs {
   std::string problem;
@@ -68,6 +70,14 @@ Subcommand AddBenchCommand(CLI::App* parent);     // bench_command.cc
 Subcommand AddTradeoffCommand(CLI::App* parent);  // tradeoff_command.cc
 Subcommand AddStressCommand(CLI::App* parent);    // stress_command.cc
 Subcommand AddSynthCommand(CLI::App* parent);     // synth_command.cc
+
+// `diffpd run`'s options that only some kinds of problem read (--small,
+// --no-compare, --ipopt: optimisation; --data, --methods, --max-iterations:
+// calibration; --calibrate, --predict, --seconds, --regions: the starfish):
+// throws InvalidInputError for one given to a problem that would ignore it,
+// "--ipopt is not used by the simulation problem 'cantilever' (only the
+// optimisation problems read it)".
+void RefuseUnusedRunOptions(const CommandArgs& args, const Problem& problem);
 
 // Calibration problems fit with the library's PD-LBFGS settings and a silent
 // simulator: throws InvalidInputError if --lbfgs-scale, --no-rigid-correction

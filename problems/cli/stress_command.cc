@@ -8,6 +8,7 @@
 
 #include "tools/bench.h"
 #include "cli/commands.h"
+#include "cli/option_checks.h"
 #include "tools/stress.h"
 
 namespace diffpd::problems {
@@ -103,23 +104,31 @@ Subcommand AddStressCommand(CLI::App* parent) {
                   "comma-separated methods: semi-implicit, newton-cholesky, newton-pcg, pd, pd-lbfgs")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--refine", args->refine, "cell doublings of every problem's mesh")->capture_default_str();
+  cmd->add_option("--refine", args->refine, "cell doublings of every problem's mesh")
+      ->check(IntegerIn("--refine", kMinRefinement, kMaxRefinement))
+      ->capture_default_str();
   cmd->add_option("--E", o.youngs_moduli, "comma-separated Young's moduli (Pa)")->delimiter(',')->capture_default_str();
   cmd->add_option("--nu", o.poissons_ratios, "comma-separated Poisson's ratios")->delimiter(',')->capture_default_str();
   cmd->add_option("--dt", o.time_steps, "comma-separated time steps (s)")->delimiter(',')->capture_default_str();
-  cmd->add_option("--steps", o.steps, "steps per case")->capture_default_str();
-  cmd->add_option("--rtol", o.rel_tolerance, "relative tolerance of each step's solve")->capture_default_str();
-  cmd->add_option("--abs-tol", o.abs_tolerance, "absolute tolerance of each step's solve (N; default: automatic)");
+  cmd->add_option("--steps", o.steps, "steps per case")->check(IntegerAtLeast("--steps", 1))->capture_default_str();
+  cmd->add_option("--rtol", o.rel_tolerance, "relative tolerance of each step's solve")
+      ->check(Fraction("--rtol"))
+      ->capture_default_str();
+  cmd->add_option("--abs-tol", o.abs_tolerance, "absolute tolerance of each step's solve (N; default: automatic)")
+      ->check(Positive("--abs-tol", "N"));
   cmd->add_option("--max-iterations", o.max_iterations, "iteration limit of each step's solve")
-      ->check(CLI::PositiveNumber)
+      ->check(IntegerAtLeast("--max-iterations", 1))
       ->capture_default_str();
   cmd->add_option("--threads", o.threads, "threads for element loops (0: OpenMP default)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(ThreadCount("--threads"));
   cmd->add_option("--energy-tol", o.energy_tolerance, "allowed relative rise of the total energy")
+      ->check(NonNegative("--energy-tol"))
       ->capture_default_str();
   cmd->add_option("--gradcheck-steps", o.gradcheck_steps, "steps of the finite-difference check (0: skip)")
+      ->check(IntegerAtLeast("--gradcheck-steps", 0))
       ->capture_default_str();
   cmd->add_option("--gradcheck-tol", o.gradcheck_tolerance, "allowed relative error of the gradient check")
+      ->check(Positive("--gradcheck-tol"))
       ->capture_default_str();
   cmd->add_option("--seed", o.seed, "seed of the loss and check directions")->capture_default_str();
   cmd->add_flag("--no-rigid-correction{false}", o.rigid_mode_correction,

@@ -8,6 +8,7 @@
 
 #include "tools/bench.h"
 #include "cli/commands.h"
+#include "cli/option_checks.h"
 #include "diffpd/error.h"
 #include "tools/tradeoff.h"
 
@@ -107,22 +108,27 @@ Subcommand AddTradeoffCommand(CLI::App* parent) {
   cmd->add_option("--tolerances", o.tolerances, "comma-separated tolerances of the tolerance sweep")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--rtol", o.rel_tolerance, "tolerance of the time-step and resolution sweeps")->capture_default_str();
-  cmd->add_option("--max-iterations", o.max_iterations, "iteration limit of each step's solve")
-      ->check(CLI::PositiveNumber)
+  cmd->add_option("--rtol", o.rel_tolerance, "tolerance of the time-step and resolution sweeps")
+      ->check(Fraction("--rtol"))
       ->capture_default_str();
-  cmd->add_option("--steps", o.steps, "number of time steps at --dt (default: the problem's)");
-  cmd->add_option("--dt", o.time_step, "coarsest time step in seconds (default: the problem's)");
+  cmd->add_option("--max-iterations", o.max_iterations, "iteration limit of each step's solve")
+      ->check(IntegerAtLeast("--max-iterations", 1))
+      ->capture_default_str();
+  cmd->add_option("--steps", o.steps, "number of time steps at --dt (default: the problem's)")
+      ->check(IntegerAtLeast("--steps", 1));
+  cmd->add_option("--dt", o.time_step, "coarsest time step in seconds (default: the problem's)")
+      ->check(Positive("--dt", "s"));
   cmd->add_option("--dt-levels", o.time_step_levels, "time steps dt / 2^k, k < dt-levels")
-      ->check(CLI::PositiveNumber)
+      ->check(IntegerAtLeast("--dt-levels", 1))
       ->capture_default_str();
   cmd->add_option("--resolution-levels", o.resolution_levels, "meshes, each halving the cells per axis")
-      ->check(CLI::PositiveNumber)
+      ->check(IntegerAtLeast("--resolution-levels", 1))
       ->capture_default_str();
   cmd->add_option("--refine", o.refine, "cell doublings of the (finest) mesh; cantilever -9 = 4x1x1")
+      ->check(IntegerIn("--refine", kMinRefinement, kMaxRefinement))
       ->capture_default_str();
   cmd->add_option("--threads", o.threads, "threads for element loops (0: OpenMP default)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(ThreadCount("--threads"));
   cmd->add_option("--seed", o.seed, "seed of the loss vectors")->capture_default_str();
   cmd->add_flag("--json", args->json, "print one JSON document (a list) on stdout");
   cmd->add_option("--plot", args->plot, "write a log-log PNG of time vs. error (needs gnuplot)");

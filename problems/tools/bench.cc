@@ -94,31 +94,28 @@ nlohmann::json NumberOrNull(bool ok, double v) { return ok ? nlohmann::json(v) :
 }  // namespace
 
 std::unique_ptr<Problem> MakeRefinedProblem(const std::string& name, int doublings) {
-  if (doublings == 0) return MakeProblem(name);
+  std::unique_ptr<Problem> problem = MakeProblem(name);  // an unknown name: the list of problems
+  if (doublings == 0) return problem;
+  if ((name == "cantilever" || name == "falling-cube") && (doublings < kMinRefinement || doublings > kMaxRefinement)) {
+    std::ostringstream msg;
+    msg << "refinement = " << doublings << " is invalid for " << name << ": it must be in [" << kMinRefinement << ", "
+        << kMaxRefinement << "] (" << kMaxRefinement << ": " << (1 << kMaxRefinement) << " times the cells)";
+    throw InvalidInputError(msg.str());
+  }
   if (name == "cantilever") {
     int cells[3] = {32, 8, 8};
     for (int i = 0; i < std::abs(doublings); ++i) {
       const int axis = doublings > 0 ? i % 3 : 2 - i % 3;
       if (doublings > 0) {
         cells[axis] *= 2;
-      } else if (cells[axis] % 2 != 0) {
-        std::ostringstream msg;
-        msg << "refinement = " << doublings << " is invalid for cantilever: it must be >= -9 (4 x 1 x 1 cells)";
-        throw InvalidInputError(msg.str());
       } else {
-        cells[axis] /= 2;
+        cells[axis] /= 2;  // 32 x 8 x 8 halves 9 times, to 4 x 1 x 1
       }
     }
     return std::make_unique<Cantilever>(cells[0], cells[1], cells[2]);
   }
   if (name == "falling-cube") {
-    const int cells = static_cast<int>(std::lround(8.0 * std::pow(2.0, doublings / 3.0)));
-    if (cells < 1) {
-      std::ostringstream msg;
-      msg << "refinement = " << doublings << " is invalid for falling-cube: it must be >= -9 (1 cell)";
-      throw InvalidInputError(msg.str());
-    }
-    return std::make_unique<FallingCube>(cells);
+    return std::make_unique<FallingCube>(static_cast<int>(std::lround(8.0 * std::pow(2.0, doublings / 3.0))));
   }
   throw InvalidInputError("problem '" + name +
                           "' cannot be refined: refinement is available for cantilever and falling-cube");
@@ -208,6 +205,10 @@ VectorXd StackState(const State& s) {
   return out;
 }
 
+std::string ThreadRange() {
+  return "in [0, " + std::to_string(MaxSolverThreads()) + "] (0: OpenMP default; SolverOptions::num_threads)";
+}
+
 void BenchOptions::Validate() const {
   const auto fail = ThrowInvalidOption;
   if (methods.empty()) throw InvalidInputError("methods is empty: name at least one method");
@@ -219,7 +220,7 @@ void BenchOptions::Validate() const {
   if (!(rel_tolerance > 0 && rel_tolerance < 1)) fail("rtol", rel_tolerance, "in (0, 1)");
   if (!(backward_rel_tolerance < 1)) fail("backward rtol", backward_rel_tolerance, "< 1 (<= 0: same as rtol)");
   if (repeat < 1) fail("repeat", repeat, ">= 1");
-  if (threads < 0) fail("threads", threads, ">= 0");
+  if (threads < 0 || threads > MaxSolverThreads()) fail("threads", threads, ThreadRange());
   if (max_iterations < 1) fail("max iterations", max_iterations, ">= 1");
   if (!(lbfgs_weight_scale > 0 && lbfgs_weight_scale <= 1)) fail("lbfgs scale", lbfgs_weight_scale, "in (0, 1]");
   if (!std::isfinite(time_step)) fail("dt", time_step, "finite (> 0, or <= 0 for the default)");

@@ -40,14 +40,22 @@ inline constexpr double kReferenceRelTolerance = 1e-10;
 // Tolerance of the reference's adjoint solves.
 inline constexpr double kReferenceBackwardRelTolerance = 1e-12;
 
+// The range of MakeRefinedProblem's doublings: -9 leaves the cantilever
+// 4 x 1 x 1 cells and the cube 1; 12 multiplies the cells by 4096 (8.4
+// million hexes for the cantilever), beyond what a run on one machine holds.
+inline constexpr int kMinRefinement = -9;
+inline constexpr int kMaxRefinement = 12;
+
 // The registered problem `name` with its cell count doubled `doublings` times
 // (cycling over x, y, z; a negative count halves z, y, x in turn), so that
 // `doublings` = 3 is 8x the elements and -3 an eighth. Cantilever: the default
 // 32 x 8 x 8 cells; -9 gives 4 x 1 x 1. Falling cube: 8^3 cells, scaled to
 // round(8 * 2^(doublings / 3)) cells per axis (exact for multiples of 3).
 // With 0 doublings, any registered problem (MakeProblem). Throws
-// InvalidInputError for an unknown problem, for other problems with
-// doublings != 0, or when a halving would leave no cells along an axis.
+// InvalidInputError for an unknown problem (MakeProblem's message, listing
+// the problems), for other problems with doublings != 0, and for doublings
+// outside [kMinRefinement, kMaxRefinement]: "refinement = 100 is invalid for
+// cantilever: it must be in [-9, 12] (12: 4096 times the cells)".
 std::unique_ptr<Problem> MakeRefinedProblem(const std::string& name, int doublings);
 
 // Methods from their names (ParseMethod each); throws InvalidInputError.
@@ -118,6 +126,10 @@ struct BenchOptions {
   // Throws InvalidInputError naming the field, its value and the valid range.
   void Validate() const;
 };
+
+// The range of the tools' thread counts, for their messages: "in [0, 8]
+// (0: OpenMP default; SolverOptions::num_threads)".
+std::string ThreadRange();
 
 struct BenchRow {
   std::string method;

@@ -66,7 +66,7 @@ void StressOptions::Validate() const {
     if (!(std::isfinite(h) && h > 0)) fail("time_step", h, "finite and > 0 (s)");
   if (steps < 1) fail("steps", steps, ">= 1");
   if (!(rel_tolerance > 0 && rel_tolerance < 1)) fail("rtol", rel_tolerance, "in (0, 1)");
-  if (threads < 0) fail("threads", threads, ">= 0");
+  if (threads < 0 || threads > MaxSolverThreads()) fail("threads", threads, ThreadRange());
   if (max_iterations < 1) fail("max_iterations", max_iterations, ">= 1");
   if (!(energy_tolerance >= 0)) fail("energy_tolerance", energy_tolerance, ">= 0");
   if (!(explicit_energy_tolerance >= 0)) fail("explicit_energy_tolerance", explicit_energy_tolerance, ">= 0");

@@ -152,7 +152,7 @@ void TradeoffOptions::Validate() const {
   for (double t : tolerances)
     if (!(t > 0 && t < 1)) fail("tolerance", t, "in (0, 1)");
   if (!(rel_tolerance > 0 && rel_tolerance < 1)) fail("rtol", rel_tolerance, "in (0, 1)");
-  if (threads < 0) fail("threads", threads, ">= 0");
+  if (threads < 0 || threads > MaxSolverThreads()) fail("threads", threads, ThreadRange());
   if (max_iterations < 1) fail("max iterations", max_iterations, ">= 1");
   if (time_step_levels < 1) fail("time-step levels", time_step_levels, ">= 1");
   if (resolution_levels < 1) fail("resolution levels", resolution_levels, ">= 1");

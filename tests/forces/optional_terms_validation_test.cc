@@ -84,6 +84,12 @@ TEST(OptionalTermsValidationTest, ContactErrorsNameTheContactAndTheValue) {
   ExpectMessage([](Scene* s) { s->frictional_contacts[0].nodes.push_back(0); },
                 "scene: frictional_contacts[0].nodes[2] = 0 has a Dirichlet DoF; frictional contact candidates must be "
                 "free");
+  ExpectMessage([](Scene* s) { s->frictional_contacts[0].surface.kind = static_cast<ContactSurface::Kind>(7); },
+                "scene: frictional_contacts[0].surface.kind = 7 is invalid: must be kPlane (0), kSphere (1) or "
+                "kHeightField (2)");
+  ExpectMessage([](Scene* s) { s->frictional_contact_options.pd_linear_solve = static_cast<ContactLinearSolve>(5); },
+                "scene: frictional_contact_options.pd_linear_solve = 5 is invalid: must be kWoodbury (0) or "
+                "kRefactorize (1)");
   ExpectMessage([](Scene* s) { s->frictional_contact_options.max_passes = 0; },
                 "scene: frictional_contact_options.max_passes = 0 is invalid: must be >= 1");
   ExpectMessage(

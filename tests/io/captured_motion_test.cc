@@ -9,6 +9,7 @@
 
 #include "diffpd/captured_motion.h"
 #include "diffpd/error.h"
+#include "util/expect_message.h"
 #include "test_scenes.h"
 #include "util/temporary_directory.h"
 
@@ -79,44 +80,63 @@ TEST(CapturedMotionTest, AcceptsSpacesBlankLinesAndInterleavedMarkers) {
   EXPECT_EQ(m.samples[2].weight, Vec3::Ones());
 }
 
+// One bad captured-motion file: its text and the exact message, with the
+// file's path replaced by "F".
+struct BadFile {
+  std::string text;
+  std::string message;
+};
+
+const std::string kHeader = std::string(kMarkers) + "time,marker,x,y,z\n";  // header on line 4
+const std::string kWeightHeader = std::string(kMarkers) + "time,marker,x,y,z,wx,wy,wz\n";
+
+const BadFile kBadFiles[] = {
+    {std::string(kMarkers) + "marker,2,vertex\n",
+     "F:4: expected 'marker,<id>,vertex,<v>' or 'marker,<id>,element,<e>,<c0>,<c1>,<c2>', got 'marker,2,vertex'"},
+    {std::string(kMarkers) + "marker,1,vertex,3\ntime,marker,x,y,z\n0,0,1,2,3\n",
+     "F:4: marker id 1 is declared twice (first on line 3)"},
+    {"marker,-2,vertex,3\n", "F:1: marker id -2 is invalid: must be an integer >= 0"},
+    {"marker,2,vertex,-3\n", "F:1: vertex index -3 is invalid: must be an integer >= 0"},
+    {kHeader + "marker,5,vertex,0\n", "F:5: marker declarations must come before the header"},
+    {std::string(kMarkers) + "0,1,2,3,4\n",
+     "F:4: expected the header 'time,marker,x,y,z' or 'time,marker,x,y,z,wx,wy,wz', got '0,1,2,3,4'"},
+    {kHeader + "0,0,1,2\n", "F:5: expected 5 fields (time,marker,x,y,z), got 4"},
+    {kWeightHeader + "0,0,1,2,3\n", "F:5: expected 8 fields (time,marker,x,y,z,wx,wy,wz), got 5"},
+    {kHeader + "0,0,abc,2,3\n", "F:5: x is not a number: 'abc'"},
+    {kHeader + "0,0,1,,3\n", "F:5: y is not a number: ''"},
+    {kHeader + "0,1.5,1,2,3\n", "F:5: marker is not an integer: '1.5'"},
+    {kHeader + "0,0,1,inf,3\n", "F:5: y = inf is not finite"},
+    {kHeader + "nan,0,1,2,3\n", "F:5: time = nan is not finite"},
+    {kHeader + "-0.1,0,1,2,3\n", "F:5: time = -0.1 is invalid: must be >= 0 (s)"},
+    {kHeader + "0,0,1e300,2,3\n", "F:5: x = 1e+300 is invalid: must be within +-1000000 (m)"},
+    {kHeader + "0,0,1,2,-1000001\n", "F:5: z = -1000001 is invalid: must be within +-1000000 (m)"},
+    {kWeightHeader + "0,0,1,2,3,1,1,-1\n", "F:5: wz = -1 is invalid: weights must be >= 0"},
+    {kWeightHeader + "0,0,1,2,3,1e300,1,1\n", "F:5: wx = 1e+300 is invalid: weights must be <= 1000000000000 (1/m)"},
+    {kHeader + "0,9,1,2,3\n", "F:5: unknown marker id 9 (declared ids: 0, 1)"},
+    {kHeader + "0.2,0,1,2,3\n0.1,1,1,2,3\n0.1,0,1,2,3\n",
+     "F:7: time 0.1 of marker 0 is not after its previous sample at time 0.2 (line 5): times must increase "
+     "strictly per marker"},
+    {kHeader + "0.2,0,1,2,3\n0.2,0,1,2,3\n",
+     "F:6: time 0.2 of marker 0 is not after its previous sample at time 0.2 (line 5): times must increase "
+     "strictly per marker"},
+    {"# nothing\ntime,marker,x,y,z\n", "F: no marker declared"},
+    {kHeader, "F: no samples"},
+    {std::string(kMarkers), "F: no samples"},
+};
+
 TEST(CapturedMotionTest, RejectsBadFilesNamingLineAndProblem) {
-  const std::string h = std::string(kMarkers) + "time,marker,x,y,z\n";  // header on line 4
-  EXPECT_EQ(ReadError(std::string(kMarkers) + "marker,2,vertex\n"),
-            "F:4: expected 'marker,<id>,vertex,<v>' or 'marker,<id>,element,<e>,<c0>,<c1>,<c2>', got "
-            "'marker,2,vertex'");
-  EXPECT_EQ(ReadError(std::string(kMarkers) + "marker,1,vertex,3\ntime,marker,x,y,z\n0,0,1,2,3\n"),
-            "F:4: marker id 1 is declared twice (first on line 3)");
-  EXPECT_EQ(ReadError("marker,-2,vertex,3\n"), "F:1: marker id -2 is invalid: must be an integer >= 0");
-  EXPECT_EQ(ReadError("marker,2,vertex,-3\n"), "F:1: vertex index -3 is invalid: must be an integer >= 0");
-  EXPECT_EQ(ReadError(h + "marker,5,vertex,0\n"), "F:5: marker declarations must come before the header");
-  EXPECT_EQ(ReadError(std::string(kMarkers) + "0,1,2,3,4\n"),
-            "F:4: expected the header 'time,marker,x,y,z' or 'time,marker,x,y,z,wx,wy,wz', got '0,1,2,3,4'");
-  EXPECT_EQ(ReadError(h + "0,0,1,2\n"), "F:5: expected 5 fields (time,marker,x,y,z), got 4");
-  EXPECT_EQ(ReadError(std::string(kMarkers) + "time,marker,x,y,z,wx,wy,wz\n0,0,1,2,3\n"),
-            "F:5: expected 8 fields (time,marker,x,y,z,wx,wy,wz), got 5");
-  EXPECT_EQ(ReadError(h + "0,0,abc,2,3\n"), "F:5: x is not a number: 'abc'");
-  EXPECT_EQ(ReadError(h + "0,0,1,,3\n"), "F:5: y is not a number: ''");
-  EXPECT_EQ(ReadError(h + "0,1.5,1,2,3\n"), "F:5: marker is not an integer: '1.5'");
-  EXPECT_EQ(ReadError(h + "0,0,1,inf,3\n"), "F:5: y = inf is not finite");
-  EXPECT_EQ(ReadError(h + "nan,0,1,2,3\n"), "F:5: time = nan is not finite");
-  EXPECT_EQ(ReadError(h + "-0.1,0,1,2,3\n"), "F:5: time = -0.1 is invalid: must be >= 0 (s)");
-  EXPECT_EQ(ReadError(std::string(kMarkers) + "time,marker,x,y,z,wx,wy,wz\n0,0,1,2,3,1,1,-1\n"),
-            "F:5: wz = -1 is invalid: weights must be >= 0");
-  EXPECT_EQ(ReadError(h + "0,9,1,2,3\n"), "F:5: unknown marker id 9 (declared ids: 0, 1)");
-  EXPECT_EQ(ReadError(h + "0.2,0,1,2,3\n0.1,1,1,2,3\n0.1,0,1,2,3\n"),
-            "F:7: time 0.1 of marker 0 is not after its previous sample at time 0.2 (line 5): times must "
-            "increase strictly per marker");
-  EXPECT_EQ(ReadError(h + "0.2,0,1,2,3\n0.2,0,1,2,3\n"),
-            "F:6: time 0.2 of marker 0 is not after its previous sample at time 0.2 (line 5): times must "
-            "increase strictly per marker");
-  EXPECT_EQ(ReadError("# nothing\ntime,marker,x,y,z\n"), "F: no marker declared");
-  EXPECT_EQ(ReadError(h), "F: no samples");
-  EXPECT_EQ(ReadError(std::string(kMarkers)), "F: no samples");
-  try {
-    ReadCapturedMotion("/nonexistent/m.csv");
-    FAIL();
-  } catch (const InvalidInputError& e) {
-    EXPECT_STREQ(e.what(), "cannot open '/nonexistent/m.csv'");
+  for (const BadFile& bad : kBadFiles) EXPECT_EQ(ReadError(bad.text), bad.message) << bad.text;
+}
+
+TEST(CapturedMotionTest, RejectsPathsThatAreNotReadableFiles) {
+  const std::string dir = TempPath("directory");
+  std::filesystem::create_directories(dir);
+  const std::pair<std::string, std::string> cases[] = {
+      {"/nonexistent/m.csv", "cannot open '/nonexistent/m.csv'"},
+      {dir, "cannot open '" + dir + "': it is a directory, not a file"},
+  };
+  for (const auto& [path, message] : cases) {
+    EXPECT_THROW_MESSAGE(ReadCapturedMotion(path), InvalidInputError, message);
   }
 }
 
@@ -226,6 +246,70 @@ TEST(CapturedMotionTest, ObservationsInterpolateLinearlyBetweenSteps) {
     FAIL();
   } catch (const InvalidInputError& e) {
     EXPECT_STREQ(e.what(), "sample 2: time 0.04 s is after the end of the simulation (3 steps of 0.01 s = 0.03 s)");
+  }
+}
+
+// A motion of marker 0 (vertex 5) sampled at `times`; `line` > 0 marks the
+// samples as read from a file, from that line on.
+CapturedMotion VertexMotion(const std::vector<double>& times, int line = 0) {
+  CapturedMotion motion;
+  motion.markers.push_back(Marker{0, 5, -1, Vec3::Zero(), 0});
+  for (size_t i = 0; i < times.size(); ++i)
+    motion.samples.push_back(
+        MarkerSample{times[i], 0, Vec3::Zero(), Vec3::Ones(), line > 0 ? line + static_cast<int>(i) : 0});
+  return motion;
+}
+
+// Sample times a simulation cannot reach, and time steps that are no time
+// steps, are refused by RequiredSteps with the exact message (never an
+// integer overflow, never a rollout of millions of steps).
+TEST(CapturedMotionTest, RequiredStepsRefusesTimesBeyondTheStepLimit) {
+  struct Case {
+    std::vector<double> times;
+    int line;
+    double time_step;
+    std::string message;
+  };
+  const Case cases[] = {
+      {{0.1, 1e300},
+       0,
+       0.01,
+       "sample 1: time 1e+300 s needs 1e+302 steps of 0.01 s, more than the limit of 100000 "
+       "(MarkerObservations::kMaxSteps)"},
+      {{1e4},
+       9,
+       0.002,
+       "line 9: time 10000 s needs 5e+06 steps of 0.002 s, more than the limit of 100000 "
+       "(MarkerObservations::kMaxSteps)"},
+      {{0.5}, 0, 0.0, "time step = 0 is invalid: must be finite and > 0 (s)"},
+      {{0.5}, 0, std::nan(""), "time step = nan is invalid: must be finite and > 0 (s)"},
+      {{0.5}, 0, -0.01, "time step = -0.01 is invalid: must be finite and > 0 (s)"},
+  };
+  for (const Case& c : cases) {
+    EXPECT_THROW_MESSAGE(MarkerObservations::RequiredSteps(VertexMotion(c.times, c.line), c.time_step),
+                         InvalidInputError, c.message);
+  }
+  EXPECT_EQ(MarkerObservations::RequiredSteps(VertexMotion({0.0, 1000.0}), 0.01), MarkerObservations::kMaxSteps);
+}
+
+// A sample far beyond the rollout's end is "after the end", however large
+// its time (it once became step INT_MIN and crashed Simulated).
+TEST(CapturedMotionTest, ObservationsRefuseSamplesAfterTheEndWithoutOverflow) {
+  const Mesh mesh = testing::BoxHexMesh(1, 1, 1, 0.1, 0.1, 0.1);
+  struct Case {
+    std::vector<double> times;
+    int line;
+    int num_steps;
+    std::string message;
+  };
+  const Case cases[] = {
+      {{0.0, 1e300}, 0, 10, "sample 1: time 1e+300 s is after the end of the simulation (10 steps of 0.01 s = 0.1 s)"},
+      {{3e9}, 4, 10, "line 4: time 3e+09 s is after the end of the simulation (10 steps of 0.01 s = 0.1 s)"},
+      {{0.0}, 0, -1, "number of steps = -1 is invalid: must be >= 0"},
+  };
+  for (const Case& c : cases) {
+    EXPECT_THROW_MESSAGE(MarkerObservations(VertexMotion(c.times, c.line), mesh, 0.01, c.num_steps), InvalidInputError,
+                         c.message);
   }
 }
 

@@ -58,6 +58,8 @@ TEST(MakeBoxHexMeshTest, RejectsBadInput) {
   EXPECT_EQ(message(Eigen::Vector3i(1, 0, 1), Vec3::Ones()), "MakeBoxHexMesh: cells(1) = 0, must be >= 1");
   EXPECT_EQ(message(Eigen::Vector3i(1, 1, 1), Vec3(1.0, 1.0, -1.0)),
             "MakeBoxHexMesh: size(2) = -1 m, must be finite and > 0");
+  EXPECT_EQ(message(Eigen::Vector3i(2000, 2000, 2000), Vec3::Ones()),
+            "MakeBoxHexMesh: cells = (2000, 2000, 2000) is 8e+09 cells, more than the limit of 1e+08");
 }
 
 }  // namespace

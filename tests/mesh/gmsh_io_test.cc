@@ -1,5 +1,6 @@
 #include "diffpd/gmsh_io.h"
 
+#include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -79,40 +80,61 @@ TEST_F(ReadGmshTest, Tets) {
   EXPECT_EQ(mesh.vertices.col(4), Vec3(1, 1, 1));
 }
 
-TEST_F(ReadGmshTest, FormatErrors) {
-  EXPECT_EQ(ErrorOf("hello\n"), "F:1: not a Gmsh MSH file (expected $MeshFormat, got 'hello')");
-  EXPECT_EQ(ErrorOf("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"),
-            "F:2: MSH version 2.2 is not supported; only 4.1 (export with 'gmsh -format msh41')");
-  EXPECT_EQ(ErrorOf("$MeshFormat\n4.1 1 8\n"),
-            "F:2: binary MSH files are not supported; export ASCII (Gmsh option Mesh.Binary = 0)");
-  EXPECT_EQ(ErrorOf(std::string(kHeader) + "$Nodes\n1 1 1 1\n3 1 0 1\n1\n0 0 0\n"),
-            "F:8: section $Nodes has no $EndNodes");
-  EXPECT_EQ(ErrorOf(std::string(kHeader) + "$Comments\nno end\n"), "F:5: section $Comments has no $EndComments");
-  EXPECT_EQ(ErrorOf(kHeader), "F: no tet4 (type 4) or hex8 (type 5) elements");
+// Five nodes (tags 1..5) of a unit tetrahedron and the point (1, 1, 1); the
+// $Elements section starts on line 19.
+const std::string kFiveNodes = std::string(kHeader) +
+                               "$Nodes\n1 5 1 5\n3 1 0 5\n1\n2\n3\n4\n5\n"
+                               "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n$EndNodes\n";
+
+// A malformed .msh text and the exact message, the path replaced by "F".
+struct BadMsh {
+  std::string text;
+  std::string message;
+};
+
+const BadMsh kBadMshs[] = {
+    {"hello\n", "F:1: not a Gmsh MSH file (expected $MeshFormat, got 'hello')"},
+    {"$MeshFormat\n2.2 0 8\n$EndMeshFormat\n",
+     "F:2: MSH version 2.2 is not supported; only 4.1 (export with 'gmsh -format msh41')"},
+    {"$MeshFormat\n4.1 1 8\n", "F:2: binary MSH files are not supported; export ASCII (Gmsh option Mesh.Binary = 0)"},
+    {std::string(kHeader) + "$Nodes\n1 1 1 1\n3 1 0 1\n1\n0 0 0\n", "F:8: section $Nodes has no $EndNodes"},
+    {std::string(kHeader) + "$Comments\nno end\n", "F:5: section $Comments has no $EndComments"},
+    {kHeader, "F: no tet4 (type 4) or hex8 (type 5) elements"},
+    {std::string(kHeader) + "$Nodes\n1 2 1 2\n3 1 0 2\n1\n1\n0 0 0\n1 0 0\n$EndNodes\n",
+     "F:8: node tag 1 appears twice"},
+    {std::string(kHeader) + "$Nodes\n-1 2 1 2\n$EndNodes\n", "F:5: numEntityBlocks must be >= 0, got -1"},
+    {std::string(kHeader) + "$Nodes\n1 3000000000 1 3000000000\n3 1 0 3000000000\n$EndNodes\n",
+     "F:6: numNodesInBlock = 3000000000 is more than the file's 95 bytes can hold"},
+    {kFiveNodes + "$Elements\n1 1 1 1\n3 1 4 2000000000\n$EndElements\n",
+     "F:20: numElementsInBlock = 2000000000 is more than the file's 156 bytes can hold"},
+    {kFiveNodes + "$Elements\n1 1 1 1\n3 1 4 1\n7 1 2 3 99\n$EndElements\n",
+     "F:21: element 7 references node tag 99, which is not in $Nodes"},
+    {kFiveNodes + "$Elements\n1 1 1 1\n3 1 5 1\n7 1 2 3 4\n$EndElements\n",
+     "F:21: element 7 has 4 node tags, expected 8 for type 5 (hex8)"},
+    {kFiveNodes + "$Elements\n1 1 1 1\n3 1 11 1\n7 1 2 3 4 5 1 2 3 4 5\n$EndElements\n",
+     "F:20: 3D element type 11 is not supported (only 4 = tet4 and 5 = hex8)"},
+    {std::string(kHeader) + kCube + "$Elements\n1 1 1 1\n3 1 4 1\n9 10 20 30 50\n$EndElements\n",
+     "F:48: the file mixes tet4 and hex8 elements (a mesh has one element type)"},
+    // Validation by ValidateMesh, with the file name as `what`.
+    {kFiveNodes + "$Elements\n1 1 1 1\n3 1 4 1\n7 1 3 2 4\n$EndElements\n",
+     "F: element 0 is inverted or degenerate (signed volume -0.166667 m^3)"},
+};
+
+TEST_F(ReadGmshTest, RejectsMalformedFilesNamingLineAndProblem) {
+  for (const BadMsh& bad : kBadMshs) EXPECT_EQ(ErrorOf(bad.text), bad.message) << bad.text;
 }
 
-TEST_F(ReadGmshTest, ContentErrors) {
-  const std::string nodes = std::string(kHeader) +
-                            "$Nodes\n1 5 1 5\n3 1 0 5\n1\n2\n3\n4\n5\n"
-                            "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n$EndNodes\n";
-  EXPECT_EQ(ErrorOf(std::string(kHeader) + "$Nodes\n1 2 1 2\n3 1 0 2\n1\n1\n0 0 0\n1 0 0\n$EndNodes\n"),
-            "F:8: node tag 1 appears twice");
-  EXPECT_EQ(ErrorOf(nodes + "$Elements\n1 1 1 1\n3 1 4 1\n7 1 2 3 99\n$EndElements\n"),
-            "F:21: element 7 references node tag 99, which is not in $Nodes");
-  EXPECT_EQ(ErrorOf(nodes + "$Elements\n1 1 1 1\n3 1 5 1\n7 1 2 3 4\n$EndElements\n"),
-            "F:21: element 7 has 4 node tags, expected 8 for type 5 (hex8)");
-  EXPECT_EQ(ErrorOf(nodes + "$Elements\n1 1 1 1\n3 1 11 1\n7 1 2 3 4 5 1 2 3 4 5\n$EndElements\n"),
-            "F:20: 3D element type 11 is not supported (only 4 = tet4 and 5 = hex8)");
-  EXPECT_EQ(ErrorOf(std::string(kHeader) + kCube + "$Elements\n1 1 1 1\n3 1 4 1\n9 10 20 30 50\n$EndElements\n"),
-            "F:48: the file mixes tet4 and hex8 elements (a mesh has one element type)");
-  // Validation by ValidateMesh, with the file name as `what`.
-  EXPECT_EQ(ErrorOf(nodes + "$Elements\n1 1 1 1\n3 1 4 1\n7 1 3 2 4\n$EndElements\n"),
-            "F: element 0 is inverted or degenerate (signed volume -0.166667 m^3)");
-}
-
-TEST_F(ReadGmshTest, MissingFile) {
+TEST_F(ReadGmshTest, RejectsPathsThatAreNotReadableFiles) {
   const std::string missing = directory_.File("missing.msh");
-  EXPECT_THROW_MESSAGE(ReadGmsh(missing), InvalidInputError, "cannot open '" + missing + "'");
+  const std::string folder = directory_.File("folder.msh");
+  std::filesystem::create_directories(folder);
+  const std::pair<std::string, std::string> cases[] = {
+      {missing, "cannot open '" + missing + "'"},
+      {folder, "cannot open '" + folder + "': it is a directory, not a file"},
+  };
+  for (const auto& [path, message] : cases) {
+    EXPECT_THROW_MESSAGE(ReadGmsh(path), InvalidInputError, message);
+  }
 }
 
 }  // namespace

@@ -85,6 +85,14 @@ TEST(SignedElementVolumeTest, UsesGivenPositions) {
   EXPECT_DOUBLE_EQ(SignedElementVolume(tet, 2.0 * tet.vertices, 0), 8.0 / 6.0);
 }
 
+// An integer cast to ElementType is refused before anything uses the type
+// (NodesPerElement would abort).
+TEST(ValidateMeshTest, UndeclaredElementType) {
+  Mesh mesh = UnitCube();
+  mesh.type = static_cast<ElementType>(7);
+  ExpectMessage(mesh, "m", "m: type = 7 is invalid: must be ElementType::kTet4 (0) or kHex8 (1)");
+}
+
 TEST(ValidateMeshTest, NoElements) { ExpectMessage(Mesh{}, "mesh", "mesh: the mesh has no elements"); }
 
 TEST(ValidateMeshTest, WrongNumberOfRows) {

@@ -1,3 +1,4 @@
+#include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -63,22 +64,54 @@ TEST_F(ReadObjTest, FanTriangulatesPolygons) {
   EXPECT_EQ(surface.triangles.col(2), Eigen::Vector3i(0, 3, 4));
 }
 
-TEST_F(ReadObjTest, Errors) {
-  EXPECT_EQ(ErrorOf("v 0 0 0\nv 1 2\n"), "F:2: expected x y z coordinates, got 'v 1 2'");
-  EXPECT_EQ(ErrorOf("v 0 abc 0\n"), "F:1: expected y coordinate (a finite number), got 'abc'");
-  EXPECT_EQ(ErrorOf("v 0 nan 0\n"), "F:1: expected y coordinate (a finite number), got 'nan'");
-  EXPECT_EQ(ErrorOf("v 0 0 0\nv 1 0 0\nf 1 2\n"), "F:3: a face needs at least 3 vertices, got 2");
-  EXPECT_EQ(ErrorOf("v 0 0 0\nf 1 1/a x\n"), "F:2: malformed face entry 'x'");
-  EXPECT_EQ(ErrorOf("v 0 0 0\nf 1 a/1 1\n"), "F:2: malformed face entry 'a/1'");
-  EXPECT_EQ(ErrorOf("v 0 0 0\nf 1 0 1\n"), "F:2: face index 0 is invalid (OBJ indices start at 1)");
-  EXPECT_EQ(ErrorOf("v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 12\nv 0 0 1\n"),
-            "F:5: face index 12 out of range (file has 4 vertices)");
-  EXPECT_EQ(ErrorOf("v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n"),
-            "F:3: face index -3 out of range (2 vertices read before this line)");
-  EXPECT_EQ(ErrorOf("# nothing\n"), "F: no vertices");
-  EXPECT_EQ(ErrorOf("v 0 0 0\n"), "F: no faces");
+// A malformed OBJ text and the exact message, the path replaced by "F".
+struct BadObj {
+  const char* text;
+  const char* message;
+};
+
+const BadObj kBadObjs[] = {
+    {"v 0 0 0\nv 1 2\n", "F:2: expected x y z coordinates, got 'v 1 2'"},
+    {"v 0 abc 0\n", "F:1: expected y coordinate (a finite number), got 'abc'"},
+    {"v 0 nan 0\n", "F:1: expected y coordinate (a finite number), got 'nan'"},
+    {"v 0 0 0\nv 1 0 0\nf 1 2\n", "F:3: a face needs at least 3 vertices, got 2"},
+    {"v 0 0 0\nf 1 1 x\n", "F:2: malformed face entry 'x'"},
+    {"v 0 0 0\nf 1 a/1 1\n", "F:2: malformed face entry 'a/1'"},
+    {"v 0 0 0\nf 1 1/a 1\n", "F:2: malformed face entry '1/a'"},
+    {"v 0 0 0\nf 1 1/ 1\n", "F:2: malformed face entry '1/'"},
+    {"v 0 0 0\nf 1 1// 1\n", "F:2: malformed face entry '1//'"},
+    {"v 0 0 0\nf 1 1/1/a 1\n", "F:2: malformed face entry '1/1/a'"},
+    {"v 0 0 0\nf 1 1/1/1/1 1\n", "F:2: malformed face entry '1/1/1/1'"},
+    {"v 0 0 0\nf 1 /1 1\n", "F:2: malformed face entry '/1'"},
+    {"v 0 0 0\nf 1 0 1\n", "F:2: face index 0 is invalid (OBJ indices start at 1)"},
+    {"v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 12\nv 0 0 1\n", "F:5: face index 12 out of range (file has 4 vertices)"},
+    {"v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n", "F:3: face index -3 out of range (2 vertices read before this line)"},
+    {"# nothing\n", "F: no vertices"},
+    {"v 0 0 0\n", "F: no faces"},
+};
+
+TEST_F(ReadObjTest, RejectsMalformedFilesNamingLineAndProblem) {
+  for (const BadObj& bad : kBadObjs) EXPECT_EQ(ErrorOf(bad.text), bad.message) << bad.text;
+}
+
+TEST_F(ReadObjTest, RejectsPathsThatAreNotReadableFiles) {
   const std::string missing = directory_.File("missing.obj");
-  EXPECT_THROW_MESSAGE(ReadObj(missing), InvalidInputError, "cannot open '" + missing + "'");
+  const std::string folder = directory_.File("folder.obj");
+  std::filesystem::create_directories(folder);
+  const std::pair<std::string, std::string> cases[] = {
+      {missing, "cannot open '" + missing + "'"},
+      {folder, "cannot open '" + folder + "': it is a directory, not a file"},
+  };
+  for (const auto& [path, message] : cases) {
+    EXPECT_THROW_MESSAGE(ReadObj(path), InvalidInputError, message);
+  }
+}
+
+TEST_F(ReadObjTest, AcceptsEveryDocumentedFaceEntryForm) {
+  const SurfaceMesh surface = ReadObj(Write("forms.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2/7 3//-2\nf 3/1/1 2 -3\n"));
+  ASSERT_EQ(surface.triangles.cols(), 2);
+  EXPECT_EQ(surface.triangles.col(0), Eigen::Vector3i(0, 1, 2));
+  EXPECT_EQ(surface.triangles.col(1), Eigen::Vector3i(2, 1, 0));
 }
 
 TEST_F(ReadObjTest, ForwardReferencesAreAllowed) {

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 
 #include <stdexcept>
+#include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -67,25 +68,58 @@ TEST_F(TetGenTest, ReadsZeroBasedFiles) {
   EXPECT_EQ(mesh.elements.col(1), Eigen::Vector4i(1, 4, 2, 3));
 }
 
-TEST_F(TetGenTest, Errors) {
-  EXPECT_EQ(ErrorOf("5 2 0 0\n", kEle1), "N:1: expected dimension 3, got 2");
-  EXPECT_EQ(ErrorOf("x 3 0 0\n", kEle1), "N:1: expected the number of points, got 'x'");
-  EXPECT_EQ(ErrorOf("2 3 0 0\n5 0 0 0\n", kEle1), "N:2: first point number must be 0 or 1, got 5");
-  EXPECT_EQ(ErrorOf("3 3 0 0\n1 0 0 0\n2 1 0 0\n4 0 1 0\n", kEle1), "N:4: point number 4 out of sequence (expected 3)");
-  EXPECT_EQ(ErrorOf("5 3 0 0\n1 0 0 0\n2 1 0 0\n", kEle1), "N: file ends after 2 of 5 points");
-  EXPECT_EQ(ErrorOf("1 3 0 0\n1 0 0\n", kEle1), "N:2: expected z coordinate, got end of line");
-  EXPECT_EQ(ErrorOf(kNodes1, "2 10 0\n"), "E:1: only 4-node tetrahedra are supported, got 10 nodes per tetrahedron");
-  EXPECT_EQ(ErrorOf(kNodes1, "2 4 0\n1 1 2 3 4\n2 2 5 3 9\n"),
-            "E:3: node 9 out of range (the .node file numbers its 5 points 1..5)");
-  EXPECT_EQ(ErrorOf(kNodes1, "2 4 0\n1 1 2 3 4\n"), "E: file ends after 1 of 2 tetrahedra");
-  EXPECT_EQ(ErrorOf(kNodes1, "2 4 0\n1 1 2 3 4\n3 2 5 3 4\n"),
-            "E:3: tetrahedron number 3 out of sequence (expected 2)");
-  // Validation by ValidateMesh, with the .ele path as `what`.
-  EXPECT_EQ(ErrorOf(kNodes1, "2 4 0\n1 1 2 3 4\n2 2 3 5 4\n"),
-            "E: element 1 is inverted or degenerate (signed volume -0.333333 m^3)");
-  EXPECT_EQ(ErrorOf(kNodes1, "1 4 0\n1 1 2 3 4\n"), "E: vertex 4 is not referenced by any element");
+// A malformed .node/.ele pair and the exact message, the paths replaced by
+// "N" and "E".
+struct BadTetGen {
+  std::string nodes;
+  std::string elements;
+  std::string message;
+};
+
+const BadTetGen kBadTetGens[] = {
+    {"5 2 0 0\n", kEle1, "N:1: expected dimension 3, got 2"},
+    {"x 3 0 0\n", kEle1, "N:1: expected the number of points, got 'x'"},
+    {"-2 3 0 0\n", kEle1, "N:1: the number of points must be >= 0, got -2"},
+    {"1000000000 3 0 0\n1 0 0 0\n", kEle1,
+     "N:1: the number of points = 1000000000 is more than the file's 25 bytes can hold"},
+    {"99999999999999 3 0 0\n", kEle1,
+     "N:1: the number of points = 99999999999999 is more than the file's 21 bytes can hold"},
+    {"2 3 0 0\n5 0 0 0\n", kEle1, "N:2: first point number must be 0 or 1, got 5"},
+    {"3 3 0 0\n1 0 0 0\n2 1 0 0\n4 0 1 0\n", kEle1, "N:4: point number 4 out of sequence (expected 3)"},
+    {"5 3 0 0\n1 0 0 0\n2 1 0 0\n", kEle1, "N: file ends after 2 of 5 points"},
+    {"1 3 0 0\n1 0 0\n", kEle1, "N:2: expected z coordinate, got end of line"},
+    {kNodes1, "2 10 0\n", "E:1: only 4-node tetrahedra are supported, got 10 nodes per tetrahedron"},
+    {kNodes1, "4000000000 4 0\n",
+     "E:1: the number of tetrahedra = 4000000000 is more than the file's 15 bytes can hold"},
+    {kNodes1, "2 4 0\n1 1 2 3 4\n2 2 5 3 9\n", "E:3: node 9 out of range (the .node file numbers its 5 points 1..5)"},
+    {kNodes1, "2 4 0\n1 1 2 3 4\n", "E: file ends after 1 of 2 tetrahedra"},
+    {kNodes1, "2 4 0\n1 1 2 3 4\n3 2 5 3 4\n", "E:3: tetrahedron number 3 out of sequence (expected 2)"},
+    // Validation by ValidateMesh, with the .ele path as `what`.
+    {kNodes1, "2 4 0\n1 1 2 3 4\n2 2 3 5 4\n", "E: element 1 is inverted or degenerate (signed volume -0.333333 m^3)"},
+    {kNodes1, "1 4 0\n1 1 2 3 4\n", "E: vertex 4 is not referenced by any element"},
+};
+
+TEST_F(TetGenTest, RejectsMalformedFilesNamingLineAndProblem) {
+  for (const BadTetGen& bad : kBadTetGens)
+    EXPECT_EQ(ErrorOf(bad.nodes, bad.elements), bad.message) << bad.nodes << "---\n" << bad.elements;
+}
+
+TEST_F(TetGenTest, RejectsPathsThatAreNotReadableFiles) {
   const std::string missing = directory_.File("missing.node");
-  EXPECT_THROW_MESSAGE(ReadTetGen(missing, missing), InvalidInputError, "cannot open '" + missing + "'");
+  const std::string folder = directory_.File("folder.node");
+  std::filesystem::create_directories(folder);
+  const std::string nodes = Write("ok.node", kNodes1);
+  struct Case {
+    std::string node_path, ele_path, message;
+  };
+  const Case cases[] = {
+      {missing, missing, "cannot open '" + missing + "'"},
+      {folder, folder, "cannot open '" + folder + "': it is a directory, not a file"},
+      {nodes, folder, "cannot open '" + folder + "': it is a directory, not a file"},
+  };
+  for (const Case& c : cases) {
+    EXPECT_THROW_MESSAGE(ReadTetGen(c.node_path, c.ele_path), InvalidInputError, c.message);
+  }
 }
 
 bool HaveTetGen() { return !internal::FindOnPath("tetgen").empty(); }
@@ -129,15 +163,28 @@ TEST(TetrahedralizeSurfaceTest, Errors) {
   EXPECT_EQ(message(sphere, "pq", 1.0), "tetgen program not found: install the Debian package 'tetgen'");
   setenv("PATH", path.c_str(), 1);
 
-  if (!HaveTetGen()) GTEST_SKIP() << "the tetgen program is not installed";
-  SurfaceMesh triangle;  // not a closed surface: TetGen gives up
+  SurfaceMesh triangle;  // an open surface: refused before TetGen runs
   triangle.vertices.resize(3, 3);
   triangle.vertices << 0, 1, 0,  //
       0, 0, 1,                   //
       0, 0, 0;
   triangle.triangles.resize(3, 1);
   triangle.triangles << 0, 1, 2;
-  const std::string failure = message(triangle, "pq1.414Y", 1.0);
+  EXPECT_EQ(message(triangle, "pq1.414Y", 1.0),
+            "TetrahedralizeSurface: the surface is not closed: 3 boundary edges, the first (0, 1) (a closed surface "
+            "has every edge in an even number of triangles)");
+
+  if (!HaveTetGen()) GTEST_SKIP() << "the tetgen program is not installed";
+  SurfaceMesh flat;  // closed but of zero volume: TetGen gives up
+  flat.vertices.resize(3, 4);
+  flat.vertices << 0, 1, 0, 1,  //
+      0, 0, 1, 1,               //
+      0, 0, 0, 0;
+  flat.triangles.resize(3, 4);
+  flat.triangles << 0, 0, 0, 1,  //
+      2, 1, 3, 2,                //
+      1, 3, 2, 3;
+  const std::string failure = message(flat, "pq1.414Y", 1.0);
   EXPECT_EQ(failure.rfind("tetgen failed (", 0), 0u) << failure;
   EXPECT_NE(failure.find(") with switches 'pq1.414Y': "), std::string::npos) << failure;
 }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -86,19 +87,31 @@ TEST(VoxelizeSdfTest, DropsUnusedNodesAndNumbersInGridOrder) {
   EXPECT_NO_THROW(ValidateMesh(mesh));
 }
 
+// A call that must throw InvalidInputError, and its exact message.
+struct Rejection {
+  std::function<void()> call;
+  std::string message;
+};
+
+void ExpectRejections(const std::vector<Rejection>& rejections) {
+  for (const Rejection& r : rejections) EXPECT_EQ(ErrorOf(r.call), r.message);
+}
+
 TEST(VoxelizeSdfTest, RejectsBadInput) {
   const auto sphere = [](const Vec3& x) { return x.norm() - 0.05; };
-  const Eigen::Vector3i cells(4, 4, 4);
-  EXPECT_EQ(ErrorOf([&] { VoxelizeSdf(sphere, Vec3::Constant(1.0), cells, 0.01); }),
-            "VoxelizeSdf: no cell centre has sdf < 0");
-  EXPECT_EQ(ErrorOf([&] { VoxelizeSdf(sphere, Vec3::Zero(), cells, 0.0); }),
-            "VoxelizeSdf: dx = 0, must be finite and > 0");
-  EXPECT_EQ(ErrorOf([&] { VoxelizeSdf(sphere, Vec3::Zero(), Eigen::Vector3i(4, -1, 4), 0.01); }),
-            "VoxelizeSdf: cells(1) = -1, must be >= 1");
-  EXPECT_EQ(ErrorOf([&] { VoxelizeSdf(nullptr, Vec3::Zero(), cells, 0.01); }), "VoxelizeSdf: sdf is empty");
   const auto nan = [](const Vec3&) { return std::numeric_limits<double>::quiet_NaN(); };
-  EXPECT_EQ(ErrorOf([&] { VoxelizeSdf(nan, Vec3::Zero(), Eigen::Vector3i(1, 1, 1), 1.0); }),
-            "VoxelizeSdf: sdf returned NaN at cell centre (0.5 0.5 0.5)");
+  const Eigen::Vector3i cells(4, 4, 4);
+  ExpectRejections({
+      {[&] { VoxelizeSdf(sphere, Vec3::Constant(1.0), cells, 0.01); }, "VoxelizeSdf: no cell centre has sdf < 0"},
+      {[&] { VoxelizeSdf(sphere, Vec3::Zero(), cells, 0.0); }, "VoxelizeSdf: dx = 0, must be finite and > 0"},
+      {[&] { VoxelizeSdf(sphere, Vec3::Zero(), Eigen::Vector3i(4, -1, 4), 0.01); },
+       "VoxelizeSdf: cells(1) = -1, must be >= 1"},
+      {[&] { VoxelizeSdf(nullptr, Vec3::Zero(), cells, 0.01); }, "VoxelizeSdf: sdf is empty"},
+      {[&] { VoxelizeSdf(nan, Vec3::Zero(), Eigen::Vector3i(1, 1, 1), 1.0); },
+       "VoxelizeSdf: sdf returned NaN at cell centre (0.5 0.5 0.5)"},
+      {[&] { VoxelizeSdf(sphere, Vec3::Zero(), Eigen::Vector3i(100000, 100000, 100000), 1e-6); },
+       "VoxelizeSdf: cells = (100000, 100000, 100000) is 1e+15 cells, more than the limit of 1e+08"},
+  });
 }
 
 TEST(VoxelizeSurfaceTest, UnitCube) {
@@ -156,25 +169,66 @@ TEST(VoxelizeSurfaceTest, SphereVolumeMatchesSurface) {
 }
 
 TEST(VoxelizeSurfaceTest, RejectsBadInput) {
-  SurfaceMesh triangle;
+  SurfaceMesh triangle;  // open: three boundary edges
   triangle.vertices.resize(3, 3);
   triangle.vertices << 0, 1, 0,  //
       0, 0, 1,                   //
       0, 0, 0;
   triangle.triangles.resize(3, 1);
   triangle.triangles << 0, 1, 2;
-  EXPECT_EQ(ErrorOf([&] { VoxelizeSurface(triangle, 0.5); }),
-            "VoxelizeSurface: no cell centre lies inside the surface (dx = 0.5, grid 2 x 2 x 1 cells); "
-            "use a smaller dx or check that the surface is closed");
-  EXPECT_EQ(ErrorOf([&] { VoxelizeSurface(triangle, -0.5); }), "VoxelizeSurface: dx = -0.5, must be finite and > 0");
-  EXPECT_EQ(ErrorOf([&] { VoxelizeSurface(triangle, 0.5, 0.0); }),
-            "VoxelizeSurface: scale = 0, must be finite and > 0");
-  EXPECT_EQ(ErrorOf([&] { VoxelizeSurface(triangle, 1e-5); }),
-            "VoxelizeSurface: dx = 1e-05 gives more than 2^31 cells for a bounding box of size (1 1 0)");
-  triangle.triangles(2, 0) = 3;
-  EXPECT_EQ(ErrorOf([&] { VoxelizeSurface(triangle, 0.5); }),
-            "VoxelizeSurface: triangle 0 references vertex 3, but the surface has 3 vertices");
-  EXPECT_EQ(ErrorOf([&] { VoxelizeSurface(SurfaceMesh{}, 0.5); }), "VoxelizeSurface: the surface has no triangles");
+  SurfaceMesh bad_index = triangle;
+  bad_index.triangles(2, 0) = 3;
+  SurfaceMesh open_box = BoxSurface(Vec3::Zero(), Vec3::Ones());  // the box without its last triangle
+  open_box.triangles.conservativeResize(3, 11);
+  SurfaceMesh flat;  // closed but of zero volume
+  flat.vertices.resize(3, 4);
+  flat.vertices << 0, 1, 0, 1,  //
+      0, 0, 1, 1,               //
+      0, 0, 0, 0;
+  flat.triangles.resize(3, 4);
+  flat.triangles << 0, 0, 0, 1,  //
+      2, 1, 3, 2,                //
+      1, 3, 2, 3;
+  const SurfaceMesh box = BoxSurface(Vec3::Zero(), Vec3(1, 1, 0.5));
+  ExpectRejections({
+      {[&] { VoxelizeSurface(flat, 0.5); },
+       "VoxelizeSurface: no cell centre lies inside the surface (dx = 0.5, grid 2 x 2 x 1 cells); "
+       "use a smaller dx or check that the surface is closed"},
+      {[&] { VoxelizeSurface(box, -0.5); }, "VoxelizeSurface: dx = -0.5, must be finite and > 0"},
+      {[&] { VoxelizeSurface(box, 0.5, 0.0); }, "VoxelizeSurface: scale = 0, must be finite and > 0"},
+      {[&] { VoxelizeSurface(box, 1e-5); },
+       "VoxelizeSurface: cells = (100000, 100000, 50000) is 5e+14 cells, more than the limit of 1e+08 (dx = 1e-05 "
+       "for a bounding box of size (  1   1 0.5))"},
+      {[&] { VoxelizeSurface(bad_index, 0.5); },
+       "VoxelizeSurface: triangle 0 references vertex 3, but the surface has 3 vertices"},
+      {[&] { VoxelizeSurface(SurfaceMesh{}, 0.5); }, "VoxelizeSurface: the surface has no triangles"},
+      {[&] { VoxelizeSurface(triangle, 0.5); },
+       "VoxelizeSurface: the surface is not closed: 3 boundary edges, the first (0, 1) (a closed surface has every "
+       "edge in an even number of triangles)"},
+      {[&] { VoxelizeSurface(open_box, 0.5); },
+       "VoxelizeSurface: the surface is not closed: 3 boundary edges, the first (1, 3) (a closed surface has every "
+       "edge in an even number of triangles)"},
+  });
+}
+
+// Surfaces that meet themselves along an edge (four triangles there, as in
+// the shared plant and cow meshes) are closed: the parity of ray crossings
+// still separates inside from outside.
+TEST(VoxelizeSurfaceTest, AcceptsClosedSurfacesTouchingAlongAnEdge) {
+  SurfaceMesh two = BoxSurface(Vec3::Zero(), Vec3::Ones());
+  const SurfaceMesh other = BoxSurface(Vec3(1, 1, 0), Vec3(2, 2, 1));  // shares the edge x = y = 1
+  two.vertices.conservativeResize(3, 16);
+  two.vertices.rightCols(8) = other.vertices;
+  two.triangles.conservativeResize(3, 24);
+  two.triangles.rightCols(12) = other.triangles.array() + 8;
+  // Weld the shared edge's two corners so that the edge is in four triangles.
+  for (int t = 12; t < 24; ++t)
+    for (int c = 0; c < 3; ++c) {
+      if (two.triangles(c, t) == 8) two.triangles(c, t) = 6;  // (1, 1, 0)
+      if (two.triangles(c, t) == 9) two.triangles(c, t) = 7;  // (1, 1, 1)
+    }
+  const Mesh mesh = VoxelizeSurface(two, 0.25);
+  EXPECT_NEAR(TotalVolume(mesh), 2.0, 1e-12);
 }
 
 }  // namespace

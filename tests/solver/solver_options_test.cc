@@ -2,7 +2,11 @@
 // the input and its valid range.
 #include <gtest/gtest.h>
 
+#include <omp.h>
+
 #include <cmath>
+#include <functional>
+#include <string>
 
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
@@ -18,33 +22,61 @@ std::string MessageOf(F&& f) {
   return testing::MessageOf<InvalidInputError>(std::forward<F>(f));
 }
 
+// One spoilt field of the default options and the exact message.
+struct BadOptions {
+  std::function<void(SolverOptions*)> spoil;
+  std::string message;
+};
+
 TEST(SolverOptionsTest, InvalidFieldsAreRejectedWithTheFieldAndRange) {
-  SolverOptions o;
-  o.time_step = 0;
-  EXPECT_EQ(MessageOf([&] { o.Validate(); }), "solver options: time_step = 0 is invalid: must be finite and > 0 (s)");
-  o = SolverOptions();
-  o.time_step = NAN;
-  EXPECT_EQ(MessageOf([&] { o.Validate(); }), "solver options: time_step = nan is invalid: must be finite and > 0 (s)");
-  o = SolverOptions();
-  o.rel_tolerance = 1.5;
-  EXPECT_EQ(MessageOf([&] { o.Validate(); }), "solver options: rel_tolerance = 1.5 is invalid: must be in [0, 1)");
-  o = SolverOptions();
-  o.max_iterations = 0;
-  EXPECT_EQ(MessageOf([&] { o.Validate(); }), "solver options: max_iterations = 0 is invalid: must be >= 1");
-  o = SolverOptions();
-  o.num_threads = -2;
-  EXPECT_EQ(MessageOf([&] { o.Validate(); }),
-            "solver options: num_threads = -2 is invalid: must be >= 0 (0: OpenMP default)");
-  o = SolverOptions();
-  o.lbfgs_weight_scale = 0;
-  EXPECT_EQ(MessageOf([&] { o.Validate(); }), "solver options: lbfgs_weight_scale = 0 is invalid: must be in (0, 1]");
-  o.lbfgs_weight_scale = 1.5;
-  EXPECT_EQ(MessageOf([&] { o.Validate(); }), "solver options: lbfgs_weight_scale = 1.5 is invalid: must be in (0, 1]");
-  o = SolverOptions();
-  o.abs_tolerance = 0;
-  o.rel_tolerance = 0;
-  EXPECT_EQ(MessageOf([&] { o.Validate(); }),
-            "solver options: abs_tolerance and rel_tolerance are both 0; at least one must be > 0");
+  const std::string threads = std::to_string(MaxSolverThreads());
+  const std::string processors = std::to_string(omp_get_num_procs());
+  const BadOptions cases[] = {
+      {[](SolverOptions* o) { o->time_step = 0; },
+       "solver options: time_step = 0 is invalid: must be finite and > 0 (s)"},
+      {[](SolverOptions* o) { o->time_step = NAN; },
+       "solver options: time_step = nan is invalid: must be finite and > 0 (s)"},
+      {[](SolverOptions* o) { o->rel_tolerance = 1.5; },
+       "solver options: rel_tolerance = 1.5 is invalid: must be in [0, 1)"},
+      {[](SolverOptions* o) { o->max_iterations = 0; }, "solver options: max_iterations = 0 is invalid: must be >= 1"},
+      {[](SolverOptions* o) { o->num_threads = -2; }, "solver options: num_threads = -2 is invalid: must be in [0, " +
+                                                          threads + "] (0: OpenMP default; at most 4 x the " +
+                                                          processors + " processors)"},
+      {[](SolverOptions* o) { o->num_threads = 99999; },
+       "solver options: num_threads = 99999 is invalid: must be in [0, " + threads +
+           "] (0: OpenMP default; at most 4 x the " + processors + " processors)"},
+      {[](SolverOptions* o) { o->lbfgs_weight_scale = 0; },
+       "solver options: lbfgs_weight_scale = 0 is invalid: must be in (0, 1]"},
+      {[](SolverOptions* o) { o->lbfgs_weight_scale = 1.5; },
+       "solver options: lbfgs_weight_scale = 1.5 is invalid: must be in (0, 1]"},
+      {[](SolverOptions* o) { o->abs_tolerance = o->rel_tolerance = 0; },
+       "solver options: abs_tolerance and rel_tolerance are both 0; at least one must be > 0"},
+      {[](SolverOptions* o) { o->max_extent_ratio = 1; },
+       "solver options: max_extent_ratio = 1 is invalid: must be > 1 (infinity: no bound)"},
+      {[](SolverOptions* o) { o->max_extent_ratio = NAN; },
+       "solver options: max_extent_ratio = nan is invalid: must be > 1 (infinity: no bound)"},
+      // Integers cast to the enums.
+      {[](SolverOptions* o) { o->method = static_cast<Method>(7); },
+       "solver options: method = 7 is invalid: must be a Method: semi-implicit (0), newton-cholesky (1), newton-pcg "
+       "(2), pd (3) or pd-lbfgs (4)"},
+      {[](SolverOptions* o) { o->method = static_cast<Method>(-1); },
+       "solver options: method = -1 is invalid: must be a Method: semi-implicit (0), newton-cholesky (1), newton-pcg "
+       "(2), pd (3) or pd-lbfgs (4)"},
+      {[](SolverOptions* o) { o->pcg_preconditioner = static_cast<PcgPreconditioner>(2); },
+       "solver options: pcg_preconditioner = 2 is invalid: must be kJacobi (0) or kIncompleteCholesky (1)"},
+      {[](SolverOptions* o) { o->pd_backward = static_cast<PdBackwardMethod>(3); },
+       "solver options: pd_backward = 3 is invalid: must be kFixedPoint (0), kLbfgs (1) or kConjugateGradient (2)"},
+  };
+  for (const BadOptions& c : cases) {
+    SolverOptions o;
+    c.spoil(&o);
+    EXPECT_EQ(MessageOf([&] { o.Validate(); }), c.message);
+    // The simulator validates the same way, at construction and in SetOptions.
+    EXPECT_EQ(MessageOf([&] { Simulator(testing::SmallBeamScene(), o); }), c.message);
+  }
+  SolverOptions most;
+  most.num_threads = MaxSolverThreads();
+  EXPECT_NO_THROW(most.Validate());
 }
 
 TEST(SolverOptionsTest, MethodNamesRoundTripAndUnknownNamesAreListed) {
@@ -84,7 +116,7 @@ TEST(SolverOptionsTest, BadScenesAndInputsAreRejected) {
   EXPECT_EQ(MessageOf([&] { sim.Step(sim.RestState(), in); }), "external_force has a non-finite entry");
 }
 
-TEST(SolverOptionsTest, AnExplicitStepTooLargeIsReportedAsNonFinite) {
+TEST(SolverOptionsTest, AnExplicitStepTooLargeIsReportedAsDiverged) {
   Scene scene = testing::SmallBeamScene();
   scene.material.youngs_modulus = 1e9;
   SolverOptions o;
@@ -97,7 +129,7 @@ TEST(SolverOptionsTest, AnExplicitStepTooLargeIsReportedAsNonFinite) {
     for (int k = 0; k < 2000; ++k) s = sim.Step(s, StepInput());
     FAIL() << "expected SolverError";
   } catch (const SolverError& e) {
-    EXPECT_EQ(e.status(), SolverStatus::kNonFinite);
+    EXPECT_EQ(e.status(), SolverStatus::kDiverged) << e.what();
   }
 }
 

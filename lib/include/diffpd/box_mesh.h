@@ -17,7 +17,9 @@ namespace diffpd {
 // Result: (nx+1)(ny+1)(nz+1) vertices, nx ny nz elements, each of volume
 // size_x size_y size_z / (nx ny nz).
 // Throws InvalidInputError if a cell count is < 1, a size is not finite and
-// > 0, or the origin is not finite.
+// > 0, the origin is not finite, or the grid has more than 10^8 cells
+// ("MakeBoxHexMesh: cells = (2000, 2000, 2000) is 8e+09 cells, more than the
+// limit of 1e+08").
 Mesh MakeBoxHexMesh(const Eigen::Vector3i& cells, const Vec3& size, const Vec3& origin = Vec3::Zero());
 
 }  // namespace diffpd

@@ -18,7 +18,8 @@
 //   [-1, 1]^3 of the trilinear map (mesh.h's node convention).
 // - The header names the sample columns: time (s, >= 0, measured from the
 //   initial state of the simulation), marker (a declared id), position x, y,
-//   z (m), and optionally per-axis weights wx, wy, wz (>= 0, default 1). A
+//   z (m, each within +-kMaxMarkerCoordinate), and optionally per-axis
+//   weights wx, wy, wz (in [0, kMaxMarkerWeight], default 1). A
 //   calibration residual is weight * (simulated - captured), so a weight is
 //   the inverse standard deviation of that coordinate (1/m) up to a common
 //   factor, and 0 ignores it.
@@ -36,6 +37,15 @@
 #include "diffpd/types.h"
 
 namespace diffpd {
+
+// The largest marker coordinate magnitude accepted (m): 1000 km. Larger
+// values are not the motion of a simulated body (and their squares, in a
+// calibration's cost, overflow double precision near 1e154).
+inline constexpr double kMaxMarkerCoordinate = 1e6;
+// The largest per-axis weight accepted (1/m): the inverse of a picometre.
+// With coordinates bounded as above, every weighted residual and its square
+// stay far inside double precision.
+inline constexpr double kMaxMarkerWeight = 1e12;
 
 // A point fixed in the material: a mesh vertex, or a point of an element.
 struct Marker {
@@ -67,14 +77,15 @@ struct CapturedMotion {
   // messages as ReadCapturedMotion (prefixed by `what` and the line when the
   // record came from a file, e.g. "plant.csv:12: ..."): a repeated or
   // negative marker id, a marker that is neither a vertex nor an element
-  // point, a non-finite value, a negative time or weight, an unknown marker
-  // id, a marker whose times do not increase, no marker or no sample.
+  // point, a non-finite value, a negative time or weight, a coordinate
+  // beyond kMaxMarkerCoordinate, an unknown marker id, a marker whose times
+  // do not increase, no marker or no sample.
   void Validate(const std::string& what = "captured motion") const;
 };
 
 // Reads and validates a captured-motion file. Throws InvalidInputError,
 // "<path>:<line>: <problem>" for a bad line, e.g.
-//   "cannot open 'm.csv'"
+//   "cannot open 'm.csv'", "cannot open 'm': it is a directory, not a file"
 //   "m.csv:3: expected 'marker,<id>,vertex,<v>' or 'marker,<id>,element,<e>,<c0>,<c1>,<c2>', got 'marker,1,vertex'"
 //   "m.csv:4: marker id 1 is declared twice (first on line 3)"
 //   "m.csv:5: marker declarations must come before the header"
@@ -83,8 +94,10 @@ struct CapturedMotion {
 //   "m.csv:7: x is not a number: 'abc'"
 //   "m.csv:7: marker is not an integer: '1.5'"
 //   "m.csv:7: y = inf is not finite"
+//   "m.csv:7: x = 1e+300 is invalid: must be within +-1000000 (m)"
 //   "m.csv:7: time = -0.1 is invalid: must be >= 0 (s)"
 //   "m.csv:7: wz = -1 is invalid: weights must be >= 0"
+//   "m.csv:7: wx = 1e+300 is invalid: weights must be <= 1000000000000 (1/m)"
 //   "m.csv:7: unknown marker id 9 (declared ids: 0, 1)"
 //   "m.csv:9: time 0.1 of marker 0 is not after its previous sample at time 0.2 (line 8): times must increase strictly
 //   per marker" "m.csv: no marker declared", "m.csv: no samples"
@@ -133,11 +146,17 @@ class MarkerObservations {
 
   // Throws what CapturedMotion::Validate throws, what MarkerStencil throws
   // (prefixed by "line <l>: " for markers declared in a file),
-  // InvalidInputError if h is not finite and > 0, and
+  // InvalidInputError if h is not finite and > 0 ("time step = 0 is invalid:
+  // must be finite and > 0 (s)") or num_steps < 0, and
   //   "line 12: time 2.5 s is after the end of the simulation (100 steps of 0.01 s = 1 s)"
   // ("sample <index>: ..." for a sample not from a file)
   // (times within 1e-9 h of the end are accepted).
   MarkerObservations(const CapturedMotion& motion, const Mesh& mesh, double time_step, int num_steps);
+
+  // The most steps a captured motion may span (RequiredSteps): 10^5. A
+  // calibration keeps its whole rollout for the backward pass, 2 x 3n
+  // doubles per step: 10^5 steps of a 1000-node mesh are 4.8 GB.
+  static constexpr int kMaxSteps = 100000;
 
   int num_samples() const { return static_cast<int>(terms_.size()); }
   int num_steps() const { return num_steps_; }
@@ -157,7 +176,11 @@ class MarkerObservations {
   // (sample s axis d at 3 s + d).
   VectorXd Residuals(const std::vector<State>& states) const;
 
-  // Number of simulation steps needed to reach the latest sample time.
+  // Number of simulation steps needed to reach the latest sample time (at
+  // least 1). Throws InvalidInputError for a time step that is not finite
+  // and > 0, and when it would exceed kMaxSteps:
+  //   "line 9: time 10000 s needs 5e+06 steps of 0.002 s, more than the limit of 100000
+  //   (MarkerObservations::kMaxSteps)" ("sample <index>: ..." for a sample not from a file).
   static int RequiredSteps(const CapturedMotion& motion, double time_step);
 
  private:

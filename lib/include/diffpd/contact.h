@@ -68,10 +68,12 @@
 //   "scene: frictional_contacts[0].surface.normal = (0, 0, 0) is invalid: must be finite with non-zero length",
 //   "scene: frictional_contacts[0].surface.radius = 0 is invalid: must be finite and > 0 (m)",
 //   "scene: frictional_contacts[0].surface: a height field needs both height and height_gradient",
+//   "scene: frictional_contacts[0].surface.kind = 7 is invalid: must be kPlane (0), kSphere (1) or kHeightField (2)",
 //   "scene: frictional_contacts[0].nodes[2] = 45 is out of range [0, 45) (no such node)",
 //   "scene: node 40 is a candidate of frictional_contacts[0] and frictional_contacts[1] (a node may be a
 //    frictional contact candidate once)",
 //   "scene: frictional_contacts[0].nodes[2] = 0 has a Dirichlet DoF; frictional contact candidates must be free",
+//   "scene: frictional_contact_options.pd_linear_solve = 5 is invalid: must be kWoodbury (0) or kRefactorize (1)",
 //   "scene: frictional_contact_options.max_passes = 0 is invalid: must be >= 1",
 //   "scene: frictional_contact_options.penetration_tolerance = -1 is invalid: must be finite and >= 0 (m)",
 //   "scene: frictional_contact_options.screening_rel_tolerance = 1 is invalid: must be finite and in [0, 1)",

@@ -29,7 +29,8 @@ enum class SolverStatus {
   kNonFinite,             // a NaN or infinity appeared in the state or a residual
   kFactorizationFailed,   // the (sparse) matrix was not positive definite
   kInvertedElement,       // a material that cannot handle inversion met J <= 0
-  kDiverged,              // an iterative linear solve's residual grew or stagnated
+  kDiverged,              // an iterative linear solve's residual grew or stagnated, or a step
+                          // tore the body apart (SolverOptions::max_extent_ratio)
   kActiveSetNotConverged  // the contact active-set loop did not settle
 };
 

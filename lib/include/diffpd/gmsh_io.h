@@ -16,7 +16,9 @@ namespace diffpd {
 // order they appear in $Nodes; elements keep their order in the file.
 // The mesh is validated with ValidateMesh(mesh, path).
 // Throws InvalidInputError "<path>:<line>: <message>", for example
-//   "cannot open '<path>'",
+//   "cannot open '<path>'", "cannot open '<path>': it is a directory, not a file",
+//   "<path>:6: numNodesInBlock = 3000000000 is more than the file's 95 bytes can hold"
+//   (every count is checked against the file's size before it is used),
 //   "<path>:1: not a Gmsh MSH file (expected $MeshFormat, got 'foo')",
 //   "<path>:2: MSH version 2.2 is not supported; only 4.1 (export with 'gmsh -format msh41')",
 //   "<path>:2: binary MSH files are not supported; export ASCII (Gmsh option Mesh.Binary = 0)",

@@ -64,7 +64,11 @@ enum class ElasticEnergy {
   kPdVolume,
 };
 
+// Its name ("linear", ..., "pd-volume"); aborts for a value that is no
+// ElasticEnergy (Scene::Validate refuses those first).
 const char* ToString(ElasticEnergy energy);
+// True for the five declared values (false for an integer cast to the enum).
+bool IsElasticEnergy(ElasticEnergy energy);
 // True for energies of the PD form (w/2) min_{P in M} |F - P|^2.
 bool IsProjective(ElasticEnergy energy);
 

@@ -37,6 +37,7 @@ struct Mesh {
 // `what` names the mesh in messages (e.g. a file name). Checks, in order, and
 // their messages (indices are 0-based; volumes in m^3, printed with 6
 // significant digits):
+//  0. a declared type:          "<what>: type = 7 is invalid: must be ElementType::kTet4 (0) or kHex8 (1)"
 //  1. at least one element:     "<what>: the mesh has no elements"
 //  2. k rows in `elements`:     "<what>: elements must have 8 rows for hex8, got 4"
 //  3. finite coordinates:       "<what>: vertex 5 has a non-finite coordinate"

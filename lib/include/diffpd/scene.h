@@ -70,16 +70,22 @@ struct Scene {
   // region 1 lists element 5 twice"), shares an element with an earlier
   // region ("scene: element 5 is in material regions 0 and 1") or has an
   // invalid material ("scene: material region 1: youngs_modulus = 0 is
-  // invalid: ..."); no energy, Dirichlet DoF out of range or not increasing, a
-  // size mismatch, or a non-finite gravity/Dirichlet value; then the optional
-  // terms (messages listed in muscle.h, contact.h and state_forces.h).
+  // invalid: ..."); no energy or one that is no ElasticEnergy ("scene:
+  // energies[1] = 9 is invalid: must be an ElasticEnergy, 0 (linear) to 4
+  // (pd-volume)"), Dirichlet DoF out of range or not increasing, a size mismatch, or a non-finite gravity/Dirichlet
+  // value; then the optional terms (messages listed in muscle.h, contact.h and state_forces.h).
   void Validate() const;
 };
 
 // Fixes all three axes of `nodes` at their rest positions (sorted, merged
-// with the existing Dirichlet DoFs). Throws on an out-of-range node.
+// with the existing Dirichlet DoFs). Throws InvalidInputError for a node out
+// of range ("FixNodes: node 99 is out of range [0, 50)"); the scene is then
+// unchanged.
 void FixNodes(Scene* scene, const std::vector<int>& nodes);
 // Fixes the given axes (0 = x, 1 = y, 2 = z) of `nodes` at rest positions.
+// Throws InvalidInputError, the scene unchanged, for an axis outside 0..2
+// ("FixNodeAxes: axis 5 is invalid: must be 0 (x), 1 (y) or 2 (z)") or a
+// node out of range ("FixNodeAxes: node -1 is out of range [0, 50)").
 void FixNodeAxes(Scene* scene, const std::vector<int>& nodes, const std::vector<int>& axes);
 
 }  // namespace diffpd

@@ -56,7 +56,9 @@ class Simulator {
 
   // One time step with the configured method. Throws InvalidInputError on
   // mismatched sizes or non-finite input, SolverError when the step fails
-  // (non-convergence, inverted neo-Hookean element, factorisation failure).
+  // (non-convergence, inverted neo-Hookean element, factorisation failure,
+  // kNonFinite for a residual or state that overflows, kDiverged for a body
+  // stretched beyond SolverOptions::max_extent_ratio).
   State Step(const State& state, const StepInput& input, StepReport* report = nullptr);
   // K = inputs.size() steps from `initial`, recorded for Backward().
   Rollout Simulate(const State& initial, const std::vector<StepInput>& inputs);
@@ -64,7 +66,13 @@ class Simulator {
   // differentiable input, given dL/dx_k and dL/dv_k (material parameters:
   // the base material's and, per region, RolloutGradient::region_materials).
   // The rollout must come from this simulator with the same materials (base
-  // and regions), time step and method.
+  // and regions), time step and method. Throws InvalidInputError naming the
+  // first problem: a rollout without one more state than inputs, a state
+  // whose x or v is not 3n finite entries, an input whose external force or
+  // activation has the wrong size or a non-finite entry, a rollout made with
+  // other settings, a frictional-contact rollout without its reports (e.g.
+  // "Backward: the rollout's state 1 has x with 24 entries, expected 48 (3 x
+  // number of nodes)"), or a loss gradient of the wrong shape.
   RolloutGradient Backward(const Rollout& rollout, const LossGradient& loss);
   // Forward mode: tangents of every state of the rollout along each of the
   // P directions (tangent_rollout.h), all P solved together per step with the

@@ -19,13 +19,14 @@ struct SurfaceMesh {
 };
 
 // Reads a Wavefront OBJ file: "v x y z [w]" lines (w ignored) and
-// "f i j k ..." lines whose entries may be "i", "i/t", "i//n" or "i/t/n".
+// "f i j k ..." lines whose entries may be "i", "i/t", "i//n" or "i/t/n"
+// (t and n integers, ignored; any other entry is malformed).
 // Indices are 1-based; a negative index -r means the r-th vertex before the
 // face line (-1 = the last one read so far). A face with p > 3 vertices is
 // fan-triangulated into (0,1,2), (0,2,3), ..., (0,p-2,p-1). All other lines
 // (vn, vt, o, g, s, usemtl, mtllib, '#' comments) are ignored.
 // Throws InvalidInputError, "<path>:<line>: ..." for a malformed line:
-//   "cannot open '<path>'",
+//   "cannot open '<path>'", "cannot open '<path>': it is a directory, not a file",
 //   "<path>:<line>: expected x y z coordinates, got 'v 1 2'",
 //   "<path>:<line>: expected x coordinate (a finite number), got 'abc'",
 //   "<path>:<line>: a face needs at least 3 vertices, got 2",

@@ -19,8 +19,10 @@ namespace diffpd {
 // reported by ValidateMesh, which is called with ele_path as `what` (its
 // vertex indices are 0-based even for a 1-based file).
 // Throws InvalidInputError "<path>:<line>: <message>", for example
-//   "cannot open '<path>'",
+//   "cannot open '<path>'", "cannot open '<path>': it is a directory, not a file",
 //   "<node_path>:1: expected dimension 3, got 2",
+//   "<node_path>:1: the number of points = 1000000000 is more than the file's 25 bytes can hold"
+//   (a count is checked against the file's size before anything is allocated),
 //   "<node_path>:2: first point number must be 0 or 1, got 5",
 //   "<node_path>:4: point number 7 out of sequence (expected 3)",
 //   "<node_path>: file ends after 2 of 5 points",
@@ -43,7 +45,9 @@ Mesh ReadTetGen(const std::string& node_path, const std::string& ele_path);
 // ReadTetGen); points TetGen leaves unused are dropped; then the mesh is
 // validated (`what` = "TetrahedralizeSurface").
 // Throws InvalidInputError for a bad scale, an empty surface, a triangle
-// index out of range, or invalid switches (empty, containing whitespace or
+// index out of range, an open surface (before TetGen runs; message as
+// VoxelizeSurface's, "TetrahedralizeSurface: the surface is not closed: ..."),
+// or invalid switches (empty, containing whitespace or
 // '-', or one of 'r', 'N', 'E', 'I', which change what TetGen reads or
 // writes), and std::runtime_error
 //   "tetgen program not found: install the Debian package 'tetgen'",

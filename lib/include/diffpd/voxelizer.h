@@ -19,7 +19,10 @@ namespace diffpd {
 // Example: a sphere of radius 0.05 at the origin, origin = (-0.05,)*3,
 // cells = (10, 10, 10), dx = 0.01 gives 552 hexes and 823 vertices.
 // Throws InvalidInputError if sdf is empty, a cell count is < 1, dx is not
-// finite and > 0, the origin is not finite, sdf returns NaN, or no cell is kept.
+// finite and > 0, the origin is not finite, the grid has more than 10^8
+// cells ("VoxelizeSdf: cells = (1000, 1000, 1000) is 1e+09 cells, more than
+// the limit of 1e+08": the mesh alone would take gigabytes), sdf returns NaN,
+// or no cell is kept.
 Mesh VoxelizeSdf(const std::function<double(const Vec3&)>& sdf, const Vec3& origin, const Eigen::Vector3i& cells,
                  double dx);
 
@@ -30,10 +33,15 @@ Mesh VoxelizeSdf(const std::function<double(const Vec3&)>& sdf, const Vec3& orig
 // A cell is kept if its centre is inside, decided by the parity of crossings
 // of axis-parallel rays along x, y and z with a majority vote of the three
 // (ties on edges and vertices are broken consistently). Mesh numbering as in
-// VoxelizeSdf. The surface should be closed (see ValidateWatertight); it is
-// not checked. Throws InvalidInputError if dx or scale is not finite and > 0,
-// the surface has no triangles or an out-of-range index, the grid would
-// exceed 2^31 cells, or no cell centre is inside.
+// VoxelizeSdf. The surface must be closed: every edge in an even number of
+// triangles (2 on a manifold surface, 4 where it touches itself along an
+// edge), else the parity of crossings means nothing. Throws
+// InvalidInputError if dx or scale is not finite and > 0, the surface has no
+// triangles or an out-of-range index, is open ("VoxelizeSurface: the surface
+// is not closed: 3 boundary edges, the first (0, 1) (a closed surface has
+// every edge in an even number of triangles)"), the grid would exceed 10^8
+// cells (as in VoxelizeSdf, with dx and the box size appended), or no cell
+// centre is inside.
 Mesh VoxelizeSurface(const SurfaceMesh& surface, double dx, double scale = 1.0);
 
 }  // namespace diffpd

@@ -92,6 +92,9 @@ void ValidateSurface(const std::string& name, const ContactSurface& surface) {
       if (!surface.height || !surface.height_gradient)
         throw InvalidInputError("scene: " + name + ": a height field needs both height and height_gradient");
       break;
+    default:
+      Invalid(name + ".kind", std::to_string(static_cast<int>(surface.kind)),
+              "kPlane (0), kSphere (1) or kHeightField (2)");
   }
 }
 
@@ -123,6 +126,9 @@ void ValidateContacts(const Scene& scene) {
     }
   }
   const FrictionalContactOptions& opt = scene.frictional_contact_options;
+  if (opt.pd_linear_solve != ContactLinearSolve::kWoodbury && opt.pd_linear_solve != ContactLinearSolve::kRefactorize)
+    Invalid("frictional_contact_options.pd_linear_solve", std::to_string(static_cast<int>(opt.pd_linear_solve)),
+            "kWoodbury (0) or kRefactorize (1)");
   if (opt.max_passes < 1) Invalid("frictional_contact_options.max_passes", std::to_string(opt.max_passes), ">= 1");
   CheckNonNegative("frictional_contact_options.penetration_tolerance", opt.penetration_tolerance, " (m)");
   if (!(std::isfinite(opt.screening_rel_tolerance) && opt.screening_rel_tolerance >= 0 &&

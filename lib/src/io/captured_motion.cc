@@ -14,6 +14,7 @@
 
 #include "diffpd/csv_fields.h"
 #include "diffpd/error.h"
+#include "diffpd/input_file.h"
 
 namespace diffpd {
 namespace {
@@ -26,8 +27,10 @@ bool ParseInteger(const std::string& s, long* value) {
   return end == s.c_str() + s.size() && errno == 0;
 }
 
+// 15 significant digits: a value just beyond a limit prints unlike the limit.
 std::string Format(double v) {
   std::ostringstream out;
+  out.precision(15);
   out << v;
   return out.str();
 }
@@ -59,14 +62,21 @@ void CheckSample(const MarkerSample& s, const std::map<int, const Marker*>& ids,
   const char* weights[3] = {"wx", "wy", "wz"};
   if (!std::isfinite(s.time)) throw InvalidInputError(at + "time = " + Format(s.time) + " is not finite");
   if (s.time < 0) throw InvalidInputError(at + "time = " + Format(s.time) + " is invalid: must be >= 0 (s)");
-  for (int d = 0; d < 3; ++d)
+  for (int d = 0; d < 3; ++d) {
     if (!std::isfinite(s.position(d)))
       throw InvalidInputError(at + axes[d] + " = " + Format(s.position(d)) + " is not finite");
+    if (std::abs(s.position(d)) > kMaxMarkerCoordinate)
+      throw InvalidInputError(at + axes[d] + " = " + Format(s.position(d)) + " is invalid: must be within +-" +
+                              Format(kMaxMarkerCoordinate) + " (m)");
+  }
   for (int d = 0; d < 3; ++d) {
     if (!std::isfinite(s.weight(d)))
       throw InvalidInputError(at + weights[d] + " = " + Format(s.weight(d)) + " is not finite");
     if (s.weight(d) < 0)
       throw InvalidInputError(at + weights[d] + " = " + Format(s.weight(d)) + " is invalid: weights must be >= 0");
+    if (s.weight(d) > kMaxMarkerWeight)
+      throw InvalidInputError(at + weights[d] + " = " + Format(s.weight(d)) +
+                              " is invalid: weights must be <= " + Format(kMaxMarkerWeight) + " (1/m)");
   }
   if (!ids.count(s.marker)) {
     std::string list;
@@ -96,6 +106,16 @@ std::map<int, const Marker*> MarkerIds(const std::vector<Marker>& markers, const
   return ids;
 }
 
+void CheckTimeStep(double time_step) {
+  if (!std::isfinite(time_step) || time_step <= 0)
+    throw InvalidInputError("time step = " + Format(time_step) + " is invalid: must be finite and > 0 (s)");
+}
+
+// "line <l>: " for a sample from a file, else "sample <index>: ".
+std::string SampleName(const MarkerSample& s, int index) {
+  return s.line > 0 ? "line " + std::to_string(s.line) + ": " : "sample " + std::to_string(index) + ": ";
+}
+
 }  // namespace
 
 const Marker* CapturedMotion::FindMarker(int id) const {
@@ -119,8 +139,7 @@ void CapturedMotion::Validate(const std::string& what) const {
 }
 
 CapturedMotion ReadCapturedMotion(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InvalidInputError("cannot open '" + path + "'");
+  std::ifstream in = OpenInputFile(path);
   CapturedMotion motion;
   std::map<int, const Marker*> ids;
   std::map<int, std::pair<double, int>> last;
@@ -261,14 +280,27 @@ std::vector<std::pair<int, double>> MarkerStencil(const Marker& marker, const Me
 }
 
 int MarkerObservations::RequiredSteps(const CapturedMotion& motion, double time_step) {
-  const double steps = motion.end_time() / time_step;
-  return std::max(1, static_cast<int>(std::ceil(steps - 1e-9)));
+  CheckTimeStep(time_step);
+  const MarkerSample* last = nullptr;
+  for (const MarkerSample& s : motion.samples)
+    if (!last || s.time > last->time) last = &s;
+  if (!last) return 1;
+  const double steps = std::ceil(last->time / time_step - 1e-9);
+  if (!(steps <= kMaxSteps)) {  // also NaN
+    std::ostringstream msg;
+    msg << SampleName(*last, static_cast<int>(last - motion.samples.data())) << "time " << last->time << " s needs "
+        << steps << " steps of " << time_step << " s, more than the limit of " << kMaxSteps
+        << " (MarkerObservations::kMaxSteps)";
+    throw InvalidInputError(msg.str());
+  }
+  return std::max(1, static_cast<int>(steps));
 }
 
 MarkerObservations::MarkerObservations(const CapturedMotion& motion, const Mesh& mesh, double time_step, int num_steps)
     : num_steps_(num_steps) {
-  if (!std::isfinite(time_step) || time_step <= 0)
-    throw InvalidInputError("time step = " + Format(time_step) + " is invalid: must be finite and > 0 (s)");
+  CheckTimeStep(time_step);
+  if (num_steps < 0)
+    throw InvalidInputError("number of steps = " + std::to_string(num_steps) + " is invalid: must be >= 0");
   motion.Validate();
   std::map<int, std::vector<std::pair<int, double>>> stencils;
   for (const Marker& m : motion.markers) {
@@ -282,20 +314,18 @@ MarkerObservations::MarkerObservations(const CapturedMotion& motion, const Mesh&
   for (const MarkerSample& s : motion.samples) {
     auto it = stencils.find(s.marker);
     DIFFPD_CHECK(it != stencils.end(), "validated motion has an unknown marker id " << s.marker);
+    // Compared as doubles first: tau may exceed any int.
     const double tau = s.time / time_step;
-    int k = static_cast<int>(std::floor(tau + 1e-9));
-    double alpha = std::max(0.0, tau - k);
-    if (alpha < 1e-9) alpha = 0;
-    if (k > num_steps || (k == num_steps && alpha > 0) || s.time < 0) {
+    if (tau > num_steps + 1e-9) {
       std::ostringstream msg;
-      if (s.line > 0)
-        msg << "line " << s.line << ": ";
-      else
-        msg << "sample " << terms_.size() << ": ";
-      msg << "time " << s.time << " s is after the end of the simulation (" << num_steps << " steps of " << time_step
+      msg << SampleName(s, static_cast<int>(terms_.size())) << "time " << s.time
+          << " s is after the end of the simulation (" << num_steps << " steps of " << time_step
           << " s = " << num_steps * time_step << " s)";
       throw InvalidInputError(msg.str());
     }
+    const int k = std::min(num_steps, static_cast<int>(std::floor(tau + 1e-9)));
+    double alpha = std::max(0.0, tau - k);
+    if (alpha < 1e-9 || k == num_steps) alpha = 0;
     std::vector<Term> terms;
     for (const auto& [node, w] : it->second) {
       terms.push_back({k, node, (1 - alpha) * w});

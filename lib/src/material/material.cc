@@ -63,6 +63,18 @@ const char* ToString(ElasticEnergy energy) {
   DIFFPD_CHECK(false, "unknown ElasticEnergy " << static_cast<int>(energy));
 }
 
+bool IsElasticEnergy(ElasticEnergy energy) {
+  switch (energy) {
+    case ElasticEnergy::kLinear:
+    case ElasticEnergy::kCorotated:
+    case ElasticEnergy::kNeoHookean:
+    case ElasticEnergy::kPdCorotated:
+    case ElasticEnergy::kPdVolume:
+      return true;
+  }
+  return false;
+}
+
 bool IsProjective(ElasticEnergy energy) {
   return energy == ElasticEnergy::kPdCorotated || energy == ElasticEnergy::kPdVolume;
 }

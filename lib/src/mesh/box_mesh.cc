@@ -25,6 +25,7 @@ Mesh MakeBoxHexMesh(const Eigen::Vector3i& cells, const Vec3& size, const Vec3& 
       throw InvalidInputError(s.str());
     }
   }
+  internal::CheckGridSize("MakeBoxHexMesh", cells.cast<double>());
   const internal::HexGrid grid{origin, cells, size.cwiseQuotient(cells.cast<double>())};
   return internal::MeshFromCells(grid, std::vector<bool>(grid.num_cells(), true));
 }

@@ -43,10 +43,10 @@ void ReadFormat(internal::LineReader* reader) {
 
 void ReadNodes(internal::LineReader* reader, GmshData* data) {
   NextLine(reader, "Nodes");
-  const long num_blocks = reader->ParseInt(0, "numEntityBlocks");
+  const long num_blocks = reader->ParseCount(0, "numEntityBlocks");
   for (long b = 0; b < num_blocks; ++b) {
     NextLine(reader, "Nodes");
-    const long count = reader->ParseInt(3, "numNodesInBlock");
+    const long count = reader->ParseCount(3, "numNodesInBlock");
     const size_t first = data->positions.size();
     for (long n = 0; n < count; ++n) {
       NextLine(reader, "Nodes");
@@ -66,12 +66,12 @@ void ReadNodes(internal::LineReader* reader, GmshData* data) {
 
 void ReadElements(internal::LineReader* reader, GmshData* data) {
   NextLine(reader, "Elements");
-  const long num_blocks = reader->ParseInt(0, "numEntityBlocks");
+  const long num_blocks = reader->ParseCount(0, "numEntityBlocks");
   for (long b = 0; b < num_blocks; ++b) {
     NextLine(reader, "Elements");
     const long dimension = reader->ParseInt(0, "entityDim");
     const long gmsh_type = reader->ParseInt(2, "elementType");
-    const long count = reader->ParseInt(3, "numElementsInBlock");
+    const long count = reader->ParseCount(3, "numElementsInBlock");
     const bool keep = gmsh_type == 4 || gmsh_type == 5;
     if (dimension == 3 && !keep) {
       reader->Fail("3D element type " + std::to_string(gmsh_type) + " is not supported (only 4 = tet4 and 5 = hex8)");

@@ -1,8 +1,19 @@
 #include "mesh/hex_grid.h"
 
+#include <sstream>
+
 #include "diffpd/error.h"
 
 namespace diffpd::internal {
+
+void CheckGridSize(const std::string& function, const Eigen::Vector3d& cells, const std::string& detail) {
+  const double total = cells.prod();
+  if (total <= kMaxGridCells) return;
+  std::ostringstream s;
+  s << function << ": cells = (" << cells(0) << ", " << cells(1) << ", " << cells(2) << ") is " << total
+    << " cells, more than the limit of " << kMaxGridCells << detail;
+  throw InvalidInputError(s.str());
+}
 
 Mesh MeshFromCells(const HexGrid& grid, const std::vector<bool>& keep) {
   DIFFPD_CHECK(static_cast<long>(keep.size()) == grid.num_cells(),

@@ -2,6 +2,7 @@
 // (internal; shared by MakeBoxHexMesh and the voxelizers).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -27,6 +28,18 @@ struct HexGrid {
     return origin + Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5).cwiseProduct(spacing);
   }
 };
+
+// The most cells a grid may have (MakeBoxHexMesh, VoxelizeSdf,
+// VoxelizeSurface): 10^8. The mesh of a full grid of that size holds 3.2 GB
+// of node indices and 2.4 GB of vertices before any simulation data; larger
+// requests are refused up front rather than failing in an allocation.
+inline constexpr double kMaxGridCells = 1e8;
+
+// Throws InvalidInputError "<function>: cells = (a, b, c) is 1e+12 cells, more
+// than the limit of 1e+08" when the product of the (positive) counts exceeds
+// kMaxGridCells; `detail` is appended to the message (e.g. the dx that led
+// to the counts).
+void CheckGridSize(const std::string& function, const Eigen::Vector3d& cells, const std::string& detail = "");
 
 // Hex8 mesh of the cells with keep[CellIndex] true, elements ordered by cell
 // index; the grid points they use become vertices, numbered compactly in

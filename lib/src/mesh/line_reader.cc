@@ -2,9 +2,11 @@
 
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "diffpd/error.h"
+#include "diffpd/input_file.h"
 
 namespace diffpd::internal {
 
@@ -24,9 +26,8 @@ bool ParseDouble(const std::string& token, double* value) {
   return result.ec == std::errc() && result.ptr == end && begin != end && std::isfinite(*value);
 }
 
-LineReader::LineReader(std::string path, char comment) : path_(std::move(path)), comment_(comment), stream_(path_) {
-  if (!stream_) throw InvalidInputError("cannot open '" + path_ + "'");
-}
+LineReader::LineReader(std::string path, char comment)
+    : path_(std::move(path)), comment_(comment), stream_(OpenInputFile(path_)), file_size_(InputFileSize(path_)) {}
 
 bool LineReader::Next() {
   while (std::getline(stream_, line_)) {
@@ -61,6 +62,16 @@ long LineReader::ParseInt(size_t i, const std::string& what) const {
   if (i >= tokens_.size()) Fail("expected " + what + ", got end of line");
   if (!internal::ParseInt(tokens_[i], &value)) Fail("expected " + what + ", got '" + tokens_[i] + "'");
   return value;
+}
+
+long LineReader::ParseCount(size_t i, const std::string& what) const {
+  const long count = ParseInt(i, what);
+  if (count < 0) Fail(what + " must be >= 0, got " + tokens_[i]);
+  if (static_cast<std::uintmax_t>(count) > file_size_)
+    Fail(what + " = " + tokens_[i] + " is more than the file's " + std::to_string(file_size_) + " bytes can hold");
+  if (count > std::numeric_limits<int>::max())
+    Fail(what + " = " + tokens_[i] + " is too large (at most " + std::to_string(std::numeric_limits<int>::max()) + ")");
+  return count;
 }
 
 double LineReader::ParseDouble(size_t i, const std::string& what) const {

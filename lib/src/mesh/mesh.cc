@@ -69,6 +69,11 @@ double SignedElementVolume(const Mesh& mesh, const Eigen::Matrix3Xd& positions, 
 }
 
 void ValidateMesh(const Mesh& mesh, const std::string& what) {
+  if (mesh.type != ElementType::kTet4 && mesh.type != ElementType::kHex8) {
+    std::ostringstream s;
+    s << "type = " << static_cast<int>(mesh.type) << " is invalid: must be ElementType::kTet4 (0) or kHex8 (1)";
+    Fail(what, s.str());
+  }
   const int k = NodesPerElement(mesh.type);
   const int n = mesh.num_vertices();
   const int m = mesh.num_elements();

@@ -14,6 +14,23 @@ struct FaceCorner {
   int line;
 };
 
+// The vertex index of a face entry "i", "i/t", "i//n" or "i/t/n" (t and n
+// integers, ignored); false for anything else ("1/a", "1/", "1/2/3/4").
+bool ParseFaceEntry(const std::string& entry, long* index) {
+  std::vector<std::string> parts;
+  size_t start = 0;
+  for (size_t slash; (slash = entry.find('/', start)) != std::string::npos; start = slash + 1)
+    parts.push_back(entry.substr(start, slash - start));
+  parts.push_back(entry.substr(start));
+  if (parts.size() > 3) return false;
+  long ignored = 0;
+  for (size_t p = 1; p < parts.size(); ++p) {
+    const bool may_be_empty = p == 1 && parts.size() == 3;  // "i//n"
+    if (parts[p].empty() ? !may_be_empty : !internal::ParseInt(parts[p], &ignored)) return false;
+  }
+  return internal::ParseInt(parts[0], index);
+}
+
 }  // namespace
 
 SurfaceMesh ReadObj(const std::string& path) {
@@ -33,7 +50,7 @@ SurfaceMesh ReadObj(const std::string& path) {
       std::vector<FaceCorner> face;
       for (size_t t = 1; t < tokens.size(); ++t) {
         long index = 0;
-        if (!internal::ParseInt(tokens[t].substr(0, tokens[t].find('/')), &index)) {
+        if (!ParseFaceEntry(tokens[t], &index)) {
           reader.Fail("malformed face entry '" + tokens[t] + "'");
         }
         if (index == 0) reader.Fail("face index 0 is invalid (OBJ indices start at 1)");

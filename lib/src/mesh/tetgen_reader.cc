@@ -15,9 +15,7 @@ namespace {
 // Reads the "<count> ..." header line; returns the count.
 long ReadCount(LineReader* reader, const char* items) {
   if (!reader->Next()) reader->Fail(std::string("expected a header line with the number of ") + items);
-  const long count = reader->ParseInt(0, std::string("the number of ") + items);
-  if (count < 0) reader->Fail(std::string("the number of ") + items + " must be >= 0, got " + reader->tokens()[0]);
-  return count;
+  return reader->ParseCount(0, std::string("the number of ") + items);
 }
 
 // Reads the item number of the current line: the first one sets the base (0

@@ -13,6 +13,7 @@
 #include "diffpd/error.h"
 #include "diffpd/tetgen_io.h"
 #include "mesh/subprocess.h"
+#include "mesh/surface_boundary.h"
 #include "mesh/surface_indices.h"
 #include "mesh/tetgen_reader.h"
 
@@ -114,6 +115,7 @@ Mesh TetrahedralizeSurface(const SurfaceMesh& surface, const std::string& switch
     throw InvalidInputError(s.str());
   }
   internal::CheckTriangleIndices(surface, "TetrahedralizeSurface");
+  internal::CheckClosed(surface, "TetrahedralizeSurface");
   CheckSwitches(switches);
   const std::string tetgen = internal::FindOnPath("tetgen");
   if (tetgen.empty()) throw std::runtime_error("tetgen program not found: install the Debian package 'tetgen'");

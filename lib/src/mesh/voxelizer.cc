@@ -8,6 +8,7 @@
 #include "diffpd/error.h"
 #include "mesh/hex_grid.h"
 #include "mesh/ray_parity.h"
+#include "mesh/surface_boundary.h"
 #include "mesh/surface_indices.h"
 
 namespace diffpd {
@@ -38,6 +39,7 @@ Mesh VoxelizeSdf(const std::function<double(const Vec3&)>& sdf, const Vec3& orig
       throw InvalidInputError(s.str());
     }
   }
+  internal::CheckGridSize("VoxelizeSdf", cells.cast<double>());
   const internal::HexGrid grid{origin, cells, Vec3::Constant(dx)};
   std::vector<bool> keep(grid.num_cells(), false);
   bool any = false;
@@ -62,24 +64,18 @@ Mesh VoxelizeSurface(const SurfaceMesh& surface, double dx, double scale) {
   CheckSpacing("VoxelizeSurface", "dx", dx);
   CheckSpacing("VoxelizeSurface", "scale", scale);
   internal::CheckTriangleIndices(surface, "VoxelizeSurface");
+  internal::CheckClosed(surface, "VoxelizeSurface");
   SurfaceMesh scaled = surface;
   scaled.vertices *= scale;
   if (!scaled.vertices.allFinite()) throw InvalidInputError("VoxelizeSurface: non-finite vertex coordinate");
   const Vec3 lo = scaled.vertices.rowwise().minCoeff();
   const Vec3 hi = scaled.vertices.rowwise().maxCoeff();
-  Eigen::Vector3i cells;
-  double total = 1.0;
-  for (int d = 0; d < 3; ++d) {
-    const double count = std::max(1.0, std::ceil((hi(d) - lo(d)) / dx));
-    total *= count;
-    if (total > 2147483647.0) {
-      std::ostringstream s;
-      s << "VoxelizeSurface: dx = " << dx << " gives more than 2^31 cells for a bounding box of size ("
-        << (hi - lo).transpose() << ")";
-      throw InvalidInputError(s.str());
-    }
-    cells(d) = static_cast<int>(count);
-  }
+  Vec3 counts;
+  for (int d = 0; d < 3; ++d) counts(d) = std::max(1.0, std::ceil((hi(d) - lo(d)) / dx));
+  std::ostringstream detail;
+  detail << " (dx = " << dx << " for a bounding box of size (" << (hi - lo).transpose() << "))";
+  internal::CheckGridSize("VoxelizeSurface", counts, detail.str());
+  const Eigen::Vector3i cells = counts.cast<int>();
   const internal::HexGrid grid{(lo + hi - dx * cells.cast<double>()) / 2.0, cells, Vec3::Constant(dx)};
   const std::vector<bool> keep = internal::InsideByRayParity(scaled, grid);
   bool any = false;

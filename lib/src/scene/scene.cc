@@ -15,6 +15,13 @@ void Scene::Validate() const {
   material.Validate();
   internal::ValidateMaterialRegions(*this);
   if (energies.empty()) throw InvalidInputError("scene: no elastic energy declared (energies is empty)");
+  for (size_t k = 0; k < energies.size(); ++k)
+    if (!IsElasticEnergy(energies[k])) {
+      std::ostringstream msg;
+      msg << "scene: energies[" << k << "] = " << static_cast<int>(energies[k])
+          << " is invalid: must be an ElasticEnergy, 0 (linear) to 4 (pd-volume)";
+      throw InvalidInputError(msg.str());
+    }
   if (gravity && !gravity->allFinite()) throw InvalidInputError("scene: gravity has a non-finite component");
   const int n = mesh.num_dofs();
   if (static_cast<Eigen::Index>(dirichlet.dofs.size()) != dirichlet.values.size()) {
@@ -44,14 +51,23 @@ void Scene::Validate() const {
   internal::ValidateOptionalTerms(*this);
 }
 
-void FixNodeAxes(Scene* scene, const std::vector<int>& nodes, const std::vector<int>& axes) {
+namespace {
+
+// FixNodeAxes, with `function` naming the caller in messages.
+void FixAxes(Scene* scene, const std::vector<int>& nodes, const std::vector<int>& axes, const char* function) {
+  for (const int a : axes)
+    if (a < 0 || a > 2) {
+      std::ostringstream msg;
+      msg << function << ": axis " << a << " is invalid: must be 0 (x), 1 (y) or 2 (z)";
+      throw InvalidInputError(msg.str());
+    }
   std::vector<std::pair<int, double>> all;
   for (size_t k = 0; k < scene->dirichlet.dofs.size(); ++k)
     all.emplace_back(scene->dirichlet.dofs[k], scene->dirichlet.values(k));
   for (const int i : nodes) {
     if (i < 0 || i >= scene->mesh.num_vertices()) {
       std::ostringstream msg;
-      msg << "FixNodes: node " << i << " is out of range [0, " << scene->mesh.num_vertices() << ")";
+      msg << function << ": node " << i << " is out of range [0, " << scene->mesh.num_vertices() << ")";
       throw InvalidInputError(msg.str());
     }
     for (const int a : axes) all.emplace_back(3 * i + a, scene->mesh.vertices(a, i));
@@ -67,6 +83,12 @@ void FixNodeAxes(Scene* scene, const std::vector<int>& nodes, const std::vector<
   }
 }
 
-void FixNodes(Scene* scene, const std::vector<int>& nodes) { FixNodeAxes(scene, nodes, {0, 1, 2}); }
+}  // namespace
+
+void FixNodeAxes(Scene* scene, const std::vector<int>& nodes, const std::vector<int>& axes) {
+  FixAxes(scene, nodes, axes, "FixNodeAxes");
+}
+
+void FixNodes(Scene* scene, const std::vector<int>& nodes) { FixAxes(scene, nodes, {0, 1, 2}, "FixNodes"); }
 
 }  // namespace diffpd

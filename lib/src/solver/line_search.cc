@@ -18,6 +18,12 @@ LineSearchResult BacktrackingLineSearch(StepObjective& objective, const VectorXd
                                         VectorXd* grad) {
   const SolverOptions& options = objective.sim().options;
   const double slope = grad->dot(d);
+  if (!std::isfinite(slope)) {
+    std::ostringstream msg;
+    msg << ToString(options.method) << ": the line search's slope grad g . d = " << slope
+        << " is not finite (|grad g| = " << grad->norm() << ", |d| = " << d.norm() << ")";
+    throw SolverError(SolverStatus::kNonFinite, msg.str());
+  }
   if (!(slope < 0)) {
     std::ostringstream msg;
     msg << ToString(options.method) << ": the search direction is not a descent direction (slope " << slope << ")";
@@ -25,6 +31,7 @@ LineSearchResult BacktrackingLineSearch(StepObjective& objective, const VectorXd
   }
   double alpha = 1.0;
   VectorXd trial_grad;
+  bool every_trial_overflowed = true;  // g or grad g was not finite at every trial point
   for (int k = 0; k <= options.max_line_search_steps; ++k) {
     const VectorXd trial = *x + alpha * d;
     double trial_value = 0;
@@ -35,7 +42,9 @@ LineSearchResult BacktrackingLineSearch(StepObjective& objective, const VectorXd
       // Non-finite or inverted trial points are rejected like too-long steps.
       if (e.status() != SolverStatus::kNonFinite && e.status() != SolverStatus::kInvertedElement) throw;
       ok = false;
+      every_trial_overflowed = every_trial_overflowed && e.status() == SolverStatus::kNonFinite;
     }
+    if (ok) every_trial_overflowed = false;
     // Armijo; or, where g's change is lost in rounding (near convergence),
     // a strict decrease of |grad g|. g's rounding is relative to its terms,
     // which can be far larger than g itself (the elastic energy near rest is
@@ -55,6 +64,13 @@ LineSearchResult BacktrackingLineSearch(StepObjective& objective, const VectorXd
       return LineSearchResult{k, false};
     }
     alpha *= 0.5;
+  }
+  if (every_trial_overflowed) {
+    std::ostringstream msg;
+    msg << ToString(options.method) << ": g is not finite at any line search point x + d / 2^k, k = 0.."
+        << options.max_line_search_steps << " (|grad g| = " << grad->norm() << ", |d| = " << d.norm()
+        << "): the step's forces or stiffness overflow double precision";
+    throw SolverError(SolverStatus::kNonFinite, msg.str());
   }
   const double floor = objective.RoundingFloor();
   if (options.accept_rounding_floor && grad->norm() <= StepObjective::kRoundingFloorStall * floor)

@@ -15,8 +15,10 @@ namespace diffpd::internal {
 // within the limit at |grad g| <= StepObjective::kRoundingFloorStall times
 // the objective's rounding floor, and SolverOptions::accept_rounding_floor,
 // returns with at_rounding_floor true and x unchanged: the solve ends there.
-// Throws SolverError(kLineSearchFailed) when d is not a descent direction or
-// for any other stall (the message gives |grad g| and the floor).
+// Throws SolverError(kNonFinite) when the slope grad^T d is not finite or g
+// is not finite at any trial point,
+// SolverError(kLineSearchFailed) when d is not a descent direction or for
+// any other stall (the message gives |grad g| and the floor).
 struct LineSearchResult {
   int halvings = 0;
   bool at_rounding_floor = false;

@@ -10,6 +10,7 @@
 #include "diffpd/error.h"
 #include "forces/activation_scope.h"
 #include "solver/energy_bounded_step.h"
+#include "solver/rollout_checks.h"
 #include "solver/simulator_impl.h"
 
 namespace diffpd {
@@ -31,6 +32,22 @@ void CheckVector(const VectorXd& v, Eigen::Index size, const char* name, bool al
 }
 
 bool IsImplicit(Method m) { return m != Method::kSemiImplicit; }
+
+// SolverOptions::max_extent_ratio: throws SolverError(kDiverged) when the
+// nodes' bounding box at positions x is too large.
+void CheckExtent(const SimulatorImpl& sim, const VectorXd& x) {
+  const double bound = sim.options.max_extent_ratio * sim.rest_extent;
+  if (std::isinf(bound)) return;
+  const Eigen::Map<const Eigen::Matrix3Xd> nodes(x.data(), 3, x.size() / 3);
+  const double extent = (nodes.rowwise().maxCoeff() - nodes.rowwise().minCoeff()).norm();
+  if (extent <= bound) return;
+  std::ostringstream msg;
+  msg << ToString(sim.options.method) << ": the step diverged: the body's extent (its bounding box's diagonal) grew to "
+      << extent << " m, beyond max_extent_ratio = " << sim.options.max_extent_ratio << " times its rest extent "
+      << sim.rest_extent << " m (h = " << sim.h() << " s"
+      << (IsImplicit(sim.options.method) ? ")" : "; an explicit method needs a smaller time step)");
+  throw SolverError(SolverStatus::kDiverged, msg.str());
+}
 
 }  // namespace
 
@@ -153,6 +170,7 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
         << " s; an explicit method needs a smaller time step)";
     throw SolverError(SolverStatus::kNonFinite, msg.str());
   }
+  CheckExtent(sim, next.x);
   rep->seconds = Seconds(start);
   if (sim.options.verbosity >= 1)
     std::fprintf(stderr, "%s step: %d iterations, |grad g| %.3e -> %.3e, %.4f s\n", ToString(sim.options.method),
@@ -173,22 +191,19 @@ Rollout Simulator::Simulate(const State& initial, const std::vector<StepInput>& 
   return r;
 }
 
-RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& loss) {
-  SimulatorImpl& sim = *impl_;
+namespace {
+
+// Backward's pass over the steps, given a checked rollout.
+RolloutGradient BackwardPass(SimulatorImpl& sim, const Rollout& rollout, const LossGradient& loss) {
   const auto start = Clock::now();
   const int n = sim.num_dofs();
   const int steps = rollout.num_steps();
-  if (static_cast<int>(rollout.states.size()) != steps + 1)
-    throw InvalidInputError("Backward: the rollout has inconsistent states and inputs");
   if (static_cast<int>(loss.dx.size()) != steps + 1 || static_cast<int>(loss.dv.size()) != steps + 1) {
     std::ostringstream msg;
     msg << "Backward: the loss gradient must have " << steps + 1 << " entries in dx and dv (got " << loss.dx.size()
         << " and " << loss.dv.size() << ")";
     throw InvalidInputError(msg.str());
   }
-  if (!internal::MadeWithCurrentSettings(sim, rollout))
-    throw InvalidInputError(
-        "Backward: the rollout was made with another material, time step or method than the simulator's current ones");
   for (int k = 0; k <= steps; ++k) {
     CheckVector(loss.dx[k], n, "loss.dx", true);
     CheckVector(loss.dv[k], n, "loss.dv", true);
@@ -196,8 +211,6 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
   const double h = sim.h();
   const VectorXd& mass = sim.Mass();
   const bool contact = !sim.scene.frictional_contacts.empty() && IsImplicit(sim.options.method);
-  if (contact && static_cast<int>(rollout.reports.size()) != steps)
-    throw InvalidInputError("Backward: a rollout with frictional contact needs its step reports (active sets)");
   RolloutGradient out;
   out.external_force.assign(steps, VectorXd());
   out.activation.assign(steps, VectorXd());
@@ -290,8 +303,29 @@ RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& 
       out.region_materials.push_back(g);
     }
   }
+  bool finite = out.x0.allFinite() && out.v0.allFinite() && std::isfinite(out.youngs_modulus) &&
+                std::isfinite(out.poissons_ratio) && std::isfinite(out.density);
+  for (int i = 0; i < steps; ++i) finite = finite && out.external_force[i].allFinite() && out.activation[i].allFinite();
+  for (const MaterialComponents& g : out.region_materials)
+    finite = finite && std::isfinite(g.youngs_modulus) && std::isfinite(g.poissons_ratio) && std::isfinite(g.density);
+  if (!finite) throw SolverError(SolverStatus::kNonFinite, "the gradient is not finite");
   out.report.seconds = Seconds(start);
   return out;
+}
+
+}  // namespace
+
+RolloutGradient Simulator::Backward(const Rollout& rollout, const LossGradient& loss) {
+  internal::CheckRolloutForDerivatives(*impl_, rollout, "Backward");
+  // The rollout is finite: a non-finite value on the way is an overflow.
+  try {
+    return BackwardPass(*impl_, rollout, loss);
+  } catch (const SolverError& e) {
+    if (e.status() != SolverStatus::kNonFinite) throw;
+    throw SolverError(SolverStatus::kNonFinite, std::string(ToString(impl_->options.method)) +
+                                                    " backward: the adjoint overflowed double precision (" + e.what() +
+                                                    ")");
+  }
 }
 
 VectorXd Simulator::SolveQuasiStatic(const VectorXd& initial_positions, const StepInput& input, StepReport* report) {

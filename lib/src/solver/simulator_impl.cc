@@ -28,6 +28,7 @@ SimulatorImpl::SimulatorImpl(const Scene& scene_in, const SolverOptions& options
     fixed[scene.dirichlet.dofs[k]] = 1;
     fixed_values(scene.dirichlet.dofs[k]) = scene.dirichlet.values(k);
   }
+  rest_extent = (scene.mesh.vertices.rowwise().maxCoeff() - scene.mesh.vertices.rowwise().minCoeff()).norm();
   MaterialsChanged();
 }
 
@@ -245,7 +246,9 @@ bool StepObjective::StopAtCheckpoint(const VectorXd& x, double grad_norm, double
 }
 
 bool Converged(const SolverOptions& options, double grad_norm, double initial_norm) {
-  return grad_norm <= options.abs_tolerance + options.rel_tolerance * initial_norm;
+  // inf <= inf would hold: a non-finite residual never converges.
+  return std::isfinite(grad_norm) && std::isfinite(initial_norm) &&
+         grad_norm <= options.abs_tolerance + options.rel_tolerance * initial_norm;
 }
 
 bool IterationConverged(StepObjective& objective, int it, const VectorXd& x, double grad_norm, StepReport* report) {
@@ -254,6 +257,13 @@ bool IterationConverged(StepObjective& objective, int it, const VectorXd& x, dou
   report->final_residual = grad_norm;
   if (options.verbosity >= 2)
     std::fprintf(stderr, "  %s iteration %d |grad g| = %.3e\n", ToString(options.method), it, grad_norm);
+  if (!std::isfinite(grad_norm) || !std::isfinite(report->initial_residual)) {
+    std::ostringstream msg;
+    msg << ToString(options.method) << ": the residual |grad g| = " << grad_norm << " at iteration " << it
+        << " (initial " << report->initial_residual
+        << ") is not finite: the step's forces or stiffness overflow double precision";
+    throw SolverError(SolverStatus::kNonFinite, msg.str());
+  }
   if (Converged(options, grad_norm, report->initial_residual)) return true;
   if (objective.StopAtCheckpoint(x, grad_norm, report->initial_residual)) return true;
   if (it >= options.max_iterations) ThrowNotConverged(options, it, grad_norm, report->initial_residual);

@@ -45,6 +45,9 @@ class SimulatorImpl {
   // (contact/contact_pin_scope.h), and removed after.
   std::vector<char> fixed;
   VectorXd fixed_values;  // 3n, Dirichlet positions (zero at free DoFs)
+  // The diagonal of the rest mesh's bounding box (m), the scale of
+  // SolverOptions::max_extent_ratio.
+  double rest_extent = 0;
 
   double h() const { return options.time_step; }
   int threads() const { return options.num_threads; }
@@ -190,7 +193,10 @@ class StepObjective {
 class StepLinearization {
  public:
   StepLinearization(SimulatorImpl& sim, const VectorXd& x, bool static_problem = false);
-  // Solves H z = b (3n; fixed entries of b ignored, of z zero).
+  // Solves H z = b (3n; fixed entries of b ignored, of z zero). Throws
+  // SolverError(kNonFinite) for a b with a non-finite entry or a solution
+  // that overflows (an adjoint or tangent beyond double precision),
+  // kFactorizationFailed for a singular H.
   VectorXd Solve(const VectorXd& b, BackwardReport* report);
   // Solves H Z = B for the P columns of B (3n x P) together: PD methods
   // iterate all columns in lockstep with one batched A^{-1} solve per
@@ -208,6 +214,7 @@ class StepLinearization {
   const std::vector<double>& PackedBlocks();
   // Assembles matrix_ (elastic and auxiliary blocks, inertia) once.
   void AssembleMatrix();
+  // False for a singular H; throws SolverError(kNonFinite) when z overflows.
   bool DirectSolve(const VectorXd& b, VectorXd* z);
   bool IterativeSolve(const VectorXd& b, VectorXd* z, int* iterations);
   // The PD-preconditioned iteration (options.pd_backward) on the columns of
@@ -235,13 +242,15 @@ VectorXd NewtonSolve(StepObjective& objective, const VectorXd& x0, StepReport* r
 VectorXd PdSolve(StepObjective& objective, const VectorXd& x0, StepReport* report);
 VectorXd PdLbfgsSolve(StepObjective& objective, const VectorXd& x0, StepReport* report);
 
-// True when ||grad|| meets the common convergence test.
+// True when ||grad|| meets the common convergence test (never for a
+// non-finite norm).
 bool Converged(const SolverOptions& options, double grad_norm, double initial_norm);
 // The per-iteration bookkeeping every forward solver shares: records
 // iteration `it` (iterate x) and |grad| in the report, logs it (verbosity >=
 // 2), and returns true when converged or stopped at the objective's
-// checkpoint; throws ThrowNotConverged's error when `it` reached the
-// iteration limit without converging.
+// checkpoint; throws SolverError(kNonFinite) when |grad| or the initial
+// residual is not finite, and ThrowNotConverged's error when `it` reached
+// the iteration limit without converging.
 bool IterationConverged(StepObjective& objective, int it, const VectorXd& x, double grad_norm, StepReport* report);
 // Adds a later solve of the same step (a re-solve from x_i, Newton after a
 // PD-LBFGS stall, a contact pass) to the step's report: its iterations,

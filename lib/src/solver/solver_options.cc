@@ -1,6 +1,10 @@
 #include "diffpd/solver_options.h"
 
+#include <omp.h>
+
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <sstream>
 
 #include "diffpd/error.h"
@@ -44,7 +48,17 @@ Method ParseMethod(const std::string& name) {
   throw InvalidInputError("unknown method '" + name + "': valid methods are " + valid);
 }
 
+int MaxSolverThreads() { return 4 * omp_get_num_procs(); }
+
 void SolverOptions::Validate() const {
+  if (std::find(std::begin(kMethods), std::end(kMethods), method) == std::end(kMethods))
+    Reject("method", static_cast<int>(method),
+           "a Method: semi-implicit (0), newton-cholesky (1), newton-pcg (2), pd (3) or pd-lbfgs (4)");
+  if (pcg_preconditioner != PcgPreconditioner::kJacobi && pcg_preconditioner != PcgPreconditioner::kIncompleteCholesky)
+    Reject("pcg_preconditioner", static_cast<int>(pcg_preconditioner), "kJacobi (0) or kIncompleteCholesky (1)");
+  if (pd_backward != PdBackwardMethod::kFixedPoint && pd_backward != PdBackwardMethod::kLbfgs &&
+      pd_backward != PdBackwardMethod::kConjugateGradient)
+    Reject("pd_backward", static_cast<int>(pd_backward), "kFixedPoint (0), kLbfgs (1) or kConjugateGradient (2)");
   if (!(std::isfinite(time_step) && time_step > 0)) Reject("time_step", time_step, "finite and > 0 (s)");
   if (!(std::isfinite(abs_tolerance) && abs_tolerance >= 0)) Reject("abs_tolerance", abs_tolerance, "finite and >= 0");
   if (!(std::isfinite(rel_tolerance) && rel_tolerance >= 0 && rel_tolerance < 1))
@@ -62,7 +76,13 @@ void SolverOptions::Validate() const {
   if (!(backward_rel_tolerance > 0 && backward_rel_tolerance < 1))
     Reject("backward_rel_tolerance", backward_rel_tolerance, "in (0, 1)");
   if (backward_max_iterations < 1) Reject("backward_max_iterations", backward_max_iterations, ">= 1");
-  if (num_threads < 0) Reject("num_threads", num_threads, ">= 0 (0: OpenMP default)");
+  if (!(max_extent_ratio > 1)) Reject("max_extent_ratio", max_extent_ratio, "> 1 (infinity: no bound)");
+  if (num_threads < 0 || num_threads > MaxSolverThreads()) {
+    std::ostringstream range;
+    range << "in [0, " << MaxSolverThreads() << "] (0: OpenMP default; at most 4 x the " << omp_get_num_procs()
+          << " processors)";
+    Reject("num_threads", num_threads, range.str().c_str());
+  }
 }
 
 }  // namespace diffpd

@@ -75,7 +75,10 @@ bool StepLinearization::DirectSolve(const VectorXd& b, VectorXd* z) {
     *z = lu.solve(rhs);
   }
   sim_.ZeroFixed(z);
-  return z->allFinite();
+  // A finite b whose solution overflows: the derivative exceeds double
+  // precision, not a singular H.
+  if (!z->allFinite()) throw SolverError(SolverStatus::kNonFinite, "the solution of H z = b overflowed");
+  return true;
 }
 
 void StepLinearization::IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, std::vector<char>* ok, int* iterations) {
@@ -134,6 +137,7 @@ bool StepLinearization::PcgSolve(const VectorXd& b, VectorXd* z, int* iterations
 VectorXd StepLinearization::Solve(const VectorXd& b, BackwardReport* report) {
   VectorXd z;
   const Method m = sim_.options.method;
+  if (!b.allFinite()) throw SolverError(SolverStatus::kNonFinite, "the right-hand side b is not finite");
   int iterations = 0;
   bool ok = false;
   bool iterative = false;
@@ -161,6 +165,7 @@ VectorXd StepLinearization::Solve(const VectorXd& b, BackwardReport* report) {
 
 MatrixXd StepLinearization::SolveColumns(const MatrixXd& b, BackwardReport* report) {
   const Method m = sim_.options.method;
+  if (!b.allFinite()) throw SolverError(SolverStatus::kNonFinite, "the right-hand sides B are not finite");
   const int cols = static_cast<int>(b.cols());
   MatrixXd z = MatrixXd::Zero(b.rows(), cols);
   std::vector<char> ok(cols, 0);

@@ -34,6 +34,7 @@
 #include "diffpd/tangent_rollout.h"
 #include "contact/active_set_step.h"
 #include "forces/activation_scope.h"
+#include "solver/rollout_checks.h"
 #include "solver/simulator_impl.h"
 
 namespace diffpd {
@@ -207,24 +208,17 @@ MaterialComponents PartComponents(const InputDirection& d, int part) {
 
 }  // namespace
 
-TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<InputDirection>& directions) {
-  SimulatorImpl& sim = *impl_;
+namespace {
+
+// Tangents' pass over the steps; checks its input first.
+TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std::vector<InputDirection>& directions) {
   const auto start = std::chrono::steady_clock::now();
   const int n = sim.num_dofs();
   const int steps = rollout.num_steps();
-  if (static_cast<int>(rollout.states.size()) != steps + 1)
-    throw InvalidInputError("Tangents: the rollout has inconsistent states and inputs");
-  for (const State& s : rollout.states)
-    if (s.x.size() != n || s.v.size() != n)
-      throw InvalidInputError("Tangents: the rollout's states do not match the scene's number of DoFs");
-  if (!internal::MadeWithCurrentSettings(sim, rollout))
-    throw InvalidInputError(
-        "Tangents: the rollout was made with another material, time step or method than the simulator's current ones");
+  internal::CheckRolloutForDerivatives(sim, rollout, "Tangents");
   CheckDirections(directions, n, steps, sim.aux.num_muscles(), static_cast<int>(sim.scene.material_regions.size()));
   CheckStateForceDirections(directions, sim.scene);
   const bool contact = !sim.scene.frictional_contacts.empty() && sim.options.method != Method::kSemiImplicit;
-  if (contact && static_cast<int>(rollout.reports.size()) != steps)
-    throw InvalidInputError("Tangents: a rollout with frictional contact needs its step reports (active sets)");
   std::vector<const ContactSurface*> surface_of(n / 3, nullptr);
   for (const FrictionalContact& c : sim.scene.frictional_contacts)
     for (const int node : c.nodes) surface_of[node] = &c.surface;
@@ -387,8 +381,26 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
     out.dv[i + 1] = (dx1 - dx0) / h;
     out.dx[i + 1] = std::move(dx1);
   }
+  for (int k = 0; k <= steps; ++k)
+    if (!out.dx[k].allFinite() || !out.dv[k].allFinite())
+      throw SolverError(SolverStatus::kNonFinite, "the tangent of state " + std::to_string(k) + " is not finite");
   out.report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
+}
+
+}  // namespace
+
+TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<InputDirection>& directions) {
+  // The rollout and directions are checked finite: a non-finite value on the
+  // way is an overflow.
+  try {
+    return TangentPass(*impl_, rollout, directions);
+  } catch (const SolverError& e) {
+    if (e.status() != SolverStatus::kNonFinite) throw;
+    throw SolverError(SolverStatus::kNonFinite, std::string(ToString(impl_->options.method)) +
+                                                    " tangent: the tangents overflowed double precision (" + e.what() +
+                                                    ")");
+  }
 }
 
 }  // namespace diffpd

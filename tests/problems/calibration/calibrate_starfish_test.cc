@@ -3,14 +3,19 @@
 // messages naming file and line, the scene has the fact sheet's boundary,
 // markers and muscles, the tendon-to-activation map (slack, lag) and its
 // derivatives, the reverse-mode loss gradient in E, nu, slack and lag agrees
-// with central finite differences, and a short fit lowers the loss.
+// with central finite differences, and a short fit lowers the loss; the
+// least-squares model's forward-mode Jacobian, its fit and intervals; the
+// metrics, baselines and trace files.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <set>
+#include <sstream>
 
 #include "calibration/calibrate_starfish.h"
+#include "calibration/starfish_trace.h"
 #include "diffpd/error.h"
 #include "util/expect_message.h"
 #include "util/temporary_directory.h"
@@ -55,27 +60,39 @@ TEST(CalibrateStarfishTest, ReadsTheRealRecordingsInSiUnits) {
   EXPECT_NEAR(r2.tendon[0], 1.1938052e-3, 1e-12);  // the pre-tension
 }
 
+// A malformed recording's text and the message after "<path>".
+struct BadRecording {
+  std::string text;
+  std::string message;
+};
+
 TEST(CalibrateStarfishTest, RejectsMalformedFilesNamingFileAndLine) {
   const std::string missing = Scratch().File("starfish_missing.csv");
   EXPECT_EQ(ReadError(missing), "cannot open '" + missing + "'");
-  std::string p = WriteTemp("starfish_empty.csv", "");
-  EXPECT_EQ(ReadError(p), p + ": empty file (expected a header row and data rows)");
-  p = WriteTemp("starfish_header.csv", "a,b,c\n" + kRow0);
-  EXPECT_EQ(ReadError(p), p + ":1: expected a header row of 10 column labels, got 3 fields");
-  p = WriteTemp("starfish_noheader.csv", kRow0 + kRow0);
-  EXPECT_EQ(ReadError(p), p + ":1: expected a header row of column labels, got the number '0'");
-  p = WriteTemp("starfish_columns.csv", kHeader + kRow0 + "16.7,0,1,2,3,4,5,6,7\n");
-  EXPECT_EQ(ReadError(p), p + ":3: expected 10 fields (time ms, tendon mm, M1 x, M1 y, ..., M4 x, M4 y), got 9");
-  p = WriteTemp("starfish_text.csv", kHeader + kRow0 + "16.7,0,1,2,3,abc,5,6,7,8\n");
-  EXPECT_EQ(ReadError(p), p + ":3: M2 y is not a number: 'abc'");
-  p = WriteTemp("starfish_nan_marker.csv", kHeader + kRow0 + "16.7,0,1,2,3,4,NaN,6,7,8\n");
-  EXPECT_EQ(ReadError(p), p + ":3: M3 x = nan is invalid: marker coordinates must be finite (mm)");
-  p = WriteTemp("starfish_inf_tendon.csv", kHeader + kRow0 + "16.7,inf,1,2,3,4,5,6,7,8\n");
-  EXPECT_EQ(ReadError(p), p + ":3: tendon = inf is invalid: must be finite or NaN (mm)");
-  p = WriteTemp("starfish_time.csv", kHeader + kRow0 + "16.5,0,1,2,3,4,5,6,7,8\n10,0,1,2,3,4,5,6,7,8\n");
-  EXPECT_EQ(ReadError(p), p + ":4: time 10 ms is not after the previous row's 16.5 ms (line 3)");
-  p = WriteTemp("starfish_rows.csv", kHeader);
-  EXPECT_EQ(ReadError(p), p + ": no data rows");
+  const std::string folder = Scratch().File("starfish_folder.csv");
+  std::filesystem::create_directories(folder);
+  EXPECT_EQ(ReadError(folder), "cannot open '" + folder + "': it is a directory, not a file");
+  const BadRecording cases[] = {
+      {"", ": empty file (expected a header row and data rows)"},
+      {"a,b,c\n" + kRow0, ":1: expected a header row of 10 column labels, got 3 fields"},
+      {kRow0 + kRow0, ":1: expected a header row of column labels, got the number '0'"},
+      {kHeader + kRow0 + "16.7,0,1,2,3,4,5,6,7\n",
+       ":3: expected 10 fields (time ms, tendon mm, M1 x, M1 y, ..., M4 x, M4 y), got 9"},
+      {kHeader + kRow0 + "16.7,0,1,2,3,abc,5,6,7,8\n", ":3: M2 y is not a number: 'abc'"},
+      {kHeader + kRow0 + "16.7,0,1,2,3,4,NaN,6,7,8\n",
+       ":3: M3 x = nan is invalid: marker coordinates must be finite and within +-1e+09 (mm)"},
+      {kHeader + kRow0 + "16.7,0,1,2,3,4,5,6,7,1e300\n",
+       ":3: M4 y = 1e+300 is invalid: marker coordinates must be finite and within +-1e+09 (mm)"},
+      {kHeader + kRow0 + "16.7,inf,1,2,3,4,5,6,7,8\n", ":3: tendon = inf is invalid: must be finite or NaN (mm)"},
+      {kHeader + kRow0 + "16.5,0,1,2,3,4,5,6,7,8\n10,0,1,2,3,4,5,6,7,8\n",
+       ":4: time 10 ms is not after the previous row's 16.5 ms (line 3)"},
+      {kHeader, ": no data rows"},
+  };
+  for (const BadRecording& c : cases) {
+    const std::string p = WriteTemp("starfish_bad.csv", c.text);
+    EXPECT_EQ(ReadError(p), p + c.message) << c.text;
+  }
+  std::string p;
   // A NaN tendon is accepted by the reader, and the window stops before it.
   p = WriteTemp("starfish_nan_tendon.csv", kHeader + kRow0 + "16.5,1,1,2,3,4,5,6,7,8\n33,NaN,1,2,3,4,5,6,7,8\n");
   const StarfishRecording r = ReadStarfishRecording(p);
@@ -204,8 +221,24 @@ TEST(StarfishActivationsTest, SlackLagAndLengthShapeTheActivation) {
   EXPECT_GT(largest[2], 1);    // 1/m
   EXPECT_THROW_MESSAGE(StarfishActivations(c, h, StarfishActuation{0, -1, 0.065}, nullptr), InvalidInputError,
                        "tendon lag = -1 is invalid: must be finite and >= 0 (s)");
-  EXPECT_THROW_MESSAGE(StarfishActivations({0.0, 0.0105}, h, StarfishActuation{0, 0, 0.005}, nullptr),
-                       InvalidInputError, "tendon: activation -1 < 0 at step 1 (slack 0 m, length 0.005 m)");
+  EXPECT_THROW_MESSAGE(
+      StarfishActivations({0.0, 0.0105}, h, StarfishActuation{0, 0, 0.005}, nullptr), InvalidInputError,
+      "tendon: activation -1 < 0 (the filtered contraction exceeds slack + length: slack 0 m, length 0.005 m) "
+      "at step 1");
+}
+
+// A tendon contraction the tendon cannot take names the recording's file and
+// row (the window's inputs are where a recording meets the actuation).
+TEST(CalibrateStarfishTest, WindowInputsNameTheRowOfANegativeActivation) {
+  const std::string p =
+      WriteTemp("starfish_long_tendon.csv",
+                kHeader + kRow0 + "16.5,1,1,2,3,4,5,6,7,8\n33,80,1,2,3,4,5,6,7,8\n50,0,1,2,3,4,5,6,7,8\n");
+  const StarfishRecording r = ReadStarfishRecording(p);
+  StarfishCalibration starfish;
+  EXPECT_THROW_MESSAGE(
+      starfish.WindowInputs(r, MakeStarfishWindow(r, 0, 10), StarfishActuation{}), InvalidInputError,
+      p + ":4: tendon = 80 mm gives activation -0.223077 < 0 (the filtered contraction exceeds slack + length: "
+          "slack 0 m, length 0.065 m)");
 }
 
 // The errors of the recording against itself are zero; a common x shift of
@@ -235,6 +268,37 @@ TEST(StarfishMetricsTest, ErrorsAndBaselinesOfTheRealRecording) {
   EXPECT_THROW_MESSAGE(
       CompareDisplacements(StarfishDisplacements(3), cap), InvalidInputError,
       "CompareDisplacements: 3 predicted frames against " + std::to_string(cap.size()) + " captured ones");
+}
+
+// The trace has a header and one row per frame: time, tendon in mm, the
+// frame's first activation, then simulated and captured x, z per marker in mm.
+TEST(StarfishTraceTest, OneRowPerFrameInMillimetres) {
+  const StarfishRecording r = ReadStarfishRecording(kCyclic1);
+  const StarfishWindow w = MakeStarfishWindow(r, 2, 0.05);
+  ASSERT_EQ(w.num_frames(), 4);
+  Rollout rollout;
+  rollout.inputs.resize(6);
+  for (int k = 0; k < 6; ++k) rollout.inputs[k].activation = VectorXd::Constant(4, 1 - 0.01 * k);
+  const StarfishDisplacements cap = CapturedDisplacements(r, w);
+  StarfishDisplacements sim = cap;
+  sim[3][1] = Eigen::Vector2d(0.002, -0.001);
+  const std::string path = WriteStarfishTrace(Scratch().path().string(), r, w, rollout, 2, sim, cap);
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 5u);
+  EXPECT_EQ(lines[0].substr(0, 54), "time_s,tendon_mm,activation,M1_sim_x,M1_cap_x,M1_sim_z");
+  std::vector<double> row;
+  std::stringstream fields(lines[4]);
+  for (std::string f; std::getline(fields, f, ',');) row.push_back(std::stod(f));
+  ASSERT_EQ(row.size(), 19u);
+  // The file has 6 significant digits.
+  EXPECT_NEAR(row[0], r.time[w.last], 1e-5 * r.time[w.last]);
+  EXPECT_NEAR(row[1], r.tendon[w.last] * 1e3, 1e-5 * r.tendon[w.last] * 1e3);
+  EXPECT_NEAR(row[2], 0.95, 1e-12);  // the frame's first step, 3 * 2 capped at the last input
+  EXPECT_NEAR(row[7], 2.0, 1e-9);    // M2 simulated x, mm
+  EXPECT_NEAR(row[9], -1.0, 1e-9);   // M2 simulated z, mm
+  EXPECT_NEAR(row[8], cap[3][1](0) * 1e3, 1e-5 * std::abs(cap[3][1](0) * 1e3) + 1e-9);
 }
 
 // The window of the gradient and fit tests: 0.15 s from 1.15 s of cyclic1

@@ -11,6 +11,7 @@
 #include "diffpd/solvers/core/initial_state_block.h"
 #include "diffpd/solvers/core/trajectory_function.h"
 #include "solvers/ceres/calibration_fixture.h"
+#include "util/expect_message.h"
 
 namespace diffpd::testing {
 namespace {
@@ -141,36 +142,31 @@ TEST(RolloutCostFunctionTest, PerFrameBlocksShareOneRolloutPerPointThroughTheCal
 
 TEST(RolloutCostFunctionTest, BadArgumentsAreRefusedWithMessages) {
   auto f = Synthetic(Method::kNewtonCholesky, true, TrueMaterial(), 4).MakeFunction(YoungsModulusAndPoissonsRatio());
-  auto message = [](const std::function<void()>& fn) -> std::string {
-    try {
-      fn();
-    } catch (const InvalidInputError& e) {
-      return e.what();
-    }
-    return "no exception";
-  };
   const int rows = f->num_rows();
-  EXPECT_EQ(message([&] { RolloutCostFunction(f.get(), {}); }), "RolloutCostFunction: no row");
-  EXPECT_EQ(message([&] { RolloutCostFunction(f.get(), {rows}); }),
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] { RolloutCostFunction(f.get(), {}); }), "RolloutCostFunction: no row");
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] { RolloutCostFunction(f.get(), {rows}); }),
             "RolloutCostFunction: row " + std::to_string(rows) + " is out of range [0, " + std::to_string(rows) + ")");
-  EXPECT_EQ(message([&] { RolloutCostFunction(f.get(), {1, 3, 1}); }), "RolloutCostFunction: row 1 is listed twice");
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] {
+              RolloutCostFunction(f.get(), {1, 3, 1});
+            }),
+            "RolloutCostFunction: row 1 is listed twice");
   double a[2], b[3];
   ceres::Problem problem;
-  EXPECT_EQ(message([&] {
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] {
               AddMarkerResidualBlocks(&problem, f.get(), 0, {a, b});
             }),
             "AddMarkerResidualBlocks: got 2 parameter blocks, the rollout function has 1");
-  EXPECT_EQ(message([&] {
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] {
               RolloutEvaluationCallback(f.get(), {a, b});
             }),
             "RolloutEvaluationCallback: got 2 parameter blocks, the rollout function has 1");
   f->AddFunctional(
       std::make_unique<PointCoordinate>(NodePoint(f->scene().mesh.num_vertices(), 0), 2, Vec3::UnitZ(), "tip"));
-  EXPECT_EQ(message([&] { AddMarkerResidualBlocks(&problem, f.get(), 1, {a}); }),
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] { AddMarkerResidualBlocks(&problem, f.get(), 1, {a}); }),
             "AddMarkerResidualBlocks: functional 1 ('tip') is not a MarkerResiduals");
   RolloutFunction no_blocks(SmallBeamScene(), TightOptions(Method::kNewtonCholesky), 2);
   no_blocks.AddFunctional(std::make_unique<PointCoordinate>(NodePoint(45, 44), 2, Vec3::UnitZ()));
-  EXPECT_EQ(message([&] { RolloutCostFunction(&no_blocks, {0}); }),
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] { RolloutCostFunction(&no_blocks, {0}); }),
             "RolloutCostFunction: the rollout function has no parameter block");
 }
 

@@ -9,21 +9,13 @@
 #include <limits>
 
 #include "diffpd/error.h"
+#include "util/expect_message.h"
 #include "solvers/core/parameter_block_cases.h"
 
 namespace diffpd::testing {
 namespace {
 
 using namespace solvers;
-
-std::string Message(const std::function<void()>& fn) {
-  try {
-    fn();
-  } catch (const InvalidInputError& e) {
-    return e.what();
-  }
-  return "no exception";
-}
 
 TEST(RolloutFunctionTest, OneRolloutPerPointAndJacobianRowsComputedOnce) {
   ParameterBlockCase c = ExternalForceCase();  // 11 parameters, 4 rows
@@ -265,31 +257,34 @@ TEST(RolloutFunctionTest, BaseSetupHasRestActivationsForMuscles) {
 TEST(RolloutFunctionTest, BadConfigurationIsRefusedWithAMessage) {
   const Scene scene = SmallBeamScene();
   const SolverOptions options = TightOptions(Method::kNewtonCholesky);
-  EXPECT_EQ(Message([&] { RolloutFunction(scene, options, 0); }),
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] { RolloutFunction(scene, options, 0); }),
             "RolloutFunction: num_steps = 0 is invalid: must be >= 1");
   RolloutFunction f(scene, options, 4);
   const int n = scene.mesh.num_dofs();
   State s = f.base().initial;
   s.v.resize(5);
-  EXPECT_EQ(Message([&] { f.SetInitialState(s); }), "initial state has " + std::to_string(n) +
-                                                        " positions and 5 velocities, expected " + std::to_string(n) +
-                                                        " each");
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] { f.SetInitialState(s); }), "initial state has " + std::to_string(n) +
+                                                                             " positions and 5 velocities, expected " +
+                                                                             std::to_string(n) + " each");
   s = f.base().initial;
   s.x(0) = std::numeric_limits<double>::infinity();
-  EXPECT_EQ(Message([&] { f.SetInitialState(s); }), "initial state has a non-finite entry");
-  EXPECT_EQ(Message([&] { f.SetInputs(std::vector<StepInput>(2)); }), "inputs has 2 steps, expected 4");
-  EXPECT_EQ(Message([&] { f.AddBlock(nullptr); }), "RolloutFunction: the parameter block is null");
-  EXPECT_EQ(Message([&] {
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] { f.SetInitialState(s); }), "initial state has a non-finite entry");
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] { f.SetInputs(std::vector<StepInput>(2)); }),
+            "inputs has 2 steps, expected 4");
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] { f.AddBlock(nullptr); }), "RolloutFunction: the parameter block is null");
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] {
               f.AddBlock(std::make_unique<InitialStateBlock>(InitialStateBlock::kVelocity, std::vector<int>{1000}));
             }),
             "initial_velocity: node 1000 is out of range: the mesh has 45 nodes");
-  EXPECT_EQ(
-      Message([&] { f.AddFunctional(std::make_unique<PointCoordinate>(NodePoint(45, 0), 7, Vec3::UnitZ(), "late")); }),
-      "functional 'late' reads state 7, outside the rollout's states [0, 4]");
-  EXPECT_EQ(Message([&] { f.AddFunctional(nullptr); }), "RolloutFunction: the functional is null");
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] {
+              f.AddFunctional(std::make_unique<PointCoordinate>(NodePoint(45, 0), 7, Vec3::UnitZ(), "late"));
+            }),
+            "functional 'late' reads state 7, outside the rollout's states [0, 4]");
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] { f.AddFunctional(nullptr); }), "RolloutFunction: the functional is null");
   EXPECT_EQ(f.num_blocks(), 0);
   EXPECT_EQ(f.num_functionals(), 0);
-  EXPECT_EQ(Message([&] { f.SetupAt(VectorXd::Zero(2)); }), "the parameter vector has 2 entries, expected 0");
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] { f.SetupAt(VectorXd::Zero(2)); }),
+            "the parameter vector has 2 entries, expected 0");
 }
 
 }  // namespace

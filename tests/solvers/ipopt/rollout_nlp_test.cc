@@ -10,6 +10,7 @@
 #include "diffpd/error.h"
 #include "diffpd/solvers/core/activation_block.h"
 #include "solvers/ipopt/test_problems.h"
+#include "util/expect_message.h"
 
 namespace diffpd::testing {
 namespace {
@@ -452,37 +453,30 @@ TEST(RolloutNlpTest, KeepsTheBestFeasiblePointWhereBothFAndGWereEvaluated) {
 }
 
 TEST(RolloutNlpTest, BadInputIsRefusedWithAMessage) {
-  auto message = [](const std::function<void()>& fn) -> std::string {
-    try {
-      fn();
-    } catch (const InvalidInputError& e) {
-      return e.what();
-    }
-    return "no exception";
-  };
-  EXPECT_EQ(message([] { RolloutNlp nlp(nullptr); }), "RolloutNlp: the rollout function is null");
+  EXPECT_EQ(MessageOf<InvalidInputError>([] { RolloutNlp nlp(nullptr); }), "RolloutNlp: the rollout function is null");
   Ipopt::SmartPtr<RolloutNlp> nlp = EmptyNlp(SmallBeamScene(), TightNewton(), 4);
-  EXPECT_EQ(message([&] {
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] {
               nlp->AddVariables(std::make_unique<solvers::InitialStateBlock>(solvers::InitialStateBlock::kVelocity,
                                                                              std::vector<int>{1000}));
             }),
             "initial_velocity: node 1000 is out of range: the mesh has 45 nodes");
-  EXPECT_EQ(message([&] {
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] {
               nlp->AddConstraint(
                   std::make_unique<solvers::PointCoordinate>(solvers::NodePoint(45, 0), 7, Vec3::UnitZ(), "late"), 0,
                   1);
             }),
             "functional 'late' reads state 7, outside the rollout's states [0, 4]");
-  EXPECT_EQ(message([&] {
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] {
               nlp->AddConstraint(
                   std::make_unique<solvers::PointCoordinate>(solvers::NodePoint(45, 0), 1, Vec3::UnitZ(), "c"), 1, 0);
             }),
             "RolloutNlp: constraint 'c' bounds [1, 0] are invalid: need lower <= upper, no NaN");
-  EXPECT_EQ(message([&] { nlp->AddObjectiveRows({3}); }), "RolloutNlp: objective row 3 is out of range [0, 0)");
-  EXPECT_EQ(message([&] { nlp->AddRegularization(0, 2, 1.0); }),
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] { nlp->AddObjectiveRows({3}); }),
+            "RolloutNlp: objective row 3 is out of range [0, 0)");
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] { nlp->AddRegularization(0, 2, 1.0); }),
             "RolloutNlp: regularization of variables [0, 2) with weight 1 is invalid: need a range inside [0, 0) and a "
             "finite weight >= 0 and reference");
-  EXPECT_EQ(message([&] { nlp->SetStartingPoint(VectorXd::Zero(2)); }),
+  EXPECT_EQ(MessageOf<InvalidInputError>([&] { nlp->SetStartingPoint(VectorXd::Zero(2)); }),
             "RolloutNlp: the starting point has 2 entries, expected 0 finite values");
 }
 

@@ -1,0 +1,29 @@
+// The preconditions Backward and Tangents share on the rollout they
+// differentiate (internal).
+#pragma once
+
+#include <string>
+
+#include "diffpd/rollout.h"
+#include "solver/simulator_impl.h"
+
+namespace diffpd::internal {
+
+// Throws InvalidInputError, the message starting with `caller` ("Backward",
+// "Tangents"), unless `rollout` can be differentiated by `sim`:
+//  - K inputs and K + 1 states: "Backward: the rollout has 4 states for 2 inputs (needs one more state than
+//    inputs)";
+//  - every state's x and v of 3n finite entries: "Backward: the rollout's state 1 has x with 24 entries, expected
+//    48 (3 x number of nodes)", "Backward: the rollout's state 1 has a non-finite entry in v";
+//  - every input's external force empty or 3n finite entries, its activation
+//    empty or one finite entry >= 0 per muscle: "Backward: the rollout's input
+//    0 has external_force with 3 entries, expected 48 (3 x number of nodes)",
+//    "Backward: the rollout's input 0: activation has 3 entries, expected 2 (one per muscle)";
+//  - made with the simulator's current materials, time step and method
+//    (MadeWithCurrentSettings): "Backward: the rollout was made with another
+//    material, time step or method than the simulator's current ones";
+//  - with frictional contact (implicit methods), one report per step: "Backward: a rollout with frictional contact
+//    needs its step reports (active sets)".
+void CheckRolloutForDerivatives(const SimulatorImpl& sim, const Rollout& rollout, const std::string& caller);
+
+}  // namespace diffpd::internal

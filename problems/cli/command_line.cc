@@ -1,0 +1,131 @@
+// RunCommandLine (command_line.h): the diffpd program's subcommands, their
+// options and the mapping of exceptions to exit statuses.
+#include "cli/command_line.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cli/commands.h"
+#include "cli/option_checks.h"
+#include "diffpd/error.h"
+#include "problem_registry.h"
+
+namespace diffpd::problems {
+namespace {
+
+// Adds the options shared by the simulating subcommands.
+void AddCommonOptions(CLI::App* cmd, CommandArgs* args, std::string* method) {
+  cmd->add_option("problem", args->problem, "problem name (see `diffpd list`)")->required();
+  cmd->add_option("--method", *method, "semi-implicit, newton-cholesky, newton-pcg, pd or pd-lbfgs")
+      ->capture_default_str();
+  cmd->add_option("--threads", args->threads, "threads for element loops (0: OpenMP default)")
+      ->check(ThreadCount("--threads"));
+  cmd->add_option("--steps", args->steps, "number of time steps (default: the problem's)")
+      ->check(IntegerAtLeast("--steps", 1));
+  cmd->add_option("--dt", args->dt, "time step in seconds (default: the problem's)")->check(Positive("--dt", "s"));
+  cmd->add_option("--rtol", args->rel_tolerance, "relative tolerance on |grad g| per step")->check(Fraction("--rtol"));
+  cmd->add_option("--lbfgs-scale", args->lbfgs_weight_scale,
+                  "pd-lbfgs: elastic weight factor of its initial Hessian A, in (0, 1]")
+      ->check(Fraction("--lbfgs-scale", true))
+      ->capture_default_str();
+  cmd->add_flag("--no-rigid-correction{false}", args->rigid_mode_correction,
+                "pd-lbfgs and the PD backward: without the rigid modes' coarse correction");
+  cmd->add_option("--verbosity", args->verbosity,
+                  "solver log on stderr: 0 none, 1 a line per step, 2 a line per iteration and contact pass")
+      ->check(IntegerIn("--verbosity", 0, 2))
+      ->capture_default_str();
+  cmd->add_flag("--json", args->json, "print one JSON document on stdout");
+}
+
+}  // namespace
+
+int RunCommandLine(const std::vector<std::string>& argv) {
+  CLI::App app{"diffpd: differentiable soft-body simulation by projective dynamics"};
+  app.require_subcommand(1);
+  bool list_json = false;
+  CLI::App* list = app.add_subcommand("list", "list the problems with a one-line description");
+  list->add_flag("--json", list_json, "print a JSON list");
+
+  CommandArgs run_args, grad_args;
+  std::string run_method = "pd-lbfgs", grad_method = "pd";  // pd-lbfgs: the fastest PD variant measured on every scene
+  CLI::App* run = app.add_subcommand("run", "simulate a problem, print a per-step table and write results");
+  AddCommonOptions(run, &run_args, &run_method);
+  run->add_option(
+      "--out", run_args.out_dir,
+      "directory for VTK frames (.vtu + .pvd), plots and summary.json (optimisation problems: default out/<problem>)");
+  run->add_flag("--small", run_args.small, "optimisation problems: the reduced instance (under a minute)");
+  run->add_flag("!--no-compare", run_args.compare_newton,
+                "optimisation problems: skip the repeat with newton-cholesky");
+  run->add_option("--ipopt", run_args.ipopt_options, "optimisation problems: Ipopt option name=value (repeatable)");
+  run->add_option("--data", run_args.data_file,
+                  "calibration problems: captured-motion CSV (default: the problem's in data/)");
+  run->add_option("--methods", run_args.methods,
+                  "calibration problems: methods to fit with, compared (comma-separated)")
+      ->delimiter(',');
+  run->add_option("--max-iterations", run_args.max_iterations, "calibration problems: Ceres iterations per fit")
+      ->check(IntegerAtLeast("--max-iterations", 1));
+  run->add_option("--calibrate", run_args.calibrate_file, "calibrate-starfish: the recording to fit");
+  run->add_option("--predict", run_args.predict_files, "calibrate-starfish: recordings to predict (repeatable)");
+  run->add_option("--seconds", run_args.seconds, "calibrate-starfish: seconds of each recording to evaluate")
+      ->check(Positive("--seconds", "s"));
+  run->add_option("--regions", run_args.regions,
+                  "calibrate-starfish: material regions, 'body-arms' (separate E for the body and the arms)");
+  run->add_option("--fit", run_args.fit,
+                  "calibrate-starfish: 'lm' (Levenberg-Marquardt on marker residuals, default) or 'lbfgs'");
+  run->add_option("--fit-start", run_args.fit_start, "calibrate-starfish: start of the fit window (s, default 1)")
+      ->check(NonNegative("--fit-start"));
+  run->add_option("--fit-seconds", run_args.fit_seconds, "calibrate-starfish: length of the fit window (s, default 2)")
+      ->check(Positive("--fit-seconds", "s"));
+
+  CLI::App* grad = app.add_subcommand("gradcheck", "compare rollout gradients with central finite differences");
+  AddCommonOptions(grad, &grad_args, &grad_method);
+  const auto bench = AddBenchCommand(&app);
+  const auto tradeoff = AddTradeoffCommand(&app);
+  const auto stress = AddStressCommand(&app);
+  const auto synth = AddSynthCommand(&app);
+
+  try {
+    // CLI11 wants argv in reverse order, without the program name.
+    std::vector<std::string> arguments(argv.rbegin(), argv.rend());
+    if (!arguments.empty()) arguments.pop_back();
+    try {
+      app.parse(arguments);
+    } catch (const CLI::ParseError& e) {
+      return app.exit(e);
+    }
+    if (*list) return ListCommand(list_json);
+    if (*run) {
+      run_args.method = ParseMethod(run_method);
+      const std::unique_ptr<Problem> problem = MakeProblem(run_args.problem);
+      RefuseUnusedRunOptions(run_args, *problem);
+      const int own = problem->Run(run_args);
+      if (own >= 0) return own;
+      return RunCommand(run_args);
+    }
+    if (*grad) {
+      grad_args.method = ParseMethod(grad_method);
+      return GradcheckCommand(grad_args);
+    }
+    if (*bench.app) return bench.run();
+    if (*tradeoff.app) return tradeoff.run();
+    if (*stress.app) return stress.run();
+    if (*synth.app) return synth.run();
+  } catch (const InvalidInputError& e) {
+    std::fprintf(stderr, "diffpd: invalid input: %s\n", e.what());
+    return 2;
+  } catch (const SolverError& e) {
+    std::fprintf(stderr, "diffpd: solver failed (%s): %s\n", ToString(e.status()), e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "diffpd: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace diffpd::problems

@@ -1,0 +1,73 @@
+// RefuseUnusedRunOptions (commands.h): which of `diffpd run`'s
+// problem-specific options each kind of problem reads.
+#include <string>
+#include <vector>
+
+#include "calibration/calibrate_problem.h"
+#include "calibration/calibrate_starfish.h"
+#include "cli/commands.h"
+#include "control/trajectory_optimization.h"
+#include "diffpd/error.h"
+
+namespace diffpd::problems {
+namespace {
+
+enum Kind { kSimulation = 1, kOptimisation = 2, kCalibration = 4, kStarfish = 8 };
+
+const char* KindName(int kind) {
+  switch (kind) {
+    case kOptimisation:
+      return "optimisation problem";
+    case kCalibration:
+      return "calibration problem";
+    case kStarfish:
+      return "starfish calibration";
+    default:
+      return "simulation problem";
+  }
+}
+
+int KindOf(const Problem& problem) {
+  if (dynamic_cast<const TrajectoryOptimizationProblem*>(&problem)) return kOptimisation;
+  if (dynamic_cast<const CalibrationProblem*>(&problem)) return kCalibration;
+  if (dynamic_cast<const StarfishCalibration*>(&problem)) return kStarfish;
+  return kSimulation;
+}
+
+// An option, whether it was given, and the kinds of problem that read it.
+struct RunOption {
+  const char* name;
+  bool given;
+  int readers;
+  const char* read_by;
+};
+
+}  // namespace
+
+void RefuseUnusedRunOptions(const CommandArgs& args, const Problem& problem) {
+  const CommandArgs defaults;
+  const RunOption options[] = {
+      {"--small", args.small, kOptimisation, "the optimisation problems"},
+      {"--no-compare", args.compare_newton != defaults.compare_newton, kOptimisation | kCalibration,
+       "the optimisation and calibration problems"},
+      {"--ipopt", !args.ipopt_options.empty(), kOptimisation, "the optimisation problems"},
+      {"--data", !args.data_file.empty(), kCalibration, "calibrate-plant and calibrate-bouncing-ball"},
+      {"--methods", !args.methods.empty(), kCalibration | kStarfish, "the calibration problems"},
+      {"--max-iterations", args.max_iterations != defaults.max_iterations, kCalibration | kStarfish,
+       "the calibration problems"},
+      {"--calibrate", !args.calibrate_file.empty(), kStarfish, "calibrate-starfish"},
+      {"--predict", !args.predict_files.empty(), kStarfish, "calibrate-starfish"},
+      {"--seconds", args.seconds != defaults.seconds, kStarfish, "calibrate-starfish"},
+      {"--regions", !args.regions.empty(), kStarfish, "calibrate-starfish"},
+      {"--fit", !args.fit.empty(), kStarfish, "calibrate-starfish"},
+      {"--fit-start", args.fit_start != defaults.fit_start, kStarfish, "calibrate-starfish"},
+      {"--fit-seconds", args.fit_seconds != defaults.fit_seconds, kStarfish, "calibrate-starfish"},
+  };
+  const int kind = KindOf(problem);
+  for (const RunOption& o : options)
+    if (o.given && !(o.readers & kind))
+      throw InvalidInputError(std::string(o.name) + " is not used by the " + KindName(kind) + " '" + problem.name() +
+                              "' (only " + o.read_by + " read it)");
+}
+
+}  // namespace diffpd::problems
