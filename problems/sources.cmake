@@ -12,11 +12,33 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/scenes/rolling_sphere.cc
   ${CMAKE_CURRENT_LIST_DIR}/scenes/bouncing_ball.cc
   ${CMAKE_CURRENT_LIST_DIR}/scenes/routing_tendon.cc
+  # paper: the DiffPD paper's table rows as data
+  ${CMAKE_CURRENT_LIST_DIR}/paper/numpy_random.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/paper_meshes.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/log_material_variables.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/rigid_placement_variables.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/activation_variables.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/trajectory_losses.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/paper_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/paper_rows.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/cantilever_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/rolling_sphere_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/plant_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/bouncing_ball_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/bunny_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/routing_tendon_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/torus_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/quadruped_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/cow_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/row_evaluation.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/row_rollout_function.cc
   # tools
   ${CMAKE_CURRENT_LIST_DIR}/tools/gradcheck.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/bench.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/tradeoff.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/stress.cc
+  ${CMAKE_CURRENT_LIST_DIR}/tools/table.cc
+  ${CMAKE_CURRENT_LIST_DIR}/tools/table_report.cc
   # the diffpd program's subcommands (main.cc is the executable's)
   ${CMAKE_CURRENT_LIST_DIR}/cli/command_line.cc
   ${CMAKE_CURRENT_LIST_DIR}/cli/option_checks.cc
@@ -27,7 +49,8 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/cli/bench_command.cc
   ${CMAKE_CURRENT_LIST_DIR}/cli/tradeoff_command.cc
   ${CMAKE_CURRENT_LIST_DIR}/cli/stress_command.cc
-  ${CMAKE_CURRENT_LIST_DIR}/cli/synth_command.cc)
+  ${CMAKE_CURRENT_LIST_DIR}/cli/synth_command.cc
+  ${CMAKE_CURRENT_LIST_DIR}/cli/table_command.cc)
 # calibration: system identification with Ceres
 set(DIFFPD_PROBLEMS_CALIBRATION_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_problem.cc
@@ -46,9 +69,13 @@ set(DIFFPD_PROBLEMS_CONTROL_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/control/trajectory_optimization.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/bunny.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/routing_tendon_opt.cc
-  ${CMAKE_CURRENT_LIST_DIR}/control/locomotion.cc)
+  ${CMAKE_CURRENT_LIST_DIR}/control/locomotion.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/row_optimisation.cc)
 get_filename_component(DIFFPD_DEFAULT_SHARED_DATA_DIR "${CMAKE_CURRENT_LIST_DIR}/../../shared/data" ABSOLUTE)
 set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/shared_data.cc PROPERTIES
   COMPILE_DEFINITIONS "DIFFPD_SHARED_DATA_DIR=\"${DIFFPD_DEFAULT_SHARED_DATA_DIR}\"")
+get_filename_component(DIFFPD_SOURCE_ROOT "${CMAKE_CURRENT_LIST_DIR}/.." ABSOLUTE)
+set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/tools/table.cc PROPERTIES
+  COMPILE_DEFINITIONS "DIFFPD_SOURCE_DIR=\"${DIFFPD_SOURCE_ROOT}\"")
 set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_problem.cc PROPERTIES
   COMPILE_DEFINITIONS "DIFFPD_PROJECT_DATA_DIR=\"${CMAKE_CURRENT_LIST_DIR}/../data\"")

@@ -88,6 +88,7 @@ int RunCommandLine(const std::vector<std::string>& argv) {
   const auto tradeoff = AddTradeoffCommand(&app);
   const auto stress = AddStressCommand(&app);
   const auto synth = AddSynthCommand(&app);
+  const auto table = AddTableCommand(&app);
 
   try {
     // CLI11 wants argv in reverse order, without the program name.
@@ -115,6 +116,7 @@ int RunCommandLine(const std::vector<std::string>& argv) {
     if (*tradeoff.app) return tradeoff.run();
     if (*stress.app) return stress.run();
     if (*synth.app) return synth.run();
+    if (*table.app) return table.run();
   } catch (const InvalidInputError& e) {
     std::fprintf(stderr, "diffpd: invalid input: %s\n", e.what());
     return 2;

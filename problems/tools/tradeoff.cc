@@ -127,17 +127,6 @@ CornerMeasurement MeasureCorners(const std::string& problem_name, int doublings,
   return out;
 }
 
-// Quotes a string for gnuplot's single-quoted strings ('' is a quote).
-std::string GnuplotQuote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) {
-    if (c == '\n' || c == '\r') throw InvalidInputError("plot path contains a line break: give a plain file name");
-    out += c;
-    if (c == '\'') out += '\'';
-  }
-  return out + "'";
-}
-
 }  // namespace
 
 void TradeoffOptions::Validate() const {
@@ -269,6 +258,16 @@ nlohmann::json TradeoffToJson(const std::vector<TradeoffRow>& rows) {
                    {"steps", r.steps}});
   }
   return out;
+}
+
+std::string GnuplotQuote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) {
+    if (c == '\n' || c == '\r') throw InvalidInputError("plot path contains a line break: give a plain file name");
+    out += c;
+    if (c == '\'') out += '\'';
+  }
+  return out + "'";
 }
 
 bool GnuplotAvailable() {

@@ -78,6 +78,10 @@ nlohmann::json TradeoffToJson(const std::vector<TradeoffRow>& rows);
 
 // True when a `gnuplot` executable is on PATH.
 bool GnuplotAvailable();
+// `s` as a gnuplot single-quoted string ('' is a quote). Throws
+// InvalidInputError for a line break ("plot path contains a line break: give
+// a plain file name").
+std::string GnuplotQuote(const std::string& s);
 // Writes a PNG of the rows with gnuplot: one column per sweep, top row state
 // error and bottom row gradient error against seconds, log-log, one curve per
 // method (zero errors drawn at 1e-17). Throws std::runtime_error when gnuplot

@@ -17,3 +17,4 @@ diffpd_add_test(rigid_mode_correction_test ${CMAKE_CURRENT_LIST_DIR}/rigid_mode_
 diffpd_add_test(rollout_test ${CMAKE_CURRENT_LIST_DIR}/rollout_test.cc)
 diffpd_add_test(rollout_checks_test ${CMAKE_CURRENT_LIST_DIR}/rollout_checks_test.cc)
 diffpd_add_test(simulator_test ${CMAKE_CURRENT_LIST_DIR}/simulator_test.cc)
+diffpd_add_test(tolerance_reference_test ${CMAKE_CURRENT_LIST_DIR}/tolerance_reference_test.cc)

@@ -10,11 +10,13 @@
 //
 // F_s the deformation gradient and vol_s the sample's rest volume (m^3), k the
 // stiffness (Pa). a = 1 is the rest length of the fibre (no force at rest),
-// a < 1 contracts, a > 1 extends. This is a projective-dynamics energy
-// (w/2)|G x - p|^2 with the feature G x = F m (3-vector), w = k vol_s and the
-// projection p = a F m / |F m| onto the sphere of radius a (at F m = 0 the
-// fibre direction m is used), so PD solves it with the constant matrix A
-// (activation does not enter A) and Newton with its exact Hessian.
+// a < 1 contracts, a > 1 extends; a <= 0 pulls the fibre toward zero length,
+// the harder the more negative a is (the energy is then (|F m| + |a|)^2).
+// This is a projective-dynamics energy (w/2)|G x - p|^2 with the feature
+// G x = F m (3-vector), w = k vol_s and the projection p = a F m / |F m| onto
+// the sphere of radius a (at F m = 0 the fibre direction m is used), so PD
+// solves it with the constant matrix A (activation does not enter A) and
+// Newton with its exact Hessian.
 // Gradients w.r.t. the activations: RolloutGradient::activation.
 //
 // Scene::Validate rejects, with InvalidInputError (j, t indices):
@@ -23,10 +25,10 @@
 //   "scene: muscles[j] has 3 fibre directions for 2 elements (need one per element or a single shared one)",
 //   "scene: muscles[j].fibers[t] = (0, 0, 0) is invalid: must be finite with non-zero length",
 //   "scene: muscles[j].stiffness = -1 is invalid: must be finite and > 0 (Pa)".
-// Step rejects a StepInput::activation of the wrong size or with a negative
-// or non-finite entry:
+// Step rejects a StepInput::activation of the wrong size or with a
+// non-finite entry:
 //   "activation has 3 entries, expected 2 (one per muscle)",
-//   "activation[1] = nan is invalid: must be finite and >= 0".
+//   "activation[1] = nan is invalid: must be finite".
 #pragma once
 
 #include <vector>

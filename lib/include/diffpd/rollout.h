@@ -19,7 +19,7 @@ struct State {
 // What drives one step. An empty vector means "none" and costs nothing.
 struct StepInput {
   VectorXd external_force;  // 3n, N, applied during the step (explicit)
-  // One activation per Scene::muscles entry (muscle.h), finite and >= 0;
+  // One activation per Scene::muscles entry (muscle.h), finite;
   // empty: all at rest (1). Held during the step.
   VectorXd activation;
 };

@@ -20,6 +20,18 @@ Method ParseMethod(const std::string& name);
 
 enum class PcgPreconditioner { kJacobi, kIncompleteCholesky };
 
+// What the relative tolerance of each step's solve is relative to.
+enum class ToleranceReference {
+  // |grad g(x_i + h v_i)|: the residual where the solve starts.
+  kStartResidual,
+  // |(M / h^2)(x_i + h v_i) + f| over the free DoFs (f the step's explicit
+  // force; (M / h^2) times the inertial prediction): the DiffPD reference
+  // code's test. It grows with the body's distance from the origin and is
+  // usually far larger than the start residual (a looser test at the same
+  // rel_tolerance).
+  kInertia,
+};
+
 // How the PD backward solves hess g z = b with the forward factor of A.
 enum class PdBackwardMethod {
   kFixedPoint,  // A z_{k+1} = b + dA z_k, the DiffPD iteration
@@ -40,6 +52,9 @@ struct SolverOptions {
   // over the free DoFs, x0 = x_i + h v_i, whichever start the solve takes.
   double abs_tolerance = 1e-9;  // N
   double rel_tolerance = 1e-6;
+  // The norm rel_tolerance multiplies (the first line's |grad g(x0)|);
+  // StepReport::initial_residual reports it.
+  ToleranceReference tolerance_reference = ToleranceReference::kStartResidual;
   int max_iterations = 1000;  // per step (Newton or PD iterations)
   // After a step's solve from x0, compare g there with g(x_i), the previous
   // total energy (kinetic + elastic + the explicit forces' potential); if the

@@ -15,9 +15,9 @@ void CheckActivation(const VectorXd& activation, int num_muscles) {
     throw InvalidInputError(msg.str());
   }
   for (Eigen::Index j = 0; j < activation.size(); ++j)
-    if (!(std::isfinite(activation(j)) && activation(j) >= 0)) {
+    if (!std::isfinite(activation(j))) {
       std::ostringstream msg;
-      msg << "activation[" << j << "] = " << activation(j) << " is invalid: must be finite and >= 0";
+      msg << "activation[" << j << "] = " << activation(j) << " is invalid: must be finite";
       throw InvalidInputError(msg.str());
     }
 }

@@ -6,10 +6,10 @@
 
 namespace diffpd::internal {
 
-// Throws InvalidInputError unless `activation` is empty or has one finite,
-// non-negative entry per muscle:
+// Throws InvalidInputError unless `activation` is empty or has one finite
+// entry per muscle (negative ones included):
 //   "activation has 3 entries, expected 2 (one per muscle)",
-//   "activation[1] = nan is invalid: must be finite and >= 0".
+//   "activation[1] = nan is invalid: must be finite".
 void CheckActivation(const VectorXd& activation, int num_muscles);
 
 // Sets sim.activation for its lifetime and restores the previous value.

@@ -151,6 +151,12 @@ VectorXd GravityPerDof(const SimulatorImpl& sim) {
 StepObjective::StepObjective(SimulatorImpl& sim, VectorXd xhat, VectorXd force, bool static_problem)
     : sim_(sim), xhat_(std::move(xhat)), force_(std::move(force)), static_(static_problem) {
   inertia_ = static_problem ? VectorXd::Zero(sim.num_dofs()) : VectorXd(sim.Mass() / (sim.h() * sim.h()));
+  if (sim.options.tolerance_reference == ToleranceReference::kInertia && !static_problem) {
+    double squares = 0;
+    for (int d = 0; d < xhat_.size(); ++d)
+      if (!sim.fixed[d]) squares += std::pow(inertia_(d) * xhat_(d) + force_(d), 2);
+    reference_residual_ = std::sqrt(squares);
+  }
 }
 
 VectorXd StepObjective::ElasticGradient(const VectorXd& x, const VectorXd& grad) const {

@@ -1,0 +1,59 @@
+#include "paper/row_evaluation.h"
+
+#include <chrono>
+
+#include "diffpd/error.h"
+
+namespace diffpd::problems {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+bool SameMaterial(const MaterialParameters& a, const MaterialParameters& b) {
+  return a.youngs_modulus == b.youngs_modulus && a.poissons_ratio == b.poissons_ratio && a.density == b.density;
+}
+
+}  // namespace
+
+RowEvaluation EvaluateRow(const PaperRow& row, Simulator* simulator, const VectorXd& x, bool gradient) {
+  if (row.prepare)
+    throw InvalidInputError(row.name + ": the row needs its preparatory simulations first (PaperRow::Prepare)");
+  const solvers::RolloutSetup setup = row.Setup(x);
+  if (!SameMaterial(setup.material, simulator->scene().material)) simulator->SetMaterial(setup.material);
+  RowEvaluation out;
+  auto start = Clock::now();
+  const Rollout rollout = simulator->Simulate(setup.initial, setup.inputs);
+  out.forward_s = SecondsSince(start);
+  long iterations = 0;
+  for (const StepReport& r : rollout.reports) {
+    iterations += r.iterations;
+    out.newton_fallback_steps += r.newton_fallback ? 1 : 0;
+  }
+  out.iterations_per_step = rollout.num_steps() > 0 ? double(iterations) / rollout.num_steps() : 0;
+  LossGradient dl;
+  out.loss = row.Loss(rollout, gradient ? &dl : nullptr);
+  if (gradient) {
+    start = Clock::now();
+    const RolloutGradient g = simulator->Backward(rollout, dl);
+    out.gradient = row.PullBack(x, g);
+    out.backward_s = SecondsSince(start);
+    out.backward_iterations_per_step =
+        rollout.num_steps() > 0 ? double(g.report.linear_iterations) / rollout.num_steps() : 0;
+    out.backward_fallbacks = g.report.fallbacks;
+  }
+  return out;
+}
+
+std::vector<double> RandomDrawLosses(const PaperRow& row, Simulator* simulator) {
+  std::vector<double> losses;
+  for (const VectorXd& draw : row.random_draws) losses.push_back(EvaluateRow(row, simulator, draw, false).loss);
+  return losses;
+}
+
+double NormalisedLoss(double loss, double random_mean, double baseline) {
+  return (loss - baseline) / (random_mean - baseline);
+}
+
+}  // namespace diffpd::problems

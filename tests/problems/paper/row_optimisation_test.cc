@@ -1,0 +1,91 @@
+// A paper row through the rollout core and the Ipopt adapter: the row's
+// rollout function gives the row's own loss and gradient, an optimisation
+// lowers the loss within its evaluation budget, and `diffpd table --optimise`
+// reports the optimiser's evaluations and final normalised loss.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "paper/paper_rows.h"
+#include "paper/row_evaluation.h"
+#include "paper/row_optimisation.h"
+#include "paper/row_rollout_function.h"
+#include "tools/table.h"
+
+namespace diffpd::problems {
+namespace {
+
+TEST(RowOptimisationTest, TheRowsRolloutFunctionGivesTheRowsLossAndGradient) {
+  PaperRow row = MakeBunnyRow(RowSize::kSmall);
+  const SolverOptions options = row.Options(Method::kPdLbfgs, 1);
+  row.Prepare(options);
+  Simulator sim(row.scene, options);
+  const VectorXd x = row.initial();
+  const RowEvaluation e = EvaluateRow(row, &sim, x, true);
+  RowRolloutFunction f = MakeRowRolloutFunction(row, options);
+  VectorXd weights = VectorXd::Zero(f.function->num_rows());
+  for (size_t t = 0; t < f.loss_rows.size(); ++t) weights(f.loss_rows[t]) += f.loss_weights[t];
+  VectorXd gradient;
+  double loss = 0;
+  ASSERT_TRUE(f.function->Gradient(x, weights, &gradient, &loss)) << f.function->statistics().last_error;
+  EXPECT_NEAR(loss, e.loss, 1e-10 * std::abs(e.loss));
+  ASSERT_EQ(gradient.size(), e.gradient.size());
+  EXPECT_LE((gradient - e.gradient).norm(), 1e-8 * e.gradient.norm());
+  EXPECT_EQ(f.function->lower_bounds(), row.lower());
+  EXPECT_EQ(f.function->upper_bounds(), row.upper());
+}
+
+TEST(RowOptimisationTest, AnOptimisationLowersThePlantLossAndStopsAtItsEvaluationBudget) {
+  PaperRow row = MakePlantRow(RowSize::kSmall);
+  const SolverOptions options = row.Options(Method::kPdLbfgs, 1);
+  row.Prepare(options);
+  RowOptimisationOptions o;
+  o.max_evaluations = 6;
+  long reported = 0;
+  o.on_evaluation = [&](long k, double loss, double forward_s) {
+    EXPECT_GT(k, reported);
+    EXPECT_TRUE(std::isfinite(loss));
+    EXPECT_GE(forward_s, 0);
+    reported = k;
+  };
+  const RowOptimisationResult r = OptimiseRow(row, options, o);
+  EXPECT_EQ(r.stopped_by, "evaluation budget") << r.status;
+  EXPECT_GE(r.evaluations, 6);
+  EXPECT_EQ(reported, r.evaluations);
+  EXPECT_GE(r.gradients, 1);
+  EXPECT_LT(r.final_loss, 0.75 * r.initial_loss);
+  EXPECT_GT(r.forward_s, 0);
+  EXPECT_GT(r.backward_s, 0);
+  for (int j = 0; j < r.x.size(); ++j) {
+    EXPECT_GE(r.x(j), row.lower()(j));
+    EXPECT_LE(r.x(j), row.upper()(j));
+  }
+}
+
+TEST(RowOptimisationTest, TheTableReportsTheOptimisersEvaluationsAndFinalNormalisedLoss) {
+  TableOptions o;
+  o.rows = {"plant"};
+  o.methods = {Method::kPdLbfgs, Method::kNewtonCholesky};
+  o.threads = 1;
+  o.size = RowSize::kSmall;
+  o.evaluations = 1;
+  o.optimise = true;
+  o.optimiser_evaluations = 6;
+  const TableResult r = RunTable(o, nullptr, {});
+  const TableRowResult& plant = r.rows[0];
+  const TableMethodResult* pd = plant.method("pd-lbfgs");
+  ASSERT_TRUE(pd->optimisation);
+  EXPECT_GE(pd->optimisation->evaluations, 6);
+  ASSERT_TRUE(pd->optimisation->normalised_loss);
+  ASSERT_TRUE(pd->normalised_loss);
+  EXPECT_LT(*pd->optimisation->normalised_loss, *pd->normalised_loss);
+  EXPECT_DOUBLE_EQ(*pd->optimisation->normalised_loss, pd->optimisation->final_loss / *plant.random_loss_mean);
+  EXPECT_FALSE(plant.method("newton-cholesky")->optimisation);  // Newton: timed at x_init only
+  const TableResult back = TableFromJson(TableToJson(r));
+  ASSERT_TRUE(back.rows[0].method("pd-lbfgs")->optimisation);
+  EXPECT_EQ(back.rows[0].method("pd-lbfgs")->optimisation->final_loss, pd->optimisation->final_loss);
+  EXPECT_EQ(back.rows[0].method("pd-lbfgs")->optimisation->loss_history, pd->optimisation->loss_history);
+}
+
+}  // namespace
+}  // namespace diffpd::problems
