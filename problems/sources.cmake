@@ -66,6 +66,12 @@ set(DIFFPD_PROBLEMS_CALIBRATION_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_cantilever.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_plant.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_bouncing_ball.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_recording.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_scene.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_actuation.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_metrics.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_trace.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_fit.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_starfish.cc
   # the swimmers' L-BFGS training
   ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_lbfgs.cc)

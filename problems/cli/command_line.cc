@@ -83,6 +83,12 @@ int RunCommandLine(const std::vector<std::string>& argv) {
       ->check(Positive("--seconds", "s"));
   run->add_option("--regions", run_args.regions,
                   "calibrate-starfish: material regions, 'body-arms' (separate E for the body and the arms)");
+  run->add_option("--fit", run_args.fit,
+                  "calibrate-starfish: 'lm' (Levenberg-Marquardt on marker residuals, default) or 'lbfgs'");
+  run->add_option("--fit-start", run_args.fit_start, "calibrate-starfish: start of the fit window (s, default 1)")
+      ->check(NonNegative("--fit-start"));
+  run->add_option("--fit-seconds", run_args.fit_seconds, "calibrate-starfish: length of the fit window (s, default 2)")
+      ->check(Positive("--fit-seconds", "s"));
 
   CLI::App* grad = app.add_subcommand("gradcheck", "compare rollout gradients with central finite differences");
   AddCommonOptions(grad, &grad_args, &grad_method);

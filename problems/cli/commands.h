@@ -51,7 +51,8 @@ struct CommandArgs {
   // calibrate-starfish: the recording to fit, those to predict, the
   // seconds of each recording to evaluate (-1: the problem's default) and
   // the material regions ("": one material; "body-arms": separate E for the
-  // central body and the four arms).
+  // central body and the four arms), the fit ("": the problem's; "lm",
+  // "lbfgs") and its window (start and length, s; -1: the problem's).
   std::string data_file;
   std::vector<std::string> methods;
   int max_iterations = -1;
@@ -59,6 +60,9 @@ struct CommandArgs {
   std::vector<std::string> predict_files;
   double seconds = -1;
   std::string regions;
+  std::string fit;
+  double fit_start = -1;
+  double fit_seconds = -1;
 };
 
 int ListCommand(bool json);

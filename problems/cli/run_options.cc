@@ -66,6 +66,9 @@ void RefuseUnusedRunOptions(const CommandArgs& args, const Problem& problem) {
       {"--predict", !args.predict_files.empty(), kStarfish, "calibrate-starfish"},
       {"--seconds", args.seconds != defaults.seconds, kStarfish, "calibrate-starfish"},
       {"--regions", !args.regions.empty(), kStarfish, "calibrate-starfish"},
+      {"--fit", !args.fit.empty(), kStarfish, "calibrate-starfish"},
+      {"--fit-start", args.fit_start != defaults.fit_start, kStarfish, "calibrate-starfish"},
+      {"--fit-seconds", args.fit_seconds != defaults.fit_seconds, kStarfish, "calibrate-starfish"},
   };
   const int kind = KindOf(problem);
   for (const RunOption& o : options)

@@ -1,9 +1,10 @@
 // Forward-mode tangents (Simulator::Tangents) vs central finite differences
 // of whole rollouts and vs reverse mode (Backward), for every method, on
-// small hex and tet beams.
+// small hex and tet beams, with and without explicit state forces.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "diffpd/error.h"
@@ -362,14 +363,157 @@ TEST(TangentRolloutTest, ActivationTangentsMatchFiniteDifferences) {
                        "Tangents: direction 0 has an activation with 2 entries, expected 1 (one per muscle)");
 }
 
-TEST(TangentRolloutTest, StateForcesAreRejectedUntilSupported) {
+// The small beam swimming in a current, damped, its lower nodes pressed
+// into a penalty floor with friction: every explicit state force.
+Scene SwimmingBeamScene() {
+  Scene scene = testing::SmallBeamScene(/*tets=*/true);
+  Hydrodynamics water;
+  water.triangles = BoundaryTriangles(scene.mesh);
+  water.thrust = 0.7;
+  water.flow_velocity = Vec3(0.05, -0.1, 0.03);
+  scene.hydrodynamics = water;
+  scene.linear_damping = 0.8;
+  PenaltyContact floor;
+  floor.offset = 0.001;  // the bottom nodes start 1 mm inside
+  floor.stiffness = 300;
+  floor.friction = 0.5;
+  floor.friction_velocity = 0.05;
+  for (int i = 0; i < scene.mesh.num_vertices(); ++i)
+    if (scene.mesh.vertices(2, i) < 1e-9 && scene.mesh.vertices(0, i) > 1e-9) floor.nodes.push_back(i);
+  scene.penalty_contacts = {floor};
+  return scene;
+}
+
+// Each state-force parameter alone as a direction (unit component), then
+// the density, x0 and v0 with every state force acting.
+std::vector<InputDirection> StateForceDirections(int n) {
+  std::vector<InputDirection> dirs(9);
+  dirs[0].state_forces.linear_damping = 1;
+  dirs[1].state_forces.fluid_density = 1e3;
+  dirs[2].state_forces.drag_tangential = 1;
+  dirs[3].state_forces.drag_normal = 1;
+  dirs[4].state_forces.thrust = 1;
+  dirs[5].state_forces.flow_velocity = Vec3(0.1, 0, 0);
+  dirs[6].state_forces.flow_velocity = Vec3(0, 0.1, -0.05);
+  dirs[7].state_forces.penalty_friction = {1.0};
+  InputDirection rho = InputDirection::Density();
+  rho.density = 1e3;
+  dirs[8] = rho;
+  std::mt19937_64 rng(5);
+  InputDirection x0, v0;
+  x0.x0 = RandomVector(n, &rng, 1e-2);
+  v0.v0 = RandomVector(n, &rng, 0.1);
+  dirs.push_back(x0);
+  dirs.push_back(v0);
+  return dirs;
+}
+
+Rollout StateForcePerturbed(const Scene& scene, const SolverOptions& options, const State& start, int steps,
+                            const InputDirection& d, double eps) {
+  Scene s = scene;
+  s.material.density += eps * d.density;
+  *s.linear_damping += eps * d.state_forces.linear_damping;
+  s.hydrodynamics->fluid_density += eps * d.state_forces.fluid_density;
+  s.hydrodynamics->drag_tangential += eps * d.state_forces.drag_tangential;
+  s.hydrodynamics->drag_normal += eps * d.state_forces.drag_normal;
+  s.hydrodynamics->thrust += eps * d.state_forces.thrust;
+  s.hydrodynamics->flow_velocity += eps * d.state_forces.flow_velocity;
+  if (!d.state_forces.penalty_friction.empty())
+    s.penalty_contacts[0].friction += eps * d.state_forces.penalty_friction[0];
+  Simulator sim(s, options);
+  State init = start;
+  if (d.x0.size()) init.x += eps * d.x0;
+  if (d.v0.size()) init.v += eps * d.v0;
+  return sim.Simulate(init, std::vector<StepInput>(steps));
+}
+
+// Forward mode through damping, drag and thrust, and penalty friction, along
+// their parameters and along the states and density they depend on, vs
+// central differences of every state and vs reverse mode.
+TEST(TangentRolloutTest, StateForceTangentsMatchCentralDifferencesAndReverseMode) {
+  const Scene scene = SwimmingBeamScene();
+  for (Method method : {Method::kNewtonCholesky, Method::kPdLbfgs, Method::kSemiImplicit}) {
+    const SolverOptions options = TightOptions(method);
+    Simulator sim(scene, options);
+    const int n = sim.num_dofs();
+    const State start = MovingStart(sim);
+    const int steps = method == Method::kSemiImplicit ? 20 : 4;
+    const Rollout rollout = sim.Simulate(start, std::vector<StepInput>(steps));
+    const std::vector<InputDirection> dirs = StateForceDirections(n);
+    const TangentRollout t = sim.Tangents(rollout, dirs);
+    // Semi-implicit steps solve nothing: their noise is rounding.
+    const double noise = method == Method::kSemiImplicit ? 1e-15 : options.rel_tolerance;
+    const double eps = testing::CentralDifferenceStep(noise, 1.0);
+    for (size_t p = 0; p < dirs.size(); ++p) {
+      const Rollout plus = StateForcePerturbed(scene, options, start, steps, dirs[p], eps);
+      const Rollout minus = StateForcePerturbed(scene, options, start, steps, dirs[p], -eps);
+      testing::DifferenceOptions check;
+      check.noise = noise;
+      // The implicit solves converge far below their tolerance (no floor);
+      // semi-implicit differences carry the states' rounding over 20 steps,
+      // which matters for damping's tangents (1e-5 of the states).
+      check.floor = method == Method::kSemiImplicit ? 1e-14 * plus.states.back().x.norm() / eps : 0.0;
+      check.rtol = 1e-5;  // the differences' truncation reaches 2e-6 of the tangent
+      for (int k = 1; k <= steps; ++k) check.derivative_scale = std::max(check.derivative_scale, t.dx[k].col(p).norm());
+      ASSERT_GT(check.derivative_scale, 0.0) << ToString(method) << " direction " << p;
+      for (int k = 1; k <= steps; ++k)
+        EXPECT_TRUE(testing::Passes(
+            testing::CompareCentralDifference(plus.states[k].x, minus.states[k].x, eps, t.dx[k].col(p), check)))
+            << ToString(method) << " direction " << p << " x_" << k;
+    }
+    // Reverse mode on a random linear loss of every state.
+    std::mt19937_64 rng(3);
+    LossGradient loss(steps);
+    for (int k = 0; k <= steps; ++k) {
+      loss.dx[k] = RandomVector(n, &rng, 1.0);
+      loss.dv[k] = RandomVector(n, &rng, 0.01);
+    }
+    const RolloutGradient g = sim.Backward(rollout, loss);
+    for (size_t p = 0; p < dirs.size(); ++p) {
+      double forward = 0;
+      for (int k = 0; k <= steps; ++k) forward += loss.dx[k].dot(t.dx[k].col(p)) + loss.dv[k].dot(t.dv[k].col(p));
+      const InputDirection& d = dirs[p];
+      const StateForceGradient& s = d.state_forces;
+      double reverse = g.density * d.density + g.state_forces.linear_damping * s.linear_damping +
+                       g.state_forces.fluid_density * s.fluid_density +
+                       g.state_forces.drag_tangential * s.drag_tangential + g.state_forces.drag_normal * s.drag_normal +
+                       g.state_forces.thrust * s.thrust + g.state_forces.flow_velocity.dot(s.flow_velocity);
+      if (!s.penalty_friction.empty()) reverse += g.state_forces.penalty_friction[0] * s.penalty_friction[0];
+      if (d.x0.size()) reverse += g.x0.dot(d.x0);
+      if (d.v0.size()) reverse += g.v0.dot(d.v0);
+      EXPECT_NEAR(forward, reverse, 1e-8 * std::abs(reverse)) << ToString(method) << " direction " << p;
+    }
+  }
+}
+
+TEST(TangentRolloutTest, RejectsStateForceDirectionsTheSceneDoesNotDeclare) {
   Scene scene = testing::SmallBeamScene();
   scene.linear_damping = 0.5;
   Simulator sim(scene, TightOptions(Method::kNewtonCholesky));
   const Rollout rollout = sim.Simulate(sim.RestState(), std::vector<StepInput>(2));
-  ASSERT_THROW_MESSAGE(sim.Tangents(rollout, {InputDirection::Density()}), InvalidInputError,
-                       "Tangents: explicit state forces (linear damping, hydrodynamics, penalty friction) are not "
-                       "differentiated in forward mode yet; use Backward");
+  InputDirection thrust;
+  thrust.state_forces.thrust = 1;
+  ASSERT_THROW_MESSAGE(sim.Tangents(rollout, {InputDirection::Density(), thrust}), InvalidInputError,
+                       "Tangents: direction 1 has a hydrodynamics component, but the scene declares no hydrodynamics");
+  Simulator swim(SwimmingBeamScene(), TightOptions(Method::kNewtonCholesky));
+  const Rollout swim_rollout = swim.Simulate(swim.RestState(), std::vector<StepInput>(2));
+  InputDirection friction;
+  friction.state_forces.penalty_friction = {1.0, 2.0};
+  ASSERT_THROW_MESSAGE(swim.Tangents(swim_rollout, {friction}), InvalidInputError,
+                       "Tangents: direction 0 has penalty_friction for 2 contacts, expected 0 or 1 (one per penalty "
+                       "contact)");
+  InputDirection nan;
+  nan.state_forces.linear_damping = std::nan("");
+  ASSERT_THROW_MESSAGE(sim.Tangents(rollout, {nan}), InvalidInputError,
+                       "Tangents: direction 0 has a non-finite state-force component");
+  Scene dry = testing::SmallBeamScene();
+  Simulator dry_sim(dry, TightOptions(Method::kNewtonCholesky));
+  const Rollout dry_rollout = dry_sim.Simulate(dry_sim.RestState(), std::vector<StepInput>(2));
+  InputDirection damping;
+  damping.state_forces.linear_damping = 1;
+  ASSERT_THROW_MESSAGE(dry_sim.Tangents(dry_rollout, {damping}), InvalidInputError,
+                       "Tangents: direction 0 has a linear_damping component, but the scene declares no linear "
+                       "damping");
 }
 
 }  // namespace

@@ -31,6 +31,12 @@ struct InputDirection {
   // Empty (zero), or one per Scene::material_regions entry, in order: the
   // direction's components for region r's E (Pa), nu and rho (kg/m^3).
   std::vector<MaterialComponents> region_materials;
+  // The declared state forces' parameters (state_forces.h), laid out as
+  // their gradient: linear damping (1/s), fluid density (kg/m^3), drag and
+  // thrust coefficients, flow velocity (m/s), penalty friction per
+  // Scene::penalty_contacts entry (empty: zero). Components of terms the
+  // scene does not declare must be zero.
+  StateForceGradient state_forces;
 
   // The unit direction of one base-material parameter.
   static InputDirection YoungsModulus();

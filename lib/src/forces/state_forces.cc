@@ -144,4 +144,82 @@ void StateForces::AddVjp(const VectorXd& x, const VectorXd& v, const VectorXd& m
   }
 }
 
+void StateForces::AddJvp(const VectorXd& x, const VectorXd& v, const VectorXd& mass, const MatrixXd& dx,
+                         const MatrixXd& dv, const std::vector<VectorXd>& dmass,
+                         const std::vector<StateForceGradient>& dtheta, MatrixXd* df) const {
+  if (empty()) return;
+  const int dirs = static_cast<int>(df->cols());
+  auto mass_direction = [&](int p) -> const VectorXd* {
+    return p < static_cast<int>(dmass.size()) && dmass[p].size() ? &dmass[p] : nullptr;
+  };
+  if (damping_) {
+    // F = -c M v.
+    for (int p = 0; p < dirs; ++p) {
+      auto col = df->col(p);
+      col -= *damping_ * mass.cwiseProduct(dv.col(p));
+      if (const VectorXd* dm = mass_direction(p)) col -= *damping_ * dm->cwiseProduct(v);
+      if (dtheta[p].linear_damping != 0) col -= dtheta[p].linear_damping * mass.cwiseProduct(v);
+    }
+  }
+  if (hydro_) {
+    const Eigen::Matrix3Xi& tri = hydro_->triangles;
+    // Per direction: the parameter components (fluid density, drag
+    // tangential, drag normal, thrust) and the flow velocity's.
+    Eigen::Matrix4Xd dparam(4, dirs);
+    Eigen::Matrix3Xd dflow(3, dirs);
+    for (int p = 0; p < dirs; ++p) {
+      dparam.col(p) << dtheta[p].fluid_density, dtheta[p].drag_tangential, dtheta[p].drag_normal, dtheta[p].thrust;
+      dflow.col(p) = dtheta[p].flow_velocity;
+    }
+    for (int t = 0; t < tri.cols(); ++t) {
+      const int a = tri(0, t), b = tri(1, t), c = tri(2, t);
+      const Vec3 u = MeanVelocity(v, a, b, c) - hydro_->flow_velocity;
+      const Vec3 xa = x.segment<3>(3 * a);
+      const Vec3 e1 = x.segment<3>(3 * b) - xa, e2 = x.segment<3>(3 * c) - xa;
+      const Vec3 area = 0.5 * e1.cross(e2);
+      // The 3 x 3 Jacobians dF/dN, dF/du and the 3 x 4 parameter Jacobian,
+      // row by row from the vector-Jacobian products with the unit vectors.
+      Mat3 d_area, d_u;
+      Eigen::Matrix<double, 3, 4> d_param;
+      for (int k = 0; k < 3; ++k) {
+        Vec3 g_area, g_u;
+        StateForceGradient g;
+        HydrodynamicForceVjp(*hydro_, area, u, Vec3::Unit(k), &g_area, &g_u, &g);
+        d_area.row(k) = g_area.transpose();
+        d_u.row(k) = g_u.transpose();
+        d_param.row(k) << g.fluid_density, g.drag_tangential, g.drag_normal, g.thrust;
+      }
+      if (d_area.isZero(0) && d_u.isZero(0) && d_param.isZero(0)) continue;
+      for (int p = 0; p < dirs; ++p) {
+        const Vec3 dxa = dx.col(p).segment<3>(3 * a);
+        const Vec3 de1 = dx.col(p).segment<3>(3 * b) - dxa, de2 = dx.col(p).segment<3>(3 * c) - dxa;
+        const Vec3 dn = 0.5 * (de1.cross(e2) + e1.cross(de2));
+        const Vec3 du = MeanVelocity(dv.col(p), a, b, c) - dflow.col(p);
+        const Vec3 share = (d_area * dn + d_u * du + d_param * dparam.col(p)) / 3.0;
+        df->col(p).segment<3>(3 * a) += share;
+        df->col(p).segment<3>(3 * b) += share;
+        df->col(p).segment<3>(3 * c) += share;
+      }
+    }
+  }
+  for (const FrictionNode& fn : friction_) {
+    const double gap = fn.normal.dot(x.segment<3>(3 * fn.node)) - fn.offset;
+    if (gap >= 0) continue;
+    // f = mu k gap vt / s, vt = P v, s = sqrt(|vt|^2 + eps^2).
+    const Vec3 vi = v.segment<3>(3 * fn.node);
+    const Vec3 vt = vi - fn.normal.dot(vi) * fn.normal;
+    const double s = std::sqrt(vt.squaredNorm() + fn.eps * fn.eps);
+    for (int p = 0; p < dirs; ++p) {
+      const double dgap = fn.normal.dot(dx.col(p).segment<3>(3 * fn.node));
+      const Vec3 dvi = dv.col(p).segment<3>(3 * fn.node);
+      const Vec3 dvt = dvi - fn.normal.dot(dvi) * fn.normal;
+      const Vec3 dvt_over_s = dvt / s - (vt.dot(dvt) / (s * s * s)) * vt;
+      const std::vector<double>& dmu = dtheta[p].penalty_friction;
+      const double dmu_c = fn.contact < static_cast<int>(dmu.size()) ? dmu[fn.contact] : 0.0;
+      df->col(p).segment<3>(3 * fn.node) +=
+          fn.stiffness * ((fn.mu * dgap + dmu_c * gap) / s * vt + fn.mu * gap * dvt_over_s);
+    }
+  }
+}
+
 }  // namespace diffpd::internal

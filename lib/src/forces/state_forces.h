@@ -3,7 +3,8 @@
 // quads), penalty-contact friction (see diffpd/state_forces.h,
 // diffpd/quad_hydrodynamics.h and diffpd/contact.h for the models). Evaluated once
 // per step at (x_i, v_i); the backward pass needs their vector-Jacobian
-// products. Every method returns at once when nothing is declared.
+// products, the tangent pass their Jacobian-vector products. Every method
+// returns at once when nothing is declared.
 #pragma once
 
 #include <optional>
@@ -30,6 +31,13 @@ class StateForces {
   // if dmass is not nullptr, *dmass += (dF/dM)^T w (3n, per DoF's mass).
   void AddVjp(const VectorXd& x, const VectorXd& v, const VectorXd& mass, const VectorXd& w, VectorXd* gx, VectorXd* gv,
               StateForceGradient* grad, VectorXd* dmass) const;
+  // Jacobian-vector products along P directions: column p of *df (3n x P,
+  // sized by the caller) += dF/dx dx.col(p) + dF/dv dv.col(p) + dF/dM
+  // dmass[p] + dF/dtheta dtheta[p]. dmass: empty, or P entries each 3n or
+  // empty (zero); dtheta: P parameter directions laid out as the gradient
+  // (penalty_friction empty or one per Scene::penalty_contacts entry).
+  void AddJvp(const VectorXd& x, const VectorXd& v, const VectorXd& mass, const MatrixXd& dx, const MatrixXd& dv,
+              const std::vector<VectorXd>& dmass, const std::vector<StateForceGradient>& dtheta, MatrixXd* df) const;
 
  private:
   struct FrictionNode {

@@ -20,8 +20,10 @@
 // d(grad E)/da . da = grad E(a + da) - grad E(a) exactly. Frictional contact:
 // the step's recorded active set is held fixed (as in Backward); a pinned node
 // moves with its pin, dx = dpin/dx_i dx_i + dpin/dv_i dv_i, and the free DoFs
-// solve H_ff dx_f = b_f - H_fp dx_p. Explicit state forces (damping,
-// hydrodynamics, penalty friction) are not differentiated in forward mode yet.
+// solve H_ff dx_f = b_f - H_fp dx_p. Explicit state forces f(x_i, v_i; M,
+// theta) (damping, hydrodynamics, penalty friction) enter both methods'
+// force directions as df = df/dx dx_i + df/dv dv_i + df/dM dM + df/dtheta
+// dtheta (their Jacobian-vector products).
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -158,6 +160,40 @@ void CheckDirections(const std::vector<InputDirection>& dirs, int n, int steps, 
   }
 }
 
+// Throws unless every direction's state-force components are finite and
+// zero for the terms the scene does not declare.
+void CheckStateForceDirections(const std::vector<InputDirection>& dirs, const Scene& scene) {
+  const int contacts = static_cast<int>(scene.penalty_contacts.size());
+  for (size_t p = 0; p < dirs.size(); ++p) {
+    const StateForceGradient& d = dirs[p].state_forces;
+    std::ostringstream msg;
+    msg << "Tangents: direction " << p << " ";
+    const double hydro[4] = {d.fluid_density, d.drag_tangential, d.drag_normal, d.thrust};
+    bool finite = std::isfinite(d.linear_damping) && d.flow_velocity.allFinite();
+    for (const double c : hydro) finite = finite && std::isfinite(c);
+    for (const double c : d.penalty_friction) finite = finite && std::isfinite(c);
+    if (!finite) {
+      msg << "has a non-finite state-force component";
+      throw InvalidInputError(msg.str());
+    }
+    if (d.linear_damping != 0 && !scene.linear_damping) {
+      msg << "has a linear_damping component, but the scene declares no linear damping";
+      throw InvalidInputError(msg.str());
+    }
+    bool any_hydro = !d.flow_velocity.isZero(0);
+    for (const double c : hydro) any_hydro = any_hydro || c != 0;
+    if (any_hydro && !scene.hydrodynamics) {
+      msg << "has a hydrodynamics component, but the scene declares no hydrodynamics";
+      throw InvalidInputError(msg.str());
+    }
+    if (!d.penalty_friction.empty() && static_cast<int>(d.penalty_friction.size()) != contacts) {
+      msg << "has penalty_friction for " << d.penalty_friction.size() << " contacts, expected 0 or " << contacts
+          << " (one per penalty contact)";
+      throw InvalidInputError(msg.str());
+    }
+  }
+}
+
 // The material components of direction d for material part `part` (0: the
 // base material, r + 1: region r).
 MaterialComponents PartComponents(const InputDirection& d, int part) {
@@ -182,10 +218,7 @@ TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std
   const int steps = rollout.num_steps();
   internal::CheckRolloutForDerivatives(sim, rollout, "Tangents");
   CheckDirections(directions, n, steps, sim.aux.num_muscles(), static_cast<int>(sim.scene.material_regions.size()));
-  if (!sim.state_forces.empty())
-    throw InvalidInputError(
-        "Tangents: explicit state forces (linear damping, hydrodynamics, penalty friction) are not differentiated in "
-        "forward mode yet; use Backward");
+  CheckStateForceDirections(directions, sim.scene);
   const bool contact = !sim.scene.frictional_contacts.empty() && sim.options.method != Method::kSemiImplicit;
   std::vector<const ContactSurface*> surface_of(n / 3, nullptr);
   for (const FrictionalContact& c : sim.scene.frictional_contacts)
@@ -239,6 +272,8 @@ TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std
     }
   };
   const VectorXd gravity = internal::GravityPerDof(sim);
+  std::vector<StateForceGradient> state_force_dirs(num_dirs);
+  for (int p = 0; p < num_dirs; ++p) state_force_dirs[p] = directions[p].state_forces;
 
   TangentRollout out;
   out.dx.resize(steps + 1);
@@ -293,6 +328,7 @@ TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std
       for (int p = 0; p < num_dirs; ++p)
         if (!directions[p].external_force.empty() && directions[p].external_force[i].size())
           b.col(p) += directions[p].external_force[i];
+      sim.state_forces.AddJvp(s0.x, s0.v, mass, dx0, dv0, dmass, state_force_dirs, &b);
       subtract_activation_terms(i, s1.x, &b);
       const std::vector<int> no_pins;
       const std::vector<int>& pinned = contact ? rollout.reports[i].contact_nodes : no_pins;
@@ -330,6 +366,7 @@ TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std
         if (!directions[p].external_force.empty() && directions[p].external_force[i].size())
           force.col(p) += directions[p].external_force[i];
       }
+      sim.state_forces.AddJvp(s0.x, s0.v, mass, dx0, dv0, dmass, state_force_dirs, &force);
       subtract_lame_terms(s0.x, &force);
       subtract_activation_terms(i, s0.x, &force);
       MatrixXd dv1 = dv0 + h * mass.cwiseInverse().asDiagonal() * force;
@@ -338,7 +375,9 @@ TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std
         sim.elastic.EnergyAndGradient(s0.x, sim.lame(), &grad_e, sim.threads());
         sim.aux.AddEnergyAndGradient(s0.x, sim.activation, &grad_e);
         const VectorXd& user = rollout.inputs[i].external_force;
-        const VectorXd net = ((user.size() ? user : VectorXd::Zero(n)) - grad_e).cwiseQuotient(mass.cwiseAbs2());
+        VectorXd force_sum = user.size() ? user : VectorXd::Zero(n);
+        sim.state_forces.Add(s0.x, s0.v, mass, &force_sum);
+        const VectorXd net = (force_sum - grad_e).cwiseQuotient(mass.cwiseAbs2());
         for (int p = 0; p < num_dirs; ++p)
           if (mass_dir[p]) dv1.col(p) -= h * dmass[p].cwiseProduct(net);
       }

@@ -209,9 +209,6 @@ void RolloutFunction::SetDerivativeMode(DerivativeMode mode) {
 }
 
 bool RolloutFunction::ForwardModeAvailable() const {
-  if (scene_.linear_damping || scene_.hydrodynamics) return false;
-  for (const PenaltyContact& c : scene_.penalty_contacts)
-    if (c.friction != 0) return false;
   for (const Block& b : blocks_)
     if (!b.block->SupportsForwardMode()) return false;
   return true;
@@ -354,8 +351,8 @@ void RolloutFunction::ComputeRows(const std::vector<int>& missing) {
   if (ResolvedMode(static_cast<int>(missing.size())) == DerivativeMode::kForward) {
     if (!ForwardModeAvailable())
       throw InvalidInputError(
-          "forward mode does not cover this rollout (a state-force parameter block, or linear damping, "
-          "hydrodynamics or penalty friction in the scene); use DerivativeMode::kReverse or kAuto");
+          "forward mode does not cover this rollout (a parameter block without forward mode); use "
+          "DerivativeMode::kReverse or kAuto");
     ForwardRows(missing);
   } else {
     ReverseRows(missing);

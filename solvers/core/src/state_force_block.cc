@@ -153,7 +153,40 @@ void StateForceBlock::PullBack(const Eigen::Ref<const VectorXd>& values, const R
 
 void StateForceBlock::PushForward(const Eigen::Ref<const VectorXd>& values, int j, const RolloutSetup& setup,
                                   InputDirection* direction) const {
-  DIFFPD_CHECK(false, "state_forces: forward mode has no direction for state-force parameters");
+  const Entry& e = entries_[j];
+  StateForceGradient& d = direction->state_forces;
+  switch (e.field) {
+    case StateForceField::kLinearDamping:
+      d.linear_damping += e.scale;
+      return;
+    case StateForceField::kFluidDensity:
+      d.fluid_density += e.scale;
+      return;
+    case StateForceField::kDragTangential:
+      d.drag_tangential += e.scale;
+      return;
+    case StateForceField::kDragNormal:
+      d.drag_normal += e.scale;
+      return;
+    case StateForceField::kThrust:
+      d.thrust += e.scale;
+      return;
+    case StateForceField::kFlowVelocityX:
+      d.flow_velocity(0) += e.scale;
+      return;
+    case StateForceField::kFlowVelocityY:
+      d.flow_velocity(1) += e.scale;
+      return;
+    case StateForceField::kFlowVelocityZ:
+      d.flow_velocity(2) += e.scale;
+      return;
+    case StateForceField::kPenaltyFriction:
+      if (d.penalty_friction.size() != setup.state_forces.penalty_friction.size())
+        d.penalty_friction.assign(setup.state_forces.penalty_friction.size(), 0.0);
+      d.penalty_friction[e.contact] += e.scale;
+      return;
+  }
+  DIFFPD_CHECK(false, "unknown StateForceField " << static_cast<int>(e.field));
 }
 
 }  // namespace diffpd::solvers

@@ -3,14 +3,19 @@
 // messages naming file and line, the scene has the fact sheet's boundary,
 // markers and muscles, the tendon-to-activation map (slack, lag) and its
 // derivatives, the reverse-mode loss gradient in E, nu, slack and lag agrees
-// with central finite differences, and a short fit lowers the loss.
+// with central finite differences, and a short fit lowers the loss; the
+// least-squares model's forward-mode Jacobian, its fit and intervals; the
+// metrics, baselines and trace files.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <set>
+#include <sstream>
 
 #include "calibration/calibrate_starfish.h"
+#include "calibration/starfish_trace.h"
 #include "diffpd/error.h"
 #include "util/expect_message.h"
 #include "util/temporary_directory.h"
@@ -236,6 +241,66 @@ TEST(CalibrateStarfishTest, WindowInputsNameTheRowOfANegativeActivation) {
           "slack 0 m, length 0.065 m)");
 }
 
+// The errors of the recording against itself are zero; a common x shift of
+// every marker leaves the arm-relative error; the zero-motion baseline is the
+// RMS displacement and the mean-displacement one is never worse (the mean is
+// the best constant per marker).
+TEST(StarfishMetricsTest, ErrorsAndBaselinesOfTheRealRecording) {
+  const StarfishRecording r = ReadStarfishRecording(kCyclic2);
+  const StarfishWindow w = MakeStarfishWindow(r, 0, 5);
+  const StarfishDisplacements cap = CapturedDisplacements(r, w);
+  ASSERT_EQ(static_cast<int>(cap.size()), w.num_frames());
+  EXPECT_EQ(CompareDisplacements(cap, cap).rmse, 0.0);
+  StarfishDisplacements shifted = cap;
+  double sum = 0;
+  for (size_t j = 1; j < cap.size(); ++j)
+    for (int m = 0; m < 4; ++m) {
+      shifted[j][m](0) += 0.003 * j / cap.size();
+      sum += cap[j][m].squaredNorm();
+    }
+  const StarfishErrors e = CompareDisplacements(shifted, cap);
+  EXPECT_GT(e.rmse, 1e-4);
+  EXPECT_NEAR(e.arm_relative_rmse, 0, 1e-15);
+  const StarfishBaselines b = BaselineErrors(cap);
+  EXPECT_NEAR(b.zero_motion.rmse, std::sqrt(sum / (4.0 * (cap.size() - 1))), 1e-15);
+  EXPECT_LT(b.mean_displacement.rmse, b.zero_motion.rmse);
+  EXPECT_EQ(b.zero_motion.frames, w.num_frames() - 1);
+  EXPECT_THROW_MESSAGE(
+      CompareDisplacements(StarfishDisplacements(3), cap), InvalidInputError,
+      "CompareDisplacements: 3 predicted frames against " + std::to_string(cap.size()) + " captured ones");
+}
+
+// The trace has a header and one row per frame: time, tendon in mm, the
+// frame's first activation, then simulated and captured x, z per marker in mm.
+TEST(StarfishTraceTest, OneRowPerFrameInMillimetres) {
+  const StarfishRecording r = ReadStarfishRecording(kCyclic1);
+  const StarfishWindow w = MakeStarfishWindow(r, 2, 0.05);
+  ASSERT_EQ(w.num_frames(), 4);
+  Rollout rollout;
+  rollout.inputs.resize(6);
+  for (int k = 0; k < 6; ++k) rollout.inputs[k].activation = VectorXd::Constant(4, 1 - 0.01 * k);
+  const StarfishDisplacements cap = CapturedDisplacements(r, w);
+  StarfishDisplacements sim = cap;
+  sim[3][1] = Eigen::Vector2d(0.002, -0.001);
+  const std::string path = WriteStarfishTrace(Scratch().path().string(), r, w, rollout, 2, sim, cap);
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 5u);
+  EXPECT_EQ(lines[0].substr(0, 54), "time_s,tendon_mm,activation,M1_sim_x,M1_cap_x,M1_sim_z");
+  std::vector<double> row;
+  std::stringstream fields(lines[4]);
+  for (std::string f; std::getline(fields, f, ',');) row.push_back(std::stod(f));
+  ASSERT_EQ(row.size(), 19u);
+  // The file has 6 significant digits.
+  EXPECT_NEAR(row[0], r.time[w.last], 1e-5 * r.time[w.last]);
+  EXPECT_NEAR(row[1], r.tendon[w.last] * 1e3, 1e-5 * r.tendon[w.last] * 1e3);
+  EXPECT_NEAR(row[2], 0.95, 1e-12);  // the frame's first step, 3 * 2 capped at the last input
+  EXPECT_NEAR(row[7], 2.0, 1e-9);    // M2 simulated x, mm
+  EXPECT_NEAR(row[9], -1.0, 1e-9);   // M2 simulated z, mm
+  EXPECT_NEAR(row[8], cap[3][1](0) * 1e3, 1e-5 * std::abs(cap[3][1](0) * 1e3) + 1e-9);
+}
+
 // The window of the gradient and fit tests: 0.15 s from 1.15 s of cyclic1
 // (the tendon first moves at 1.18 s), one step per frame.
 class StarfishFitTest : public ::testing::Test {
@@ -249,6 +314,7 @@ class StarfishFitTest : public ::testing::Test {
 };
 
 TEST_F(StarfishFitTest, LossGradientMatchesCentralDifferences) {
+  starfish_.set_fit_method(StarfishFitMethod::kLbfgs);
   SolverOptions options = starfish_.Options(Method::kPdLbfgs, 1);
   options.rel_tolerance = 1e-10;
   options.abs_tolerance = 1e-10;
@@ -291,6 +357,7 @@ TEST_F(StarfishFitTest, BodyArmsRegionsGiveTheArmsTheirOwnYoungsModulus) {
   EXPECT_THROW_MESSAGE(ParseStarfishRegions("legs"), InvalidInputError,
                        "--regions = 'legs' is invalid: calibrate-starfish knows 'body-arms'");
   starfish_.set_regions(StarfishRegions::kBodyArms);
+  starfish_.set_fit_method(StarfishFitMethod::kLbfgs);
   const Scene scene = starfish_.MakeScene();
   ASSERT_EQ(scene.material_regions.size(), 1u);
   const size_t arms = scene.material_regions[0].elements.size();
@@ -347,33 +414,40 @@ TEST_F(StarfishFitTest, BodyArmsRegionsGiveTheArmsTheirOwnYoungsModulus) {
   EXPECT_EQ(fit.statistics.failures, 0) << fit.statistics.last_error;
 }
 
-TEST_F(StarfishFitTest, CoordinatesMapIntoTheBoundsAndBack) {
-  double u[2];
-  StarfishCalibration::ToCoordinates(MaterialParameters{5e5, 0.4, 400}, u);
-  const MaterialParameters m = StarfishCalibration::FromCoordinates(u, 400);
-  EXPECT_NEAR(m.youngs_modulus, 5e5, 1e-6);
-  EXPECT_NEAR(m.poissons_ratio, 0.4, 1e-12);
-  const double far[2] = {-60, 60};
-  const MaterialParameters edge = StarfishCalibration::FromCoordinates(far, 400);
-  EXPECT_NEAR(edge.youngs_modulus, 1e4, 1e-6);
-  EXPECT_NEAR(edge.poissons_ratio, 0.45, 1e-12);
-  EXPECT_THROW(StarfishCalibration::ToCoordinates(MaterialParameters{6e6, 0.4, 400}, u), InvalidInputError);
-  double v[3];
-  StarfishCalibration::ActuationToCoordinates(StarfishActuation{0.003, 0.05, 0.065}, v);
-  const StarfishActuation a = StarfishCalibration::ActuationFromCoordinates(v);
-  EXPECT_NEAR(a.slack, 0.003, 1e-15);
-  EXPECT_NEAR(a.lag, 0.05, 1e-15);
-  EXPECT_NEAR(a.length, 0.065, 1e-15);
-  const double ends[3] = {-60, 60, -60};
-  const StarfishActuation edge_a = StarfishCalibration::ActuationFromCoordinates(ends);
-  EXPECT_NEAR(edge_a.slack, 0, 1e-15);
-  EXPECT_NEAR(edge_a.lag, 0.5, 1e-12);
-  EXPECT_NEAR(edge_a.length, 0.03, 1e-12);
-  EXPECT_THROW_MESSAGE(StarfishCalibration::ActuationToCoordinates(StarfishActuation{0.02, 0.05, 0.065}, v),
+// The fit's bounds are the manifold's: a huge step stays inside them, E,
+// nu, lag and length move relatively, and a start outside is refused.
+TEST_F(StarfishFitTest, FitCoordinatesKeepTheBoundsAndRefuseStartsOutside) {
+  const std::vector<double> x =
+      StarfishFitStart(MaterialParameters{5e5, 0.4, 400}, StarfishActuation{0.003, 0.05, 0.065}, false);
+  ASSERT_EQ(x, (std::vector<double>{5e5, 0.4, 0.003, 0.05, 0.065}));
+  const solvers::CoordinateManifold manifold(StarfishFitCoordinates(false));
+  ASSERT_EQ(manifold.AmbientSize(), 5);
+  const double low[5] = {-60, 60, -60, 60, -60}, high[5] = {60, -60, 60, -60, 60};
+  double y[5];
+  ASSERT_TRUE(manifold.Plus(x.data(), low, y));
+  EXPECT_NEAR(y[0], 1e4, 1e-6);
+  EXPECT_NEAR(y[1], 0.45, 1e-12);
+  EXPECT_NEAR(y[2], 0, 1e-15);
+  EXPECT_NEAR(y[3], 0.5, 1e-12);
+  EXPECT_NEAR(y[4], 0.03, 1e-12);
+  ASSERT_TRUE(manifold.Plus(x.data(), high, y));
+  EXPECT_NEAR(y[0], 5e6, 1e-3);
+  EXPECT_NEAR(y[1], 0.2, 1e-12);
+  EXPECT_NEAR(y[2], 0.015, 1e-15);
+  EXPECT_NEAR(y[3], 1e-3, 1e-12);
+  EXPECT_NEAR(y[4], 0.13, 1e-12);
+  EXPECT_EQ(StarfishFitCoordinates(true).size(), 6u);
+  EXPECT_EQ(StarfishFitStart(MaterialParameters{5e5, 0.4, 400}, StarfishActuation{0.003, 0.05, 0.065}, true).back(),
+            5e5);
+  EXPECT_THROW_MESSAGE(
+      StarfishFitStart(MaterialParameters{6e6, 0.4, 400}, StarfishActuation{0.003, 0.05, 0.065}, false),
+      InvalidInputError, "youngs_modulus = 6e+06 is outside the fit's interval (1e4, 5e6) Pa");
+  EXPECT_THROW_MESSAGE(StarfishFitStart(MaterialParameters{5e5, 0.4, 400}, StarfishActuation{0.02, 0.05, 0.065}, false),
                        InvalidInputError, "tendon slack = 0.02 is outside the fit's interval (0, 0.015) m");
 }
 
 TEST_F(StarfishFitTest, ShortFitLowersTheLoss) {
+  starfish_.set_fit_method(StarfishFitMethod::kLbfgs);
   const StarfishFit fit =
       starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
                     StarfishCalibration::ActuationGuess(), 3, nullptr);
@@ -382,6 +456,61 @@ TEST_F(StarfishFitTest, ShortFitLowersTheLoss) {
   EXPECT_LT(fit.final_cost, 0.9 * fit.initial_cost);
   EXPECT_GT(fit.statistics.gradients, 0);
   EXPECT_EQ(fit.statistics.failures, 0) << fit.statistics.last_error;
+}
+
+// The least-squares model's residual Jacobian (forward-mode tangents through
+// the water's drag) against central differences of the residuals.
+TEST_F(StarfishFitTest, ResidualJacobianMatchesCentralDifferences) {
+  ASSERT_EQ(starfish_.fit_method(), StarfishFitMethod::kLevenbergMarquardt);
+  SolverOptions options = starfish_.Options(Method::kPdLbfgs, 1);
+  options.rel_tolerance = 1e-10;
+  options.abs_tolerance = 1e-10;
+  auto model = starfish_.MakeModel(recording_, window_, options, MaterialParameters{2e5, 0.35, 400},
+                                   StarfishActuation{0.004, 0.03, 0.05});
+  ASSERT_EQ(model->ResolvedMode(model->num_rows()), solvers::DerivativeMode::kForward);
+  VectorXd p0(5);
+  p0 << 2e5, 0.35, 0.004, 0.03, 0.05;
+  MatrixXd j;
+  ASSERT_TRUE(model->Evaluate(p0, model->AllRows(), nullptr, &j)) << model->statistics().last_error;
+  EXPECT_EQ(model->statistics().tangent_passes, 1);
+  const double step[5] = {2e5 * 1e-4, 1e-4, 1e-6, 1e-5, 1e-6};
+  for (int i = 0; i < 5; ++i) {
+    VectorXd plus = p0, minus = p0, rp, rm;
+    plus(i) += step[i];
+    minus(i) -= step[i];
+    ASSERT_TRUE(model->Evaluate(plus, model->AllRows(), &rp, nullptr));
+    ASSERT_TRUE(model->Evaluate(minus, model->AllRows(), &rm, nullptr));
+    const VectorXd fd = (rp - rm) / (2 * step[i]);
+    EXPECT_GT(fd.norm() * std::abs(p0(i)), 1e-3) << "column " << i << ": the residuals depend on it";
+    EXPECT_LT((j.col(i) - fd).norm(), 1e-4 * fd.norm()) << "column " << i;
+  }
+}
+
+// Levenberg-Marquardt lowers the cost and gives every parameter a finite
+// standard deviation and a symmetric correlation matrix with unit diagonal.
+TEST_F(StarfishFitTest, LeastSquaresFitLowersTheCostAndHasIntervals) {
+  const StarfishFit fit =
+      starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
+                    StarfishCalibration::ActuationGuess(), 3, nullptr);
+  EXPECT_TRUE(fit.usable) << fit.termination;
+  EXPECT_LT(fit.final_cost, 0.9 * fit.initial_cost);
+  EXPECT_GT(fit.statistics.tangent_passes, 0);
+  EXPECT_EQ(fit.statistics.adjoint_passes, 0);
+  EXPECT_EQ(fit.residuals, 8 * (window_.num_frames() - 1));
+  ASSERT_EQ(fit.standard_deviation.size(), 5u);
+  ASSERT_EQ(fit.correlation.size(), 25u);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_TRUE(std::isfinite(fit.standard_deviation[i]) && fit.standard_deviation[i] > 0) << i;
+    EXPECT_NEAR(fit.correlation[6 * i], 1, 1e-9);
+    for (int k = 0; k < 5; ++k) EXPECT_NEAR(fit.correlation[5 * i + k], fit.correlation[5 * k + i], 1e-12);
+  }
+  starfish_.set_regions(StarfishRegions::kBodyArms);
+  EXPECT_THROW_MESSAGE(
+      starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
+                    StarfishCalibration::ActuationGuess(), 3, nullptr),
+      InvalidInputError, "the lm fit has no tied arms' nu: fit body-arms regions with --fit lbfgs");
+  EXPECT_THROW_MESSAGE(ParseStarfishFitMethod("newton"), InvalidInputError,
+                       "--fit = 'newton' is invalid: calibrate-starfish fits with 'lm' or 'lbfgs'");
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 // CoordinateManifold (coordinate_manifold.h): Ceres' manifold invariants for
-// linear, log and logit coordinates, multiplicative log steps, intervals
-// never left, rejection of points outside the domain.
+// linear, log, logit and log-logit coordinates, multiplicative log steps,
+// intervals never left, rejection of points outside the domain.
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include <ceres/manifold_test_utils.h>
 
@@ -16,14 +18,14 @@ using ceres::Vector;
 using namespace ceres;  // NOLINT
 
 TEST(CoordinateManifoldTest, SatisfiesCeresManifoldInvariants) {
-  const CoordinateManifold manifold(
-      {CoordinateMap::Log(), CoordinateMap::Linear(), CoordinateMap::Logit(0, 0.5), CoordinateMap::Logit(-1, 3)});
-  Vector x(4);
-  x << 2e5, -0.3, 0.4, 2.5;
+  const CoordinateManifold manifold({CoordinateMap::Log(), CoordinateMap::Linear(), CoordinateMap::Logit(0, 0.5),
+                                     CoordinateMap::Logit(-1, 3), CoordinateMap::LogLogit(1e4, 5e6)});
+  Vector x(5);
+  x << 2e5, -0.3, 0.4, 2.5, 3e4;
   for (int k = 0; k < 3; ++k) {
-    Vector delta(4), y(4);
-    delta << 0.1 * k, -0.2 * k, 0.3 * k - 0.4, 1.0 - k;
-    y << 3e5 - 5e4 * k, 0.1 * k, 0.05 + 0.1 * k, -0.5 + k;
+    Vector delta(5), y(5);
+    delta << 0.1 * k, -0.2 * k, 0.3 * k - 0.4, 1.0 - k, 0.5 * k - 0.7;
+    y << 3e5 - 5e4 * k, 0.1 * k, 0.05 + 0.1 * k, -0.5 + k, 2e4 + 1e6 * k;
     EXPECT_THAT_MANIFOLD_INVARIANTS_HOLD(manifold, x, delta, y, 1e-9);
   }
 }
@@ -52,6 +54,35 @@ TEST(CoordinateManifoldTest, LogStepsAreMultiplicativeAndLogitStaysInside) {
   EXPECT_FALSE(manifold.Minus(x, outside, y));
   const double negative[2] = {-1.0, 0.3};
   EXPECT_FALSE(manifold.MinusJacobian(negative, j));
+}
+
+// log x is a logit coordinate of (log lo, log hi): the midpoint of the
+// logarithms at u = 0, the ends for huge steps, relative steps inside.
+TEST(CoordinateManifoldTest, LogLogitIsALogitOfTheLogarithm) {
+  const CoordinateManifold manifold({CoordinateMap::LogLogit(1e4, 1e6)});
+  const double mid = 1e5, zero = 0;
+  double y;
+  ASSERT_TRUE(manifold.Plus(&mid, &zero, &y));
+  EXPECT_DOUBLE_EQ(y, 1e5);
+  const double up = 2.0;  // s(2) = 0.8808: log10 y = 4 + 2 * 0.8808
+  ASSERT_TRUE(manifold.Plus(&mid, &up, &y));
+  EXPECT_NEAR(std::log10(y), 4 + 2 / (1 + std::exp(-2.0)), 1e-12);
+  const double huge[2] = {-800, 800};
+  ASSERT_TRUE(manifold.Plus(&mid, &huge[0], &y));
+  EXPECT_GE(y, 1e4);
+  ASSERT_TRUE(manifold.Plus(&mid, &huge[1], &y));
+  EXPECT_LE(y, 1e6);
+  double j;
+  ASSERT_TRUE(manifold.PlusJacobian(&mid, &j));
+  EXPECT_NEAR(j, 1e5 * std::log(100.0) * 0.25, 1e-9);
+  const double outside = 1e3;
+  EXPECT_FALSE(manifold.Plus(&outside, &zero, &y));
+  try {
+    CoordinateManifold({CoordinateMap::LogLogit(0, 1)});
+    FAIL();
+  } catch (const InvalidInputError& e) {
+    EXPECT_STREQ(e.what(), "CoordinateManifold: coordinate 0 has the log-logit interval (0, 1): needs 0 < lower");
+  }
 }
 
 TEST(CoordinateManifoldTest, RejectsEmptyListsAndIntervals) {

@@ -95,7 +95,7 @@ TEST(ParameterBlocksTest, StateForceBlockNeedsDeclaredTerms) {
   EXPECT_EQ(block.initial()(0), *scene.linear_damping);
   EXPECT_EQ(block.initial()(1), scene.hydrodynamics->fluid_density / 1e3);
   EXPECT_EQ(block.initial()(8), scene.penalty_contacts[0].friction);
-  EXPECT_FALSE(block.SupportsForwardMode());
+  EXPECT_TRUE(block.SupportsForwardMode());
   const Scene plain = SmallBeamScene();
   EXPECT_EQ(MessageOf<InvalidInputError>([&] { StateForceBlock({}, scene); }), "state_forces: no parameter");
   EXPECT_EQ(MessageOf<InvalidInputError>([&] { StateForceBlock({StateForceField::kLinearDamping}, plain); }),

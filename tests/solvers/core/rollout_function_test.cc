@@ -108,22 +108,56 @@ TEST(RolloutFunctionTest, ForwardAndReverseJacobiansAgreeForEveryMethod) {
   }
 }
 
-TEST(RolloutFunctionTest, ForwardModeIsRefusedForStateForcesWithAMessage) {
+// A block that declares no forward mode: the state-force block's values and
+// pull-back, without its push-forward.
+class ReverseOnlyBlock : public ParameterBlock {
+ public:
+  explicit ReverseOnlyBlock(std::unique_ptr<ParameterBlock> inner)
+      : ParameterBlock(inner->size()), inner_(std::move(inner)) {
+    SetInitial(inner_->initial());
+  }
+  std::string name() const override { return "reverse_only"; }
+  void CheckFits(const Scene& scene, int num_steps) const override { inner_->CheckFits(scene, num_steps); }
+  void Apply(const Eigen::Ref<const VectorXd>& values, RolloutSetup* setup) const override {
+    inner_->Apply(values, setup);
+  }
+  void PullBack(const Eigen::Ref<const VectorXd>& values, const RolloutGradient& grad,
+                Eigen::Ref<VectorXd> out) const override {
+    inner_->PullBack(values, grad, out);
+  }
+  int FirstAffectedState(int j) const override { return inner_->FirstAffectedState(j); }
+  bool SupportsForwardMode() const override { return false; }
+  void PushForward(const Eigen::Ref<const VectorXd>& values, int j, const RolloutSetup& setup,
+                   InputDirection* direction) const override {
+    ADD_FAILURE() << "PushForward of a block without forward mode";
+  }
+
+ private:
+  std::unique_ptr<ParameterBlock> inner_;
+};
+
+TEST(RolloutFunctionTest, ForwardModeCoversStateForcesAndIsRefusedForABlockWithoutIt) {
   ParameterBlockCase c = StateForceCase();
-  RolloutFunction& f = *c.function;
+  EXPECT_TRUE(c.function->ForwardModeAvailable());
+  EXPECT_EQ(c.function->ResolvedMode(1000), DerivativeMode::kForward);
+  RolloutFunction f(c.function->scene(), c.function->options(), c.function->num_steps());
+  f.AddBlock(std::make_unique<ReverseOnlyBlock>(
+      std::make_unique<StateForceBlock>(std::vector<StateForceBlock::Entry>{StateForceField::kThrust}, f.scene())));
+  AddProbes(&f);
   EXPECT_FALSE(f.ForwardModeAvailable());
   EXPECT_EQ(f.ResolvedMode(1000), DerivativeMode::kReverse);
   f.SetDerivativeMode(DerivativeMode::kForward);
   MatrixXd j;
-  EXPECT_FALSE(f.Evaluate(c.point, f.AllRows(), nullptr, &j));
+  VectorXd point = VectorXd::Constant(1, 0.6);
+  EXPECT_FALSE(f.Evaluate(point, f.AllRows(), nullptr, &j));
   EXPECT_EQ(f.statistics().last_error,
-            "Jacobian rejected: forward mode does not cover this rollout (a state-force parameter block, or linear "
-            "damping, hydrodynamics or penalty friction in the scene); use DerivativeMode::kReverse or kAuto");
+            "Jacobian rejected: forward mode does not cover this rollout (a parameter block without forward mode); "
+            "use DerivativeMode::kReverse or kAuto");
   // The failure is remembered for the point, the values are not lost.
-  EXPECT_FALSE(f.Evaluate(c.point, f.AllRows(), nullptr, &j));
+  EXPECT_FALSE(f.Evaluate(point, f.AllRows(), nullptr, &j));
   EXPECT_EQ(f.statistics().failures, 1);
   VectorXd v;
-  EXPECT_TRUE(f.Evaluate(c.point, f.AllRows(), &v, nullptr));
+  EXPECT_TRUE(f.Evaluate(point, f.AllRows(), &v, nullptr));
 }
 
 // A functional that fails: SolverError, or a NaN value.

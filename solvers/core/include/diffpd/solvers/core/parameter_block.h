@@ -65,14 +65,15 @@ class ParameterBlock {
   // the initial state, i + 1 for an input of step i, kAffectsNoState for none.
   // Used to declare Jacobian sparsity.
   virtual int FirstAffectedState(int j) const = 0;
-  // Whether PushForward is available (Simulator::Tangents has no direction
-  // for some inputs, e.g. state-force parameters).
+  // Whether PushForward is available (a block whose setup change has no
+  // InputDirection, e.g. one that changes the mesh, returns false).
   virtual bool SupportsForwardMode() const { return true; }
   // Adds d(setup)/d(values_j) into `direction`, whose lists are sized for
   // `setup` (the setup at `values`): x0 and v0 3n (zero), external_force and
   // activation one entry per step (empty: zero; an activation entry, once
-  // filled, has one value per muscle), region_materials one per region.
-  // Only called when SupportsForwardMode().
+  // filled, has one value per muscle), region_materials one per region,
+  // state_forces zero (penalty_friction empty). Only called when
+  // SupportsForwardMode().
   virtual void PushForward(const Eigen::Ref<const VectorXd>& values, int j, const RolloutSetup& setup,
                            InputDirection* direction) const = 0;
 

@@ -32,9 +32,8 @@
 //    after the row's last state (Rollout::Truncated: a row at state k costs k
 //    adjoint steps). kAuto uses forward mode when it is available and the
 //    parameters are fewer than the rows asked for. Forward mode is available
-//    unless a block does not support it (state-force parameters) or the scene
-//    has state forces (linear damping, hydrodynamics, penalty friction),
-//    which Simulator::Tangents refuses.
+//    unless a block does not support it (ParameterBlock::SupportsForwardMode;
+//    every block of the library does, state-force parameters included).
 //  - Gradients of weighted sums of rows (Gradient): one Backward pass over
 //    the rollout truncated after the last state a weighted row reads.
 // Jacobian rows and the last gradient are cached per point (and so are their

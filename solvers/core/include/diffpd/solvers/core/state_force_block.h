@@ -4,9 +4,8 @@
 // divided by a scale (parameter = value / scale).
 //
 // A change of these values rebuilds the rollout function's simulator (its
-// precomputation and PD factor) before the next rollout. Forward mode has no
-// direction for them (SupportsForwardMode() is false): Jacobians with this
-// block are computed in reverse mode.
+// precomputation and PD factor) before the next rollout. Both derivative
+// modes cover them (forward mode through InputDirection::state_forces).
 #pragma once
 
 #include <string>
@@ -57,8 +56,6 @@ class StateForceBlock : public ParameterBlock {
   void PullBack(const Eigen::Ref<const VectorXd>& values, const RolloutGradient& grad,
                 Eigen::Ref<VectorXd> out) const override;
   int FirstAffectedState(int j) const override { return 1; }
-  bool SupportsForwardMode() const override { return false; }
-  // Never called (SupportsForwardMode() is false); aborts.
   void PushForward(const Eigen::Ref<const VectorXd>& values, int j, const RolloutSetup& setup,
                    InputDirection* direction) const override;
 

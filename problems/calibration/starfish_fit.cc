@@ -1,0 +1,295 @@
+#include "calibration/starfish_fit.h"
+
+#include <cmath>
+#include <sstream>
+
+#include <ceres/covariance.h>
+#include <ceres/gradient_problem.h>
+#include <ceres/gradient_problem_solver.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include "diffpd/error.h"
+#include "diffpd/solvers/ceres/rollout_cost_function.h"
+#include "diffpd/solvers/ceres/rollout_evaluation_callback.h"
+
+namespace diffpd::problems {
+namespace {
+
+constexpr double kMm = 1e-3;
+constexpr double kMinE = 1e4, kMaxE = 5e6, kMinNu = 0.2, kMaxNu = 0.45;
+constexpr double kMaxSlack = 0.015;                     // m
+constexpr double kMinLag = 1e-3, kMaxLag = 0.5;         // s
+constexpr double kMinLength = 0.03, kMaxLength = 0.13;  // m
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// The model's parameters of the fitted values x (file comment): x0, x1
+// (and x5, x1 for the arms' region), then x2..x4.
+VectorXd ModelParameters(const double* x, bool arms) {
+  VectorXd p(arms ? 7 : 5);
+  if (arms)
+    p << x[0], x[1], x[5], x[1], x[2], x[3], x[4];
+  else
+    p << x[0], x[1], x[2], x[3], x[4];
+  return p;
+}
+
+// The model's loss as a function of the fitted values (the tie of the arms'
+// nu to the body's is the only change of variables; the bounds are the
+// manifold's).
+class StarfishLoss : public ceres::FirstOrderFunction {
+ public:
+  StarfishLoss(solvers::RolloutFunction* model, bool arms) : model_(model), arms_(arms) {}
+  bool Evaluate(const double* x, double* cost, double* gradient) const override {
+    const VectorXd p = ModelParameters(x, arms_);
+    if (gradient) {
+      VectorXd g;
+      if (!model_->Gradient(p, VectorXd::Ones(1), &g, cost)) return false;
+      const int a = arms_ ? 4 : 2;  // the actuation block's first entry
+      gradient[0] = g(0);
+      gradient[1] = arms_ ? g(1) + g(3) : g(1);
+      for (int j = 0; j < 3; ++j) gradient[2 + j] = g(a + j);
+      if (arms_) gradient[5] = g(2);
+    } else {
+      VectorXd value;
+      if (!model_->Evaluate(p, {0}, &value, nullptr)) return false;
+      *cost = value(0);
+    }
+    return std::isfinite(*cost);
+  }
+  int NumParameters() const override { return arms_ ? 6 : 5; }
+
+ private:
+  solvers::RolloutFunction* model_;
+  bool arms_;
+};
+
+class FitTable : public ceres::IterationCallback {
+ public:
+  FitTable(FILE* log, const double* x, bool arms) : log_(log), x_(x), arms_(arms) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    if (s.iteration == 0) {
+      std::fprintf(log_, "%4s %13s %11s %11s %9s %14s %14s %9s %9s %9s", "iter", "loss", "loss_change", "|gradient|",
+                   "total_t", "youngs_modulus", "poissons_ratio", "slack_mm", "lag_s", "length_mm");
+      std::fprintf(log_, arms_ ? " %14s\n" : "\n", "arms_youngs_modulus");
+    }
+    std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %9.2f %14.6g %14.6g %9.4f %9.4f %9.3f", s.iteration, s.cost,
+                 s.cost_change, s.gradient_max_norm, s.cumulative_time_in_seconds, x_[0], x_[1], x_[2] / kMm, x_[3],
+                 x_[4] / kMm);
+    if (arms_) std::fprintf(log_, " %14.6g", x_[5]);
+    std::fprintf(log_, "\n");
+    std::fflush(log_);
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  FILE* log_;
+  const double* x_;
+  bool arms_;
+};
+
+// The iteration table of the least-squares fit (values in the two blocks).
+class LeastSquaresTable : public ceres::IterationCallback {
+ public:
+  LeastSquaresTable(FILE* log, const double* material, const double* actuation)
+      : log_(log), material_(material), actuation_(actuation) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    if (s.iteration == 0)
+      std::fprintf(log_, "%4s %13s %11s %11s %9s %14s %14s %9s %9s %9s\n", "iter", "cost", "cost_change", "|gradient|",
+                   "total_t", "youngs_modulus", "poissons_ratio", "slack_mm", "lag_s", "length_mm");
+    std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %9.2f %14.6g %14.6g %9.4f %9.4f %9.3f\n", s.iteration, s.cost,
+                 s.cost_change, s.gradient_max_norm, s.cumulative_time_in_seconds, material_[0], material_[1],
+                 actuation_[0] / kMm, actuation_[1], actuation_[2] / kMm);
+    std::fflush(log_);
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  FILE* log_;
+  const double* material_;
+  const double* actuation_;
+};
+
+// The tangent coordinate of x under `map` (0 for linear and log maps).
+double BoundCoordinate(const solvers::CoordinateMap& map, double x) {
+  if (map.kind == solvers::CoordinateMap::Kind::kLogit) {
+    return std::log((x - map.lower) / (map.upper - x));
+  }
+  if (map.kind == solvers::CoordinateMap::Kind::kLogLogit) {
+    const double s = std::log(x / map.lower) / std::log(map.upper / map.lower);
+    return std::log(s / (1 - s));
+  }
+  return 0;
+}
+
+}  // namespace
+
+const char* ToString(StarfishFitMethod method) {
+  switch (method) {
+    case StarfishFitMethod::kLbfgs:
+      return "lbfgs";
+    case StarfishFitMethod::kLevenbergMarquardt:
+      return "lm";
+  }
+  return "unknown";
+}
+
+StarfishFitMethod ParseStarfishFitMethod(const std::string& name) {
+  if (name == "lbfgs") return StarfishFitMethod::kLbfgs;
+  if (name == "lm") return StarfishFitMethod::kLevenbergMarquardt;
+  throw InvalidInputError("--fit = '" + name + "' is invalid: calibrate-starfish fits with 'lm' or 'lbfgs'");
+}
+
+std::vector<solvers::CoordinateMap> StarfishFitCoordinates(bool arms) {
+  using solvers::CoordinateMap;
+  std::vector<CoordinateMap> maps = {CoordinateMap::LogLogit(kMinE, kMaxE), CoordinateMap::LogLogit(kMinNu, kMaxNu),
+                                     CoordinateMap::Logit(0, kMaxSlack), CoordinateMap::LogLogit(kMinLag, kMaxLag),
+                                     CoordinateMap::LogLogit(kMinLength, kMaxLength)};
+  if (arms) maps.push_back(CoordinateMap::LogLogit(kMinE, kMaxE));
+  return maps;
+}
+
+std::vector<double> StarfishFitStart(const MaterialParameters& m, const StarfishActuation& a, bool arms) {
+  if (!(m.youngs_modulus > kMinE && m.youngs_modulus < kMaxE))
+    throw InvalidInputError("youngs_modulus = " + Num(m.youngs_modulus) +
+                            " is outside the fit's interval (1e4, 5e6) Pa");
+  if (!(m.poissons_ratio > kMinNu && m.poissons_ratio < kMaxNu))
+    throw InvalidInputError("poissons_ratio = " + Num(m.poissons_ratio) + " is outside the fit's interval (0.2, 0.45)");
+  if (!(a.slack > 0 && a.slack < kMaxSlack))
+    throw InvalidInputError("tendon slack = " + Num(a.slack) + " is outside the fit's interval (0, 0.015) m");
+  if (!(a.lag > kMinLag && a.lag < kMaxLag))
+    throw InvalidInputError("tendon lag = " + Num(a.lag) + " is outside the fit's interval (0.001, 0.5) s");
+  if (!(a.length > kMinLength && a.length < kMaxLength))
+    throw InvalidInputError("tendon length = " + Num(a.length) + " is outside the fit's interval (0.03, 0.13) m");
+  std::vector<double> x = {m.youngs_modulus, m.poissons_ratio, a.slack, a.lag, a.length};
+  if (arms) x.push_back(m.youngs_modulus);
+  return x;
+}
+
+StarfishFit FitStarfishLoss(solvers::RolloutFunction* model, bool arms, const MaterialParameters& guess,
+                            const StarfishActuation& actuation_guess, int max_iterations, FILE* log) {
+  std::vector<double> x = StarfishFitStart(guess, actuation_guess, arms);
+  ceres::GradientProblem problem(new StarfishLoss(model, arms),
+                                 new solvers::CoordinateManifold(StarfishFitCoordinates(arms)));
+  ceres::GradientProblemSolver::Options options;
+  options.line_search_direction_type = ceres::LBFGS;
+  // Scale L-BFGS' initial inverse Hessian by the observed curvature: the
+  // first step is the gradient's length, the later ones Newton-like.
+  options.use_approximate_eigenvalue_bfgs_scaling = true;
+  options.max_num_iterations = max_iterations;
+  options.function_tolerance = 1e-5;
+  options.gradient_tolerance = 1e-8;
+  options.parameter_tolerance = 1e-5;
+  options.logging_type = ceres::SILENT;
+  options.update_state_every_iteration = true;
+  FitTable table(log, x.data(), arms);
+  if (log) options.callbacks.push_back(&table);
+  ceres::GradientProblemSolver::Summary summary;
+  ceres::Solve(options, problem, x.data(), &summary);
+  StarfishFit fit;
+  fit.material = MaterialParameters{x[0], x[1], guess.density};
+  fit.actuation = StarfishActuation{x[2], x[3], x[4]};
+  if (arms) fit.region_materials = {MaterialParameters{x[5], x[1], guess.density}};
+  fit.initial_cost = summary.initial_cost;
+  fit.final_cost = summary.final_cost;
+  fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  fit.usable = summary.IsSolutionUsable() && std::isfinite(summary.final_cost);
+  fit.termination = summary.message;
+  fit.statistics = model->statistics();
+  return fit;
+}
+
+StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residual_functional,
+                                    const MaterialParameters& guess, const StarfishActuation& actuation_guess,
+                                    int max_iterations, FILE* log) {
+  const std::vector<double> start = StarfishFitStart(guess, actuation_guess, false);
+  const std::vector<solvers::CoordinateMap> maps = StarfishFitCoordinates(false);
+  double material[2] = {start[0], start[1]};
+  double actuation[3] = {start[2], start[3], start[4]};
+  solvers::RolloutEvaluationCallback callback(model, {material, actuation});
+  ceres::Problem::Options problem_options;
+  problem_options.evaluation_callback = &callback;
+  ceres::Problem problem(problem_options);
+  solvers::AddMarkerResidualBlocks(&problem, model, residual_functional, {material, actuation});
+  problem.SetManifold(material, new solvers::CoordinateManifold({maps[0], maps[1]}));
+  problem.SetManifold(actuation, new solvers::CoordinateManifold({maps[2], maps[3], maps[4]}));
+
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  // The marker error is far from quadratic over Ceres' default first trust
+  // region (1e4): start with steps of order 1 in the tangent coordinates.
+  options.initial_trust_region_radius = 1;
+  options.max_num_iterations = max_iterations;
+  options.function_tolerance = 1e-6;
+  options.parameter_tolerance = 1e-6;
+  options.gradient_tolerance = 1e-12;
+  options.update_state_every_iteration = true;
+  options.logging_type = ceres::SILENT;
+  LeastSquaresTable table(log, material, actuation);
+  if (log) options.callbacks.push_back(&table);
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+
+  StarfishFit fit;
+  fit.material = MaterialParameters{material[0], material[1], guess.density};
+  fit.actuation = StarfishActuation{actuation[0], actuation[1], actuation[2]};
+  fit.initial_cost = summary.initial_cost;
+  fit.final_cost = summary.final_cost;
+  fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  fit.usable = summary.IsSolutionUsable() && summary.termination_type != ceres::FAILURE;
+  fit.termination = summary.message;
+  if (!std::isfinite(summary.final_cost)) {  // Ceres "converges" on a cost that stays inf
+    fit.usable = false;
+    fit.termination += "; the cost is not finite";
+  }
+
+  // Rows with a weight (the markers' unobserved y has none).
+  VectorXd r;
+  VectorXd point(5);
+  point << material[0], material[1], actuation[0], actuation[1], actuation[2];
+  const std::vector<int> rows = model->RowsOf(residual_functional);
+  if (fit.usable && model->Evaluate(point, rows, &r, nullptr)) {
+    MatrixXd j;
+    model->Evaluate(point, rows, nullptr, &j);
+    int used = 0;
+    for (int i = 0; i < j.rows(); ++i) used += j.row(i).squaredNorm() > 0 || r(i) != 0;
+    fit.residuals = used;
+    const double noise = r.squaredNorm() / std::max(1, used - 5);
+    ceres::Covariance::Options covariance_options;
+    covariance_options.algorithm_type = ceres::DENSE_SVD;
+    covariance_options.null_space_rank = -1;
+    ceres::Covariance covariance(covariance_options);
+    const std::vector<std::pair<const double*, const double*>> pairs = {
+        {material, material}, {material, actuation}, {actuation, actuation}};
+    if (covariance.Compute(pairs, &problem)) {
+      double c_mm[4], c_ma[6], c_aa[9];
+      covariance.GetCovarianceBlock(material, material, c_mm);
+      covariance.GetCovarianceBlock(material, actuation, c_ma);
+      covariance.GetCovarianceBlock(actuation, actuation, c_aa);
+      Eigen::Matrix<double, 5, 5> c;
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) c(a, b) = c_mm[2 * a + b];
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 3; ++b) c(a, 2 + b) = c(2 + b, a) = c_ma[3 * a + b];
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) c(2 + a, 2 + b) = c_aa[3 * a + b];
+      c *= noise;
+      for (int a = 0; a < 5; ++a) fit.standard_deviation.push_back(std::sqrt(std::max(0.0, c(a, a))));
+      for (int a = 0; a < 5; ++a)
+        for (int b = 0; b < 5; ++b) {
+          const double d = fit.standard_deviation[a] * fit.standard_deviation[b];
+          fit.correlation.push_back(d > 0 ? c(a, b) / d : 0.0);
+        }
+    }
+    for (int a = 0; a < 5; ++a) fit.at_bound.push_back(std::abs(BoundCoordinate(maps[a], point(a))) > 5);
+  }
+  fit.statistics = model->statistics();
+  return fit;
+}
+
+}  // namespace diffpd::problems

@@ -1,0 +1,92 @@
+// The starfish fit: material and tendon actuation parameters of a rollout
+// function (StarfishCalibration::MakeModel) fitted to a recording with
+// Ceres, bounded by the library's CoordinateManifold.
+//
+// The fitted values x (physical units) and their bounds, each a log-logit
+// coordinate (coordinate_manifold.h) unless said otherwise:
+//   x0 E      in (1e4, 5e6) Pa
+//   x1 nu     in (0.2, 0.45)
+//   x2 slack  in (0, 15) mm (logit)
+//   x3 lag    in (1, 500) ms
+//   x4 length in (30, 130) mm
+//   x5 E_arms in (1e4, 5e6) Pa (StarfishRegions::kBodyArms only; the arms'
+//      nu is tied to the body's)
+#pragma once
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "calibration/starfish_actuation.h"
+#include "diffpd/material.h"
+#include "diffpd/solvers/ceres/coordinate_manifold.h"
+#include "diffpd/solvers/core/rollout_function.h"
+
+namespace diffpd::problems {
+
+// How a fit minimises the marker error.
+enum class StarfishFitMethod {
+  kLbfgs,               // FitStarfishLoss: L-BFGS on the scalar loss (one adjoint per gradient)
+  kLevenbergMarquardt,  // FitStarfishLeastSquares: per-frame residuals, forward-mode Jacobians
+};
+// "lbfgs", "lm".
+const char* ToString(StarfishFitMethod method);
+// Throws InvalidInputError for other names:
+//   "--fit = 'newton' is invalid: calibrate-starfish fits with 'lm' or 'lbfgs'".
+StarfishFitMethod ParseStarfishFitMethod(const std::string& name);
+
+// The outcome of a fit.
+struct StarfishFit {
+  MaterialParameters material;  // fitted (the body's with kBodyArms)
+  // kBodyArms: the arms' fitted material (E fitted; nu = material's,
+  // density = material's); empty otherwise.
+  std::vector<MaterialParameters> region_materials;
+  StarfishActuation actuation;  // fitted
+  double initial_cost = 0;      // the model's loss at the start
+  double final_cost = 0;
+  int iterations = 0;                     // Ceres iterations
+  bool usable = false;                    // Ceres' solution is usable
+  std::string termination;                // Ceres' message
+  solvers::RolloutStatistics statistics;  // rollouts, gradients, timings
+  // FitStarfishLeastSquares only (empty otherwise): per fitted value x0..x4
+  // its standard deviation from ceres::Covariance (physical units; the
+  // residuals scaled by their fitted noise, s^2 = |r|^2 / (rows - 5)), the
+  // 5 x 5 correlation matrix (row-major), and whether the value lies at a
+  // bound of its interval (tangent coordinate |u| > 5: within 1% of an end),
+  // where the interval is not meaningful.
+  std::vector<double> standard_deviation;
+  std::vector<double> correlation;
+  std::vector<bool> at_bound;
+  int residuals = 0;  // rows of the least-squares problem with non-zero weight
+};
+
+// The coordinate maps of the fitted values (5, or 6 with `arms`).
+std::vector<solvers::CoordinateMap> StarfishFitCoordinates(bool arms);
+// The fitted values of a starting point. Throws InvalidInputError for a
+// value outside its open interval, e.g.
+//   "youngs_modulus = 6e+06 is outside the fit's interval (1e4, 5e6) Pa",
+//   "tendon slack = 0.02 is outside the fit's interval (0, 0.015) m".
+std::vector<double> StarfishFitStart(const MaterialParameters& material, const StarfishActuation& actuation, bool arms);
+
+// Fits `model` (blocks: material {E, nu} or, with `arms`, {E, nu, E_arms,
+// nu_arms}, then TendonActuationBlock; functional 0: a scalar loss) with
+// Ceres' L-BFGS (GradientProblem on the manifold of StarfishFitCoordinates)
+// from `guess` (both regions) and `actuation_guess`, at most
+// `max_iterations` iterations; the iteration table goes to `log` (nullptr:
+// silent). A failed rollout makes Ceres shorten its step (the failure is
+// counted in statistics). `density` of the result is guess.density.
+StarfishFit FitStarfishLoss(solvers::RolloutFunction* model, bool arms, const MaterialParameters& guess,
+                            const StarfishActuation& actuation_guess, int max_iterations, FILE* log);
+
+// Fits `model` (blocks: material {E, nu}, then TendonActuationBlock;
+// functional `residual_functional`: a MarkerResiduals) by Levenberg-Marquardt
+// (ceres::Problem, one residual block per capture frame, Jacobians by the
+// rollout function: forward-mode tangents for 5 parameters) on the manifolds
+// of StarfishFitCoordinates(false), from `guess` and `actuation_guess`, at
+// most `max_iterations` iterations, then the parameters' covariance (see
+// StarfishFit). The iteration table goes to `log` (nullptr: silent).
+StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residual_functional,
+                                    const MaterialParameters& guess, const StarfishActuation& actuation_guess,
+                                    int max_iterations, FILE* log);
+
+}  // namespace diffpd::problems
