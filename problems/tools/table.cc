@@ -29,7 +29,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using nlohmann::json;
 
-bool IsNewton(Method m) { return m == Method::kNewtonCholesky || m == Method::kNewtonPcg; }
+bool IsNewton(Method m) { return m == Method::kNewtonCholesky || m == Method::kNewtonPcg || m == Method::kNewtonLdlt; }
 
 std::string SizeName(RowSize size) { return size == RowSize::kPaper ? "paper" : "small"; }
 

@@ -28,7 +28,7 @@ namespace diffpd {
 
 // One step's action, or the gradient of a loss w.r.t. it. Empty vectors mean
 // none (zero gradient): activation has one entry per Scene::muscles entry
-// (muscle.h; actions finite and >= 0), external_force 3n entries (N).
+// (muscle.h; finite, any sign), external_force 3n entries (N).
 struct ControlAction {
   VectorXd activation;
   VectorXd external_force;

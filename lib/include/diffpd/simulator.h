@@ -68,8 +68,8 @@ class Simulator {
   // The rollout records the actions as its inputs, the memory and the
   // controller's parameters. Throws InvalidInputError for steps < 0, an
   // action of the wrong size or with an invalid entry ("Simulate: the
-  // controller's action at step 3: activation[1] = -0.5 is invalid: must be
-  // finite and >= 0") or a memory of the wrong size or non-finite ("Simulate:
+  // controller's action at step 3: activation[1] = nan is invalid: must be
+  // finite") or a memory of the wrong size or non-finite ("Simulate:
   // the controller's memory after step 0 has 3 entries, expected 4"); the
   // step's own exceptions otherwise.
   Rollout Simulate(const State& initial, const Controller& controller, int steps);
