@@ -10,9 +10,10 @@
 // rel_tolerance being the forward's (the min only where it is > 0), and
 // tol_i not below kMinAdjointRelTolerance. A step without a report, or
 // with a zero initial residual (it started at its solution), takes
-// r_i = rel_tolerance. The factor's default is measured by
-// benchmarks/backward_benchmark --sweep (gradient error against a converged
-// reference as a function of the adjoint tolerance, per forward tolerance).
+// r_i = rel_tolerance. The factor's default is checked by
+// adjoint_tolerance_test (a small beam: within 1.5x of the exact adjoint's
+// gradient error); benchmarks/backward_benchmark --sweep measures the
+// gradient error against the adjoint tolerance on larger scenes.
 #pragma once
 
 #include "diffpd/rollout.h"
