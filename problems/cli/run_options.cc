@@ -3,11 +3,15 @@
 #include <string>
 #include <vector>
 
-#include "calibration/calibrate_problem.h"
-#include "calibration/calibrate_starfish.h"
 #include "cli/commands.h"
 #include "control/swimmer_control.h"
+#if DIFFPD_WITH_CERES
+#include "calibration/calibrate_problem.h"
+#include "calibration/calibrate_starfish.h"
+#endif
+#if DIFFPD_WITH_IPOPT
 #include "control/trajectory_optimization.h"
+#endif
 #include "diffpd/error.h"
 
 namespace diffpd::problems {
@@ -31,9 +35,13 @@ const char* KindName(int kind) {
 }
 
 int KindOf(const Problem& problem) {
+#if DIFFPD_WITH_IPOPT
   if (dynamic_cast<const TrajectoryOptimizationProblem*>(&problem)) return kOptimisation;
+#endif
+#if DIFFPD_WITH_CERES
   if (dynamic_cast<const CalibrationProblem*>(&problem)) return kCalibration;
   if (dynamic_cast<const StarfishCalibration*>(&problem)) return kStarfish;
+#endif
   if (dynamic_cast<const SwimmerControl*>(&problem)) return kControl;
   return kSimulation;
 }
