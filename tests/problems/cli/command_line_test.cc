@@ -36,8 +36,18 @@ struct Refusal {
   std::string error;
 };
 
+// Whether this diffpd has the problem (the calibration and optimisation
+// problems come with their adapters).
+bool Registered(const std::string& name) {
+  for (const auto& p : AllProblems())
+    if (p->name() == name) return true;
+  return false;
+}
+
 void ExpectRefusals(const std::vector<Refusal>& refusals) {
   for (const Refusal& r : refusals) {
+    const bool refuses_the_name = r.error.find("unknown problem") != std::string::npos;
+    if (r.args.size() >= 2 && r.args[0] == "run" && !refuses_the_name && !Registered(r.args[1])) continue;
     std::vector<std::string> argv = {"diffpd"};
     argv.insert(argv.end(), r.args.begin(), r.args.end());
     std::string line;
