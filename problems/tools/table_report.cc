@@ -258,18 +258,7 @@ void WriteTablePlot(const TableResult& result, const std::string& png_path) {
            << colours[k] << "' fill pattern 4";
   }
   script << "\nset output\n";
-  FILE* pipe = popen("gnuplot", "w");
-  if (!pipe) throw std::runtime_error("could not start gnuplot");
-  const std::string text = script.str();
-  std::fwrite(text.data(), 1, text.size(), pipe);
-  const int status = pclose(pipe);
-  if (status != 0) {
-    std::ostringstream msg;
-    msg << "gnuplot failed (status " << status << ") while writing " << png_path;
-    throw std::runtime_error(msg.str());
-  }
-  if (!std::filesystem::is_regular_file(png_path) || std::filesystem::file_size(png_path) == 0)
-    throw std::runtime_error("gnuplot did not write " + png_path);
+  RunGnuplot(script.str(), png_path);
 }
 
 }  // namespace diffpd::problems

@@ -270,6 +270,20 @@ std::string GnuplotQuote(const std::string& s) {
   return out + "'";
 }
 
+void RunGnuplot(const std::string& script, const std::string& png_path) {
+  FILE* pipe = popen("gnuplot", "w");
+  if (!pipe) throw std::runtime_error("could not start gnuplot");
+  std::fwrite(script.data(), 1, script.size(), pipe);
+  const int status = pclose(pipe);
+  if (status != 0) {
+    std::ostringstream msg;
+    msg << "gnuplot failed (status " << status << ") while writing " << png_path;
+    throw std::runtime_error(msg.str());
+  }
+  if (!std::filesystem::is_regular_file(png_path) || std::filesystem::file_size(png_path) == 0)
+    throw std::runtime_error("gnuplot did not write " + png_path);
+}
+
 bool GnuplotAvailable() {
   const char* path = std::getenv("PATH");
   if (!path) return false;
@@ -345,18 +359,7 @@ void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& 
     }
   script << "unset multiplot\nset output\n";
 
-  FILE* pipe = popen("gnuplot", "w");
-  if (!pipe) throw std::runtime_error("could not start gnuplot");
-  const std::string text = script.str();
-  std::fwrite(text.data(), 1, text.size(), pipe);
-  const int status = pclose(pipe);
-  if (status != 0) {
-    std::ostringstream msg;
-    msg << "gnuplot failed (status " << status << ") while writing " << png_path;
-    throw std::runtime_error(msg.str());
-  }
-  if (!std::filesystem::is_regular_file(png_path) || std::filesystem::file_size(png_path) == 0)
-    throw std::runtime_error("gnuplot did not write " + png_path);
+  RunGnuplot(script.str(), png_path);
 }
 
 }  // namespace diffpd::problems

@@ -82,6 +82,9 @@ bool GnuplotAvailable();
 // InvalidInputError for a line break ("plot path contains a line break: give
 // a plain file name").
 std::string GnuplotQuote(const std::string& s);
+// Runs gnuplot on `script`, which writes `png_path`. Throws
+// std::runtime_error when gnuplot cannot start, fails, or writes no file.
+void RunGnuplot(const std::string& script, const std::string& png_path);
 // Writes a PNG of the rows with gnuplot: one column per sweep, top row state
 // error and bottom row gradient error against seconds, log-log, one curve per
 // method (zero errors drawn at 1e-17). Throws std::runtime_error when gnuplot
