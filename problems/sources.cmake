@@ -44,7 +44,10 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/tools/derivative_verdict.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/gradcheck.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/bench.cc
+  ${CMAKE_CURRENT_LIST_DIR}/tools/problem_objective.cc
+  ${CMAKE_CURRENT_LIST_DIR}/tools/reference_cache.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/tradeoff.cc
+  ${CMAKE_CURRENT_LIST_DIR}/tools/tradeoff_front.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/stress.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/table.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/table_report.cc

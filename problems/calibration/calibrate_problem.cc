@@ -235,21 +235,28 @@ std::string CalibrationProblem::DefaultDataPath() const {
   return (std::filesystem::path(dir) / data_file()).lexically_normal().string();
 }
 
+std::unique_ptr<solvers::RolloutFunction> CalibrationProblem::MakeModel(const CapturedMotion& motion,
+                                                                        const SolverOptions& solver) const {
+  Scene scene = MakeScene();
+  scene.material = initial_guess();
+  const int steps = MarkerObservations::RequiredSteps(motion, solver.time_step);
+  auto function = std::make_unique<solvers::RolloutFunction>(scene, solver, steps);
+  function->SetInitialState(InitialState(function->simulator()));
+  function->SetInputs(Inputs(function->simulator(), steps));
+  const std::vector<MaterialField> fields = fitted();
+  function->AddBlock(std::make_unique<solvers::MaterialBlock>(
+      std::vector<solvers::MaterialBlock::Entry>(fields.begin(), fields.end()), scene));
+  function->AddFunctional(std::make_unique<solvers::MarkerResiduals>(motion, scene.mesh, solver.time_step, steps));
+  return function;
+}
+
 CalibrationFit CalibrationProblem::Fit(const CapturedMotion& motion, Method method, int max_iterations,
                                        FILE* log) const {
   const auto start = std::chrono::steady_clock::now();
-  Scene scene = MakeScene();
-  scene.material = initial_guess();
-  const SolverOptions solver = FitOptions(method);
-  const int steps = MarkerObservations::RequiredSteps(motion, solver.time_step);
-  solvers::RolloutFunction function(scene, solver, steps);
-  function.SetInitialState(InitialState(function.simulator()));
-  function.SetInputs(Inputs(function.simulator(), steps));
+  const std::unique_ptr<solvers::RolloutFunction> model = MakeModel(motion, FitOptions(method));
+  solvers::RolloutFunction& function = *model;
   const std::vector<MaterialField> fields = fitted();
-  function.AddBlock(std::make_unique<solvers::MaterialBlock>(
-      std::vector<solvers::MaterialBlock::Entry>(fields.begin(), fields.end()), scene));
-  const int markers =
-      function.AddFunctional(std::make_unique<solvers::MarkerResiduals>(motion, scene.mesh, solver.time_step, steps));
+  constexpr int markers = 0;
   CalibrationFit fit;
   fit.method = method;
   fit.fitted = fields;

@@ -81,6 +81,13 @@ class CalibrationProblem : public Problem {
   // directory in the environment variable DIFFPD_DATA when set).
   std::string DefaultDataPath() const;
 
+  // The fit's model: a rollout function of MakeScene() at initial_guess()
+  // with `solver`, covering the motion's capture times, one block (the
+  // fitted() fields of the base material) and functional 0, the marker
+  // residuals against `motion`. Throws InvalidInputError for a motion that
+  // does not fit the problem's mesh.
+  std::unique_ptr<solvers::RolloutFunction> MakeModel(const CapturedMotion& motion, const SolverOptions& solver) const;
+
   // One fit of fitted() with Ceres (Levenberg-Marquardt, log E and logit nu
   // steps, one residual block per frame sharing one rollout per point), its
   // iteration table on `log` (nullptr: silent). Throws InvalidInputError for

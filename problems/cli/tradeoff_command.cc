@@ -1,62 +1,144 @@
-// `diffpd tradeoff`: the command-line edge of tradeoff.h.
+// `diffpd tradeoff`: the command-line edge of tradeoff.h and tradeoff_front.h.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 
-#include "tools/bench.h"
 #include "cli/commands.h"
 #include "cli/option_checks.h"
 #include "diffpd/error.h"
+#include "tools/bench.h"
+#include "tools/problem_objective.h"
 #include "tools/tradeoff.h"
+#include "tools/tradeoff_front.h"
 
 namespace diffpd::problems {
 namespace {
 
 constexpr const char* kTradeoffFooter = R"(
-Time (forward + backward seconds) against error for each method, in three
-sweeps, each against newton-cholesky converged to rel_tolerance 1e-10:
- tolerance  : rel_tolerance (forward and adjoint) = each --tolerances value;
-              error of the final state [x_K, v_K] and of the gradient
-              [dL/dx0, dL/dv0, dL/dE, dL/dnu, dL/drho] of L = c_x.x_K + c_v.v_K.
- time_step  : fixed duration T = steps * dt; h = dt / 2^k, k < --dt-levels,
-              at --rtol; reference at dt / 2^dt-levels; same errors at T.
- resolution : the mesh with 3 j fewer doublings (half the cells per axis per
-              level, --resolution-levels levels), at --rtol; reference on the
-              finest mesh; errors of the final displacement of the 8 corner
-              nodes and of (E dL/dE, nu dL/dnu, rho dL/drho), L linear in
-              the corner positions.
-JSON: a list of {sweep, method, parameter, value, seconds, state_rel_error,
-grad_rel_error, status, forward_s, backward_s, iters_per_step, dofs, steps}.
---plot FILE.png: log-log plot (gnuplot), one curve per method, one column
-per sweep, state error on top and gradient error below. The full cantilever
-takes minutes per Newton run: use --steps (and --refine) to keep it short.)";
+Time (forward + backward seconds of one evaluation) against the error of the
+problem's own loss and of its gradient with respect to the problem's own
+optimisation variables, against newton-cholesky converged to rel_tolerance
+1e-10 (adjoint 1e-12), cached in --cache (default <out>/reference_cache).
+Every run starts from the problem's own settings ('default'); sweeps:
+ tolerance  : each --methods at each --tolerances value
+ options    : the other tolerance reference (start residual / inertia) per
+              tolerance; pd and pd-lbfgs with each adjoint solver (auto,
+              iterative, direct) and each backward tolerance factor; the
+              contact screening tolerance where the scene has contact
+ time_step  : forward scenes: h = dt / 2^k, k < --dt-levels, fixed duration
+ resolution : cantilever, falling-cube: 3 fewer doublings per level
+Problems: every registered problem (small instances of the optimisation and
+control problems), the paper's rows as paper-<row> (small), the calibrations.
+--all: every problem, small, reduced sweeps (a few minutes on 2 cores).
+--out DIR writes <problem>.json (the report below) and, with gnuplot,
+<problem>.png (log-log, one curve per method, the default marked); --all
+also writes summary.json. Report: default (method, tolerance, seconds,
+gradient error, slowdown over the front), the front, for gradient-error
+bounds 1e-3, 1e-2, 1e-1 the fastest setting and how far the default's
+tolerance may be loosened, and the monotonicity violations (a tighter
+tolerance with a larger error than --noise times a looser one's plus 1e-9).
+Exit code 6 with --check when a problem has a monotonicity violation.)";
 
 struct TradeoffArgs {
   std::string problem;
-  std::vector<std::string> methods = {"pd", "pd-lbfgs", "newton-pcg", "newton-cholesky"};
-  std::vector<std::string> sweeps = {"tolerance", "time_step", "resolution"};
+  bool all = false;
+  bool quick = false;
+  std::vector<std::string> methods = {"pd", "pd-lbfgs", "newton-pcg", "newton-cholesky", "newton-ldlt"};
+  std::vector<std::string> sweeps = {"tolerance", "options", "time_step", "resolution"};
   TradeoffOptions options;
   bool json = false;
+  bool check = false;
+  double noise = 3;
+  std::string out;
   std::string plot;
 };
 
+// The reduced settings of --all and --quick: four tolerances, two time-step
+// and resolution levels, forward scenes at 10 steps on coarse meshes.
+void Reduce(const std::string& problem, TradeoffOptions* o) {
+  o->tolerances = {1e-2, 1e-4, 1e-6, 1e-8};
+  o->backward_factors = {1, 0.01};
+  o->screenings = {0, 1e-1};
+  o->time_step_levels = 2;
+  o->resolution_levels = 2;
+  if (o->steps <= 0) o->steps = 10;
+  if (o->refine == 0) o->refine = problem == "cantilever" ? -6 : problem == "falling-cube" ? -3 : 0;
+}
+
+struct ProblemReport {
+  TradeoffResult result;
+  TradeoffFront front;
+  std::vector<MonotonicityViolation> violations;
+};
+
+void PrintTable(const ProblemReport& p) {
+  const TradeoffResult& r = p.result;
+  std::printf("== %s: %d DoFs, %d steps, h = %g s; gradient w.r.t. %s; loss %s\n", r.problem.c_str(), r.dofs, r.steps,
+              r.time_step, r.variables.c_str(), r.loss.c_str());
+  std::printf("%-19s %-16s %-25s %10s %-14s %10s %11s %11s %11s %8s\n", "sweep", "method", "parameter", "value",
+              "setting", "seconds", "state_err", "loss_err", "grad_err", "it/step");
+  for (const auto& row : r.rows) {
+    std::printf("%-19s %-16s %-25s %10.3g %-14s ", row.sweep.c_str(), row.method.c_str(), row.parameter.c_str(),
+                row.value, row.setting.c_str());
+    if (!row.ok())
+      std::printf("failed: %s\n", row.failure.c_str());
+    else
+      std::printf("%10.4f %11.3e %11.3e %11.3e %8.2f\n", row.seconds, row.state_rel_error, row.loss_rel_error,
+                  row.grad_rel_error, row.iters_per_step);
+  }
+  if (!r.rows[0].ok())
+    std::printf("default %s at rel_tolerance %g failed: %s\n", r.default_method.c_str(), r.default_rel_tolerance,
+                r.rows[0].failure.c_str());
+  else
+    std::printf("default %s at rel_tolerance %g: %.4f s, gradient error %.3e, %.2fx the front's time at that error%s\n",
+                r.default_method.c_str(), r.default_rel_tolerance, r.rows[0].seconds, r.rows[0].grad_rel_error,
+                p.front.default_slowdown, p.front.default_on_front ? " (on the front)" : "");
+  for (const auto& b : p.front.bounds) {
+    if (!b.met) {
+      std::printf("gradient error <= %g: no run reaches it\n", b.bound);
+      continue;
+    }
+    std::printf("gradient error <= %g: fastest %s (%s, rel_tolerance %g) %.4f s; ", b.bound, b.method.c_str(),
+                b.setting.c_str(), b.rel_tolerance, b.seconds);
+    if (b.default_method_tolerance > 0)
+      std::printf("%s meets it from rel_tolerance %g down (%gx the default)\n", r.default_method.c_str(),
+                  b.default_method_tolerance, b.loosening);
+    else
+      std::printf("%s meets it at no swept tolerance\n", r.default_method.c_str());
+  }
+  for (const auto& v : p.violations)
+    std::printf("NOT MONOTONE: %s %s error %.3e at rel_tolerance %g > %.3e at %g\n", v.method.c_str(), v.error.c_str(),
+                v.tighter_error, v.tighter_tolerance, v.looser_error, v.looser_tolerance);
+}
+
 int RunTradeoffArgs(const TradeoffArgs& args) {
+  if (args.all == !args.problem.empty())
+    throw InvalidInputError("name one problem or give --all (diffpd tradeoff --help lists the problems)");
   TradeoffOptions options = args.options;
   options.methods = ParseMethods(args.methods);
-  options.sweep_tolerance = options.sweep_time_step = options.sweep_resolution = false;
+  options.sweep_tolerance = options.sweep_solver_options = options.sweep_time_step = options.sweep_resolution = false;
   for (const auto& s : args.sweeps) {
     if (s == "tolerance")
       options.sweep_tolerance = true;
+    else if (s == "options")
+      options.sweep_solver_options = true;
     else if (s == "time_step")
       options.sweep_time_step = true;
     else if (s == "resolution")
       options.sweep_resolution = true;
     else
-      throw InvalidInputError("sweep '" + s + "' is invalid: valid sweeps are tolerance, time_step, resolution");
+      throw InvalidInputError("sweep '" + s +
+                              "' is invalid: valid sweeps are tolerance, options, time_step, resolution");
   }
+  if (!(args.noise >= 1))
+    throw InvalidInputError("--noise = " + std::to_string(args.noise) + " is invalid: must be >= 1");
+  if (options.cache_dir.empty() && !args.out.empty())
+    options.cache_dir = (std::filesystem::path(args.out) / "reference_cache").string();
+  if (!args.out.empty()) std::filesystem::create_directories(args.out);
   if (!args.plot.empty()) {
     // Fail before the (long) sweeps, not after.
     if (!GnuplotAvailable())
@@ -67,27 +149,39 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
     if (!std::filesystem::is_directory(dir))
       throw InvalidInputError("--plot " + args.plot + " is invalid: directory " + dir.string() + " does not exist");
   }
-  const auto rows = RunTradeoff(args.problem, options, &std::cerr);
-  if (!args.plot.empty()) {
-    WriteTradeoffPlot(rows, args.plot, "diffpd tradeoff: " + args.problem);
-    std::cerr << "[tradeoff] wrote " << args.plot << std::endl;
-  }
-  if (args.json) {
-    std::printf("%s\n", TradeoffToJson(rows).dump(2).c_str());
-    return 0;
-  }
-  std::printf("%-11s %-16s %-14s %12s %10s %12s %12s %10s\n", "sweep", "method", "parameter", "value", "seconds",
-              "state_err", "grad_err", "iters/step");
-  for (const auto& r : rows) {
-    if (!r.failure.empty()) {
-      std::printf("%-11s %-16s %-14s %12.4g failed: %s\n", r.sweep.c_str(), r.method.c_str(), r.parameter.c_str(),
-                  r.value, r.failure.c_str());
-      continue;
+  const std::vector<std::string> problems = args.all ? ObjectiveProblemNames() : std::vector<std::string>{args.problem};
+  std::vector<ProblemReport> reports;
+  nlohmann::json summary = nlohmann::json::array();
+  bool monotone = true;
+  for (const auto& name : problems) {
+    TradeoffOptions o = options;
+    if (args.all || args.quick) Reduce(name, &o);
+    ProblemReport p;
+    p.result = RunTradeoff(name, o, &std::cerr);
+    p.front = AnalyseFront(p.result);
+    p.violations = CheckMonotone(p.result.rows, args.noise, 1e-9);
+    monotone = monotone && p.violations.empty();
+    const nlohmann::json report = TradeoffReportJson(p.result, p.front, p.violations);
+    summary.push_back(report);
+    if (!args.out.empty()) {
+      const auto base = std::filesystem::path(args.out) / name;
+      std::ofstream(base.string() + ".json") << report.dump(1) << "\n";
+      if (GnuplotAvailable()) {
+        WriteTradeoffPlot(p.result.rows, base.string() + ".png", "diffpd tradeoff: " + name);
+        std::cerr << "[tradeoff] wrote " << base.string() << ".png" << std::endl;
+      }
     }
-    std::printf("%-11s %-16s %-14s %12.4g %10.4f %12.3e %12.3e %10.2f\n", r.sweep.c_str(), r.method.c_str(),
-                r.parameter.c_str(), r.value, r.seconds, r.state_rel_error, r.grad_rel_error, r.iters_per_step);
+    if (!args.plot.empty()) {
+      WriteTradeoffPlot(p.result.rows, args.plot, "diffpd tradeoff: " + name);
+      std::cerr << "[tradeoff] wrote " << args.plot << std::endl;
+    }
+    if (!args.json) PrintTable(p);
+    std::fflush(stdout);
   }
-  return 0;
+  if (!args.out.empty() && args.all)
+    std::ofstream((std::filesystem::path(args.out) / "summary.json").string()) << summary.dump(1) << "\n";
+  if (args.json) std::printf("%s\n", (args.all ? summary : summary[0]).dump(2).c_str());
+  return args.check && !monotone ? 6 : 0;
 }
 
 }  // namespace
@@ -95,28 +189,31 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
 Subcommand AddTradeoffCommand(CLI::App* parent) {
   auto args = std::make_shared<TradeoffArgs>();
   CLI::App* cmd = parent->add_subcommand(
-      "tradeoff", "time vs. error per method, sweeping tolerance, time step and mesh resolution");
+      "tradeoff", "time vs. error of a problem's loss and gradient per method, tolerance and solver option");
   cmd->footer(kTradeoffFooter);
   TradeoffOptions& o = args->options;
-  cmd->add_option("problem", args->problem, "problem name: cantilever or falling-cube")->required();
-  cmd->add_option("--methods", args->methods, "comma-separated methods: newton-cholesky, newton-pcg, pd, pd-lbfgs")
+  cmd->add_option("problem", args->problem, "problem name (diffpd list; paper rows as paper-<row>)");
+  cmd->add_flag("--all", args->all, "every problem's small instance, reduced sweeps");
+  cmd->add_flag("--quick", args->quick, "the reduced sweeps of --all for one problem");
+  cmd->add_option("--methods", args->methods,
+                  "comma-separated methods: newton-cholesky, newton-pcg, newton-ldlt, pd, pd-lbfgs")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--sweeps", args->sweeps, "comma-separated sweeps: tolerance, time_step, resolution")
+  cmd->add_option("--sweeps", args->sweeps, "comma-separated sweeps: tolerance, options, time_step, resolution")
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--tolerances", o.tolerances, "comma-separated tolerances of the tolerance sweep")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--rtol", o.rel_tolerance, "tolerance of the time-step and resolution sweeps")
-      ->check(Fraction("--rtol"))
-      ->capture_default_str();
+  cmd->add_option("--rtol", o.rel_tolerance,
+                  "tolerance of the time-step and resolution sweeps (default: the problem's)")
+      ->check(Fraction("--rtol"));
   cmd->add_option("--max-iterations", o.max_iterations, "iteration limit of each step's solve")
       ->check(IntegerAtLeast("--max-iterations", 1))
       ->capture_default_str();
-  cmd->add_option("--steps", o.steps, "number of time steps at --dt (default: the problem's)")
+  cmd->add_option("--steps", o.steps, "forward scenes: number of time steps at --dt (default: the problem's)")
       ->check(IntegerAtLeast("--steps", 1));
-  cmd->add_option("--dt", o.time_step, "coarsest time step in seconds (default: the problem's)")
+  cmd->add_option("--dt", o.time_step, "forward scenes: coarsest time step in seconds (default: the problem's)")
       ->check(Positive("--dt", "s"));
   cmd->add_option("--dt-levels", o.time_step_levels, "time steps dt / 2^k, k < dt-levels")
       ->check(IntegerAtLeast("--dt-levels", 1))
@@ -129,8 +226,12 @@ Subcommand AddTradeoffCommand(CLI::App* parent) {
       ->capture_default_str();
   cmd->add_option("--threads", o.threads, "threads for element loops (0: OpenMP default)")
       ->check(ThreadCount("--threads"));
-  cmd->add_option("--seed", o.seed, "seed of the loss vectors")->capture_default_str();
-  cmd->add_flag("--json", args->json, "print one JSON document (a list) on stdout");
+  cmd->add_option("--seed", o.seed, "seed of the forward scenes' loss vectors")->capture_default_str();
+  cmd->add_option("--cache", o.cache_dir, "directory of cached references (default: <out>/reference_cache)");
+  cmd->add_option("--out", args->out, "directory for <problem>.json, <problem>.png (and summary.json with --all)");
+  cmd->add_option("--noise", args->noise, "noise factor of the monotonicity check")->capture_default_str();
+  cmd->add_flag("--check", args->check, "exit code 6 when a tolerance sweep is not monotone");
+  cmd->add_flag("--json", args->json, "print the report as JSON on stdout");
   cmd->add_option("--plot", args->plot, "write a log-log PNG of time vs. error (needs gnuplot)");
   return {cmd, [args] { return RunTradeoffArgs(*args); }};
 }

@@ -7,33 +7,20 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
 #include "tools/bench.h"
+#include "tools/problem_objective.h"
+#include "tools/reference_cache.h"
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
 #include "cli/invalid_option.h"
 
 namespace diffpd::problems {
 namespace {
-
-SolverOptions Options(Method method, double tolerance, double h, int threads, int max_iterations) {
-  SolverOptions s;
-  s.max_iterations = max_iterations;
-  s.method = method;
-  s.time_step = h;
-  s.rel_tolerance = tolerance;
-  s.backward_rel_tolerance = tolerance;
-  s.num_threads = threads;
-  return s;
-}
-
-SolverOptions ReferenceOptions(double h, int threads) {
-  SolverOptions s = Options(Method::kNewtonCholesky, kReferenceRelTolerance, h, threads, 1000);
-  s.backward_rel_tolerance = kReferenceBackwardRelTolerance;
-  return s;
-}
 
 void Progress(std::ostream* out, const std::string& line) {
   if (out) *out << line << std::endl;
@@ -67,11 +54,13 @@ TradeoffRow MakeRow(const std::string& sweep, Method method, const std::string& 
 
 std::string Describe(const TradeoffRow& r) {
   std::ostringstream s;
-  s << "[tradeoff] " << r.sweep << " " << r.method << " " << r.parameter << " = " << r.value << ": ";
+  s << "[tradeoff] " << r.sweep << " " << r.method << " " << r.parameter << " = "
+    << (r.setting.empty() ? std::to_string(r.value) : r.setting) << ": ";
   if (!r.failure.empty())
     s << "failed: " << r.failure;
   else
-    s << r.seconds << " s, state error " << r.state_rel_error << ", gradient error " << r.grad_rel_error;
+    s << r.seconds << " s, state error " << r.state_rel_error << ", loss error " << r.loss_rel_error
+      << ", gradient error " << r.grad_rel_error;
   return s.str();
 }
 
@@ -127,6 +116,104 @@ CornerMeasurement MeasureCorners(const std::string& problem_name, int doublings,
   return out;
 }
 
+// Options of a method at a tolerance on top of the problem's settings.
+SolverOptions SweepOptions(const SolverOptions& defaults, Method method, double tolerance, double h) {
+  SolverOptions s = defaults;
+  s.method = method;
+  s.time_step = h;
+  s.rel_tolerance = tolerance;
+  if (defaults.backward_rel_tolerance == defaults.rel_tolerance) s.backward_rel_tolerance = tolerance;
+  return s;
+}
+
+SolverOptions ConvergedOptions(const SolverOptions& defaults, double h) {
+  SolverOptions s = SweepOptions(defaults, Method::kNewtonCholesky, kReferenceRelTolerance, h);
+  s.backward_rel_tolerance = kReferenceBackwardRelTolerance;
+  s.tolerance_reference = ToleranceReference::kStartResidual;
+  return s;
+}
+
+void RunTimeStepSweep(const std::string& problem_name, const TradeoffOptions& o, const SolverOptions& defaults,
+                      double tolerance, std::ostream* progress, std::vector<TradeoffRow>* rows) {
+  const auto problem = MakeRefinedProblem(problem_name, o.refine);
+  const Scene scene = problem->MakeScene();
+  const int steps = o.steps > 0 ? o.steps : problem->default_steps();
+  const double h0 = defaults.time_step;
+  State initial;
+  LinearLoss loss;
+  {
+    Simulator sim(scene, ConvergedOptions(defaults, h0));
+    initial = problem->InitialState(sim);
+    loss = LinearLoss::Random(sim.num_dofs(), o.seed);
+  }
+  auto inputs_for = [&](double h, int k) {
+    Simulator sim(scene, ConvergedOptions(defaults, h));
+    return problem->Inputs(sim, k);
+  };
+  const int dofs = scene.mesh.num_dofs();
+  const int ref_steps = steps << o.time_step_levels;
+  const double ref_h = h0 / (1 << o.time_step_levels);
+  std::ostringstream key;
+  key.precision(17);
+  key << "tradeoff time-step reference v1|" << problem_name << "|steps " << ref_steps << "|h " << ref_h << "|refine "
+      << o.refine << "|seed " << o.seed << "|max_iterations " << o.max_iterations;
+  const ReferenceValues ref = CachedReference(o.cache_dir, problem_name, key.str(), [&] {
+    Progress(progress, "[tradeoff] time-step sweep: reference at h = " + std::to_string(ref_h) + " s (" +
+                           std::to_string(ref_steps) + " steps) ...");
+    const RolloutMeasurement m = MustSucceed(
+        MeasureRollout(scene, ConvergedOptions(defaults, ref_h), initial, inputs_for(ref_h, ref_steps), loss),
+        "time-step sweep");
+    ReferenceValues r;
+    r.loss = loss.Value(m.final_state);
+    r.state = StackState(m.final_state);
+    r.gradient = m.gradient;
+    r.seconds = m.forward_s + m.backward_s;
+    return r;
+  });
+  for (Method method : o.methods)
+    for (int k = 0; k < o.time_step_levels; ++k) {
+      const double h = h0 / (1 << k);
+      const int n_steps = steps << k;
+      const SolverOptions so = SweepOptions(defaults, method, tolerance, h);
+      const RolloutMeasurement m = MeasureRollout(scene, so, initial, inputs_for(h, n_steps), loss);
+      TradeoffRow row = MakeRow("time_step", method, "time_step", h, m, dofs, n_steps);
+      row.rel_tolerance = tolerance;
+      if (m.ok()) {
+        row.state_rel_error = RelativeError(StackState(m.final_state), ref.state);
+        row.loss_rel_error =
+            RelativeError(VectorXd::Constant(1, loss.Value(m.final_state)), VectorXd::Constant(1, ref.loss));
+        row.grad_rel_error = RelativeError(m.gradient, ref.gradient);
+      }
+      Progress(progress, Describe(row));
+      rows->push_back(row);
+    }
+}
+
+void RunResolutionSweep(const std::string& problem_name, const TradeoffOptions& o, double h0, double tolerance,
+                        std::ostream* progress, std::vector<TradeoffRow>* rows) {
+  SolverOptions defaults;
+  defaults.num_threads = o.threads;
+  defaults.max_iterations = o.max_iterations;
+  const VectorXd corner_weights = LinearLoss::Random(24, o.seed + 1).cx;  // one per corner DoF
+  Progress(progress, "[tradeoff] resolution sweep: reference on the finest mesh ...");
+  const CornerMeasurement ref =
+      MeasureCorners(problem_name, o.refine, ConvergedOptions(defaults, h0), o.steps, corner_weights);
+  MustSucceed(ref.m, "resolution sweep");
+  for (Method method : o.methods)
+    for (int j = o.resolution_levels - 1; j >= 0; --j) {
+      const SolverOptions so = SweepOptions(defaults, method, tolerance, h0);
+      const CornerMeasurement c = MeasureCorners(problem_name, o.refine - 3 * j, so, o.steps, corner_weights);
+      TradeoffRow row = MakeRow("resolution", method, "elements", c.elements, c.m, c.dofs, c.steps);
+      row.rel_tolerance = tolerance;
+      if (c.m.ok()) {
+        row.state_rel_error = RelativeError(c.displacement, ref.displacement);
+        row.grad_rel_error = RelativeError(c.material_gradient, ref.material_gradient);
+      }
+      Progress(progress, Describe(row));
+      rows->push_back(row);
+    }
+}
+
 }  // namespace
 
 void TradeoffOptions::Validate() const {
@@ -140,7 +227,11 @@ void TradeoffOptions::Validate() const {
   if (sweep_tolerance && tolerances.empty()) throw InvalidInputError("tolerances is empty: give at least one");
   for (double t : tolerances)
     if (!(t > 0 && t < 1)) fail("tolerance", t, "in (0, 1)");
-  if (!(rel_tolerance > 0 && rel_tolerance < 1)) fail("rtol", rel_tolerance, "in (0, 1)");
+  if (!(rel_tolerance < 1) || std::isnan(rel_tolerance)) fail("rtol", rel_tolerance, "< 1 (<= 0: the problem's)");
+  for (double f : backward_factors)
+    if (!(f > 0 && f <= 1)) fail("backward factor", f, "in (0, 1]");
+  for (double r : screenings)
+    if (!(r >= 0 && r < 1)) fail("screening", r, "in [0, 1)");
   if (threads < 0 || threads > MaxSolverThreads()) fail("threads", threads, ThreadRange());
   if (max_iterations < 1) fail("max iterations", max_iterations, ">= 1");
   if (time_step_levels < 1) fail("time-step levels", time_step_levels, ">= 1");
@@ -148,107 +239,170 @@ void TradeoffOptions::Validate() const {
   if (!std::isfinite(time_step)) fail("dt", time_step, "finite (> 0, or <= 0 for the default)");
 }
 
-std::vector<TradeoffRow> RunTradeoff(const std::string& problem_name, const TradeoffOptions& o,
-                                     std::ostream* progress) {
+namespace {
+
+VectorXd ToVector(double v) { return VectorXd::Constant(1, v); }
+
+TradeoffRow ObjectiveRow(const std::string& sweep, const SolverOptions& so, const std::string& parameter, double value,
+                         const std::string& setting, const ObjectiveMeasurement& m, const ReferenceValues& ref,
+                         const ProblemObjective& objective) {
+  TradeoffRow row;
+  row.sweep = sweep;
+  row.method = ToString(so.method);
+  row.parameter = parameter;
+  row.value = value;
+  row.setting = setting;
+  row.rel_tolerance = so.rel_tolerance;
+  row.failure = m.failure;
+  row.dofs = objective.dofs;
+  row.steps = objective.steps;
+  if (m.ok()) {
+    row.forward_s = m.forward_s;
+    row.backward_s = m.backward_s;
+    row.seconds = m.forward_s + m.backward_s;
+    row.iters_per_step = m.iters_per_step;
+    row.state_rel_error = RelativeError(m.final_state, ref.state);
+    row.loss_rel_error = RelativeError(ToVector(m.loss), ToVector(ref.loss));
+    row.grad_rel_error = RelativeError(m.gradient, ref.gradient);
+  }
+  return row;
+}
+
+std::string ReferenceKey(const std::string& what, const ProblemObjective& objective, const TradeoffOptions& o) {
+  std::ostringstream key;
+  key.precision(17);
+  key << "tradeoff reference v1|" << what << "|" << objective.problem << "|steps " << objective.steps << "|dofs "
+      << objective.dofs << "|h " << objective.defaults.time_step << "|refine " << o.refine << "|max_iterations "
+      << o.max_iterations << "|seed " << o.seed << "|rtol " << kReferenceRelTolerance << "|btol "
+      << kReferenceBackwardRelTolerance;
+  return key.str();
+}
+
+}  // namespace
+
+TradeoffResult RunTradeoff(const std::string& problem_name, const TradeoffOptions& o, std::ostream* progress) {
   o.Validate();
-  std::vector<TradeoffRow> rows;
-  const auto problem = MakeRefinedProblem(problem_name, o.refine);
-  const Scene scene = problem->MakeScene();
-  const int steps = o.steps > 0 ? o.steps : problem->default_steps();
-  const double h0 = o.time_step > 0 ? o.time_step : problem->default_time_step();
-  State initial;
-  LinearLoss loss;
-  {
-    Simulator sim(scene, ReferenceOptions(h0, o.threads));
-    initial = problem->InitialState(sim);
-    loss = LinearLoss::Random(sim.num_dofs(), o.seed);
-  }
-  auto inputs_for = [&](double h, int k) {
-    Simulator sim(scene, ReferenceOptions(h, o.threads));
-    return problem->Inputs(sim, k);
+  TradeoffResult result;
+  Progress(progress, "[tradeoff] " + problem_name + ": building the instance ...");
+  const ProblemObjective objective = MakeProblemObjective(problem_name, o.threads, o.steps, o.refine);
+  if (o.time_step > 0 && !objective.time_step_knob)
+    throw InvalidInputError("--dt is invalid for " + problem_name + ": the problem fixes its time step");
+  SolverOptions defaults = objective.defaults;
+  defaults.num_threads = o.threads;
+  if (o.time_step > 0) defaults.time_step = o.time_step;
+  const bool tied_backward = defaults.backward_rel_tolerance == defaults.rel_tolerance;
+  result.problem = problem_name;
+  result.variables = objective.variables;
+  result.loss = objective.loss;
+  result.dofs = objective.dofs;
+  result.steps = objective.steps;
+  result.time_step = defaults.time_step;
+  result.default_method = ToString(defaults.method);
+  result.default_rel_tolerance = defaults.rel_tolerance;
+
+  // The converged reference of the problem's own loss.
+  ProblemObjective keyed = objective;
+  keyed.defaults = defaults;
+  const ReferenceValues ref = CachedReference(
+      o.cache_dir, problem_name, ReferenceKey("objective", keyed, o),
+      [&] {
+        Progress(progress, "[tradeoff] reference (newton-cholesky, rel_tolerance 1e-10) ...");
+        SolverOptions so = defaults;
+        so.method = Method::kNewtonCholesky;
+        so.rel_tolerance = kReferenceRelTolerance;
+        so.backward_rel_tolerance = kReferenceBackwardRelTolerance;
+        so.tolerance_reference = ToleranceReference::kStartResidual;
+        so.abs_tolerance = std::min(so.abs_tolerance, 1e-10);
+        so.max_iterations = std::max(so.max_iterations, o.max_iterations);
+        const ObjectiveMeasurement m = objective.measure(so, 0);
+        if (!m.ok())
+          throw std::runtime_error("the reference of " + problem_name +
+                                   " (newton-cholesky, rel_tolerance 1e-10) failed: " + m.failure);
+        ReferenceValues r;
+        r.loss = m.loss;
+        r.gradient = m.gradient;
+        r.state = m.final_state;
+        r.seconds = m.forward_s + m.backward_s;
+        return r;
+      },
+      &result.reference_cached);
+  result.reference_s = ref.seconds;
+  Progress(progress, std::string("[tradeoff] reference ") + (result.reference_cached ? "from the cache" : "computed") +
+                         " (" + std::to_string(ref.seconds) + " s)");
+
+  auto run = [&](const std::string& sweep, const SolverOptions& so, const std::string& parameter, double value,
+                 const std::string& setting, double screening = -1) {
+    const ObjectiveMeasurement m = objective.measure(so, screening);
+    TradeoffRow row = ObjectiveRow(sweep, so, parameter, value, setting, m, ref, objective);
+    Progress(progress, Describe(row));
+    result.rows.push_back(row);
   };
-  const int dofs = scene.mesh.num_dofs();
-  auto method_options = [&o](Method method, double tolerance, double h) {
-    return Options(method, tolerance, h, o.threads, o.max_iterations);
+  auto at_tolerance = [&](Method method, double tol) {
+    SolverOptions so = defaults;
+    so.method = method;
+    so.rel_tolerance = tol;
+    if (tied_backward) so.backward_rel_tolerance = tol;
+    return so;
   };
 
-  if (o.sweep_tolerance) {
-    Progress(progress, "[tradeoff] tolerance sweep: reference ...");
-    const auto inputs = inputs_for(h0, steps);
-    const RolloutMeasurement ref =
-        MustSucceed(MeasureRollout(scene, ReferenceOptions(h0, o.threads), initial, inputs, loss), "tolerance sweep");
-    const VectorXd ref_state = StackState(ref.final_state);
+  run("default", defaults, "rel_tolerance", defaults.rel_tolerance, "");
+  if (o.sweep_tolerance)
     for (Method method : o.methods)
-      for (double tol : o.tolerances) {
-        const RolloutMeasurement m = MeasureRollout(scene, method_options(method, tol, h0), initial, inputs, loss);
-        TradeoffRow row = MakeRow("tolerance", method, "rel_tolerance", tol, m, dofs, steps);
-        if (m.ok()) {
-          row.state_rel_error = RelativeError(StackState(m.final_state), ref_state);
-          row.grad_rel_error = RelativeError(m.gradient, ref.gradient);
-        }
-        Progress(progress, Describe(row));
-        rows.push_back(row);
+      for (double tol : o.tolerances) run("tolerance", at_tolerance(method, tol), "rel_tolerance", tol, "");
+
+  if (o.sweep_solver_options) {
+    const ToleranceReference other = defaults.tolerance_reference == ToleranceReference::kStartResidual
+                                         ? ToleranceReference::kInertia
+                                         : ToleranceReference::kStartResidual;
+    const std::string other_name = other == ToleranceReference::kInertia ? "inertia" : "start_residual";
+    for (double tol : o.tolerances) {
+      SolverOptions so = at_tolerance(defaults.method, tol);
+      so.tolerance_reference = other;
+      run("tolerance_reference", so, "rel_tolerance", tol, other_name);
+    }
+    std::vector<Method> pd_methods;
+    for (Method m : o.methods)
+      if (m == Method::kPd || m == Method::kPdLbfgs) pd_methods.push_back(m);
+    for (Method method : pd_methods)
+      for (AdjointSolver a : {AdjointSolver::kAuto, AdjointSolver::kIterative, AdjointSolver::kDirect}) {
+        SolverOptions so = at_tolerance(method, defaults.rel_tolerance);
+        so.adjoint_solver = a;
+        run("adjoint_solver", so, "adjoint_solver", static_cast<double>(a), ToString(a));
       }
+    for (Method method : pd_methods)
+      for (double factor : o.backward_factors) {
+        SolverOptions so = at_tolerance(method, defaults.rel_tolerance);
+        so.backward_rel_tolerance = 0;
+        so.backward_tolerance_factor = factor;
+        run("backward_tolerance", so, "backward_tolerance_factor", factor, "");
+      }
+    if (objective.frictional_contact && objective.screening_knob)
+      for (double screening : o.screenings)
+        run("screening", defaults, "screening_rel_tolerance", screening, "", screening);
   }
 
-  if (o.sweep_time_step) {
-    const int ref_steps = steps << o.time_step_levels;
-    const double ref_h = h0 / (1 << o.time_step_levels);
-    Progress(progress, "[tradeoff] time-step sweep: reference at h = " + std::to_string(ref_h) + " s (" +
-                           std::to_string(ref_steps) + " steps) ...");
-    const RolloutMeasurement ref = MustSucceed(
-        MeasureRollout(scene, ReferenceOptions(ref_h, o.threads), initial, inputs_for(ref_h, ref_steps), loss),
-        "time-step sweep");
-    const VectorXd ref_state = StackState(ref.final_state);
-    for (Method method : o.methods)
-      for (int k = 0; k < o.time_step_levels; ++k) {
-        const double h = h0 / (1 << k);
-        const int n_steps = steps << k;
-        const RolloutMeasurement m =
-            MeasureRollout(scene, method_options(method, o.rel_tolerance, h), initial, inputs_for(h, n_steps), loss);
-        TradeoffRow row = MakeRow("time_step", method, "time_step", h, m, dofs, n_steps);
-        if (m.ok()) {
-          row.state_rel_error = RelativeError(StackState(m.final_state), ref_state);
-          row.grad_rel_error = RelativeError(m.gradient, ref.gradient);
-        }
-        Progress(progress, Describe(row));
-        rows.push_back(row);
-      }
-  }
-
-  if (o.sweep_resolution) {
-    const VectorXd corner_weights = LinearLoss::Random(24, o.seed + 1).cx;  // one per corner DoF
-    Progress(progress, "[tradeoff] resolution sweep: reference on the finest mesh ...");
-    const CornerMeasurement ref =
-        MeasureCorners(problem_name, o.refine, ReferenceOptions(h0, o.threads), o.steps, corner_weights);
-    MustSucceed(ref.m, "resolution sweep");
-    for (Method method : o.methods)
-      for (int j = o.resolution_levels - 1; j >= 0; --j) {
-        const SolverOptions so = method_options(method, o.rel_tolerance, h0);
-        const CornerMeasurement c = MeasureCorners(problem_name, o.refine - 3 * j, so, o.steps, corner_weights);
-        TradeoffRow row = MakeRow("resolution", method, "elements", c.elements, c.m, c.dofs, c.steps);
-        if (c.m.ok()) {
-          row.state_rel_error = RelativeError(c.displacement, ref.displacement);
-          row.grad_rel_error = RelativeError(c.material_gradient, ref.material_gradient);
-        }
-        Progress(progress, Describe(row));
-        rows.push_back(row);
-      }
-  }
-  return rows;
+  const double sweep_tolerance = o.rel_tolerance > 0 ? o.rel_tolerance : defaults.rel_tolerance;
+  if (o.sweep_time_step && objective.time_step_knob)
+    RunTimeStepSweep(problem_name, o, defaults, sweep_tolerance, progress, &result.rows);
+  if (o.sweep_resolution && objective.resolution_knob)
+    RunResolutionSweep(problem_name, o, defaults.time_step, sweep_tolerance, progress, &result.rows);
+  return result;
 }
 
 nlohmann::json TradeoffToJson(const std::vector<TradeoffRow>& rows) {
   nlohmann::json out = nlohmann::json::array();
   for (const auto& r : rows) {
-    const bool ok = r.failure.empty();
+    const bool ok = r.ok();
     auto num = [ok](double v) { return ok ? nlohmann::json(v) : nlohmann::json(nullptr); };
     out.push_back({{"sweep", r.sweep},
                    {"method", r.method},
                    {"parameter", r.parameter},
                    {"value", r.value},
+                   {"setting", r.setting},
+                   {"rel_tolerance", r.rel_tolerance},
                    {"seconds", num(r.seconds)},
                    {"state_rel_error", num(r.state_rel_error)},
+                   {"loss_rel_error", num(r.loss_rel_error)},
                    {"grad_rel_error", num(r.grad_rel_error)},
                    {"status", ok ? std::string("ok") : "failed: " + r.failure},
                    {"forward_s", num(r.forward_s)},
@@ -302,63 +456,86 @@ void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& 
     throw std::runtime_error(
         "--plot needs the gnuplot program, which is not on PATH (Debian: apt-get install "
         "gnuplot-nox), or leave out --plot");
-  const std::vector<std::string> sweeps = {"tolerance", "time_step", "resolution"};
+  // Columns: the runs at the problem's settings, then the time-step and
+  // resolution sweeps where present.
+  auto column_of = [](const TradeoffRow& r) { return r.at_problem_settings() ? std::string("settings") : r.sweep; };
   std::vector<std::string> present;
-  for (const auto& s : sweeps)
+  for (const std::string c : {"settings", "time_step", "resolution"})
     for (const auto& r : rows)
-      if (r.sweep == s && r.failure.empty()) {
-        present.push_back(s);
+      if (column_of(r) == c && r.ok()) {
+        present.push_back(c);
         break;
       }
   if (present.empty()) throw std::runtime_error("nothing to plot: every tradeoff run failed");
   std::vector<std::string> methods;
   for (const auto& r : rows)
     if (std::find(methods.begin(), methods.end(), r.method) == methods.end()) methods.push_back(r.method);
+  const std::vector<std::string> options_sweeps = {"tolerance_reference", "adjoint_solver", "backward_tolerance",
+                                                   "screening"};
 
   std::ostringstream script;
   script << "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) { set terminal pngcairo size " << 500 * present.size()
-         << ",900 } else { set terminal png size " << 500 * present.size() << ",900 }\n";
+         << ",1200 } else { set terminal png size " << 500 * present.size() << ",1200 }\n";
   script << "set output " << GnuplotQuote(png_path) << "\n";
-  script << "set logscale xy\nset format y '10^{%L}'\nset grid\nset key top right font ',9'\n";
-  // Data blocks: one per (sweep, method), columns seconds, state error, gradient error.
-  auto block = [](const std::string& sweep, const std::string& method) {
-    std::string name = "$" + sweep + "_" + method;
-    for (char& c : name)
+  script << "set logscale xy\nset format y '10^{%L}'\nset grid\nset key top right font ',8'\n";
+  auto name = [](std::string n) {
+    for (char& c : n)
       if (c == '-') c = '_';
-    return name;
+    return "$" + n;
   };
-  for (const auto& s : present)
+  auto write_block = [&](const std::string& block, const std::function<bool(const TradeoffRow&)>& take) {
+    script << name(block) << " << EOD\n";
+    int n = 0;
+    for (const auto& r : rows)
+      if (r.ok() && take(r)) {
+        script << r.seconds << " " << std::max(r.state_rel_error, 1e-17) << " " << std::max(r.loss_rel_error, 1e-17)
+               << " " << std::max(r.grad_rel_error, 1e-17) << "\n";
+        ++n;
+      }
+    script << "EOD\n";
+    return n > 0;
+  };
+  // Blocks: (column, method) curves, the solver-option sweeps' points, the default.
+  std::vector<std::pair<std::string, std::string>> curves;  // block, title
+  std::map<std::string, std::vector<std::pair<std::string, std::string>>> by_column;
+  for (const auto& c : present) {
     for (const auto& m : methods) {
-      script << block(s, m) << " << EOD\n";
-      for (const auto& r : rows)
-        if (r.sweep == s && r.method == m && r.failure.empty())
-          script << r.seconds << " " << std::max(r.state_rel_error, 1e-17) << " " << std::max(r.grad_rel_error, 1e-17)
-                 << "\n";
-      script << "EOD\n";
+      const std::string block = c + "_" + m;
+      const std::string sweep = c == "settings" ? "tolerance" : c;
+      if (write_block(block, [&](const TradeoffRow& r) { return r.sweep == sweep && r.method == m; }))
+        by_column[c].push_back({block, m});
     }
-  script << "set multiplot layout 2," << present.size() << " title " << GnuplotQuote(title) << "\n";
-  const char* what[2] = {"state", "gradient"};
-  for (int row = 0; row < 2; ++row)
-    for (const auto& s : present) {
-      const std::string label = s == "tolerance"   ? "tolerance sweep"
-                                : s == "time_step" ? "time-step sweep"
+    if (c == "settings") {
+      for (const auto& sw : options_sweeps)
+        if (write_block("opt_" + sw, [&](const TradeoffRow& r) { return r.sweep == sw; }))
+          by_column[c].push_back({"opt_" + sw, sw});
+      if (write_block("default_point", [](const TradeoffRow& r) { return r.sweep == "default"; }))
+        by_column[c].push_back({"default_point", "default"});
+    }
+  }
+  script << "set multiplot layout 3," << present.size() << " title " << GnuplotQuote(title) << "\n";
+  const char* what[3] = {"final state", "loss", "gradient"};
+  for (int row = 0; row < 3; ++row)
+    for (const auto& c : present) {
+      const std::string label = c == "settings"    ? "method, tolerance and solver options"
+                                : c == "time_step" ? "time-step sweep"
                                                    : "mesh-resolution sweep";
       script << "set title '" << label << "'\nset xlabel 'forward + backward time (s)'\nset ylabel '" << what[row]
              << " relative error'\nplot ";
       bool first = true;
-      for (const auto& m : methods) {
-        const bool any = std::any_of(rows.begin(), rows.end(), [&](const TradeoffRow& r) {
-          return r.sweep == s && r.method == m && r.failure.empty();
-        });
-        if (!any) continue;  // every run failed: no curve (and no gnuplot warning)
-        script << (first ? "" : ", ") << block(s, m) << " using 1:" << (row + 2) << " with linespoints title '" << m
-               << "'";
+      for (const auto& [block, label_text] : by_column[c]) {
+        const bool is_default = block == "default_point";
+        const bool is_option = block.rfind("opt_", 0) == 0;
+        script << (first ? "" : ", ") << name(block) << " using 1:" << (row + 2)
+               << (is_default  ? " with points pt 3 ps 3 lw 2 lc rgb 'black'"
+                   : is_option ? " with points ps 1.2"
+                               : " with linespoints")
+               << " title '" << label_text << "'";
         first = false;
       }
       script << "\n";
     }
   script << "unset multiplot\nset output\n";
-
   RunGnuplot(script.str(), png_path);
 }
 

@@ -1,22 +1,36 @@
-// `diffpd tradeoff`: time against error for each solver method, sweeping
-// (1) the solve tolerance, (2) the time step and (3) the mesh resolution,
-// each against a converged reference (newton-cholesky, rel_tolerance 1e-10,
-// see bench.h). Loss, gradient and error norms are those of bench.h.
+// `diffpd tradeoff`: time against error of a problem's own loss and its
+// gradient with respect to the problem's own optimisation variables
+// (problem_objective.h), for every problem, against a converged reference of
+// the same problem (newton-cholesky, rel_tolerance 1e-10, adjoint 1e-12,
+// cached on disk by reference_cache.h). Every run starts from the problem's
+// own settings (ProblemObjective::defaults) and changes what its sweep
+// names:
 //
-//  - tolerance: the problem at its time step and mesh; each method with
-//    rel_tolerance = backward_rel_tolerance = each value of `tolerances`.
-//    Reference: the same rollout, converged.
-//  - time_step: a fixed simulated duration T = steps * h0; h = h0 / 2^k for
-//    k = 0 .. time_step_levels - 1 (steps * 2^k steps), each method at
-//    rel_tolerance. Reference: converged at h0 / 2^time_step_levels. The state
-//    and gradient compared are those at T (same loss vectors).
-//  - resolution: the mesh with refine - 3 j doublings (j = levels-1 .. 0, each
-//    coarser level has half the cells per axis), each method at rel_tolerance.
-//    States of different meshes are compared through the 8 nodes nearest the
-//    corners of the rest bounding box: state_rel_error is the relative error of
-//    their final displacements (24 numbers), grad_rel_error that of
-//    (E dL/dE, nu dL/dnu, rho dL/drho) for L = c . (those 24 positions).
-//    Reference: converged on the finest mesh (the problem's own).
+//  - default: the problem's settings unchanged (the point users get).
+//  - tolerance: each method with rel_tolerance = each value of `tolerances`
+//    (the adjoint's tolerance follows as the problem's settings say: tied to
+//    the forward's where the problem ties them, else unchanged).
+//  - tolerance_reference: the default method at each tolerance with the other
+//    ToleranceReference (start residual <-> inertial term).
+//  - adjoint_solver: pd and pd-lbfgs (those of `methods`) at the default
+//    tolerance with each AdjointSolver (auto, iterative, direct).
+//  - backward_tolerance: pd and pd-lbfgs at the default tolerance with
+//    backward_rel_tolerance = 0 and backward_tolerance_factor = each of
+//    `backward_factors`.
+//  - screening: scenes with frictional contact whose screening the objective
+//    can set: the default method at the default tolerance with
+//    screening_rel_tolerance = each of `screenings` (0: none).
+//  - time_step (forward scenes only): a fixed duration T = steps * h0,
+//    h = h0 / 2^k for k < time_step_levels, each method at the default
+//    tolerance, against the reference at h0 / 2^time_step_levels, with the
+//    linear loss of bench.h (state and gradient at T).
+//  - resolution (cantilever, falling-cube): the mesh with refine - 3 j
+//    doublings, errors of the 8 corner nodes' displacement and of
+//    (E dL/dE, nu dL/dnu, rho dL/drho), L linear in their positions,
+//    against the finest mesh.
+//
+// Errors are relative 2-norms against the reference: of the final state
+// [x_K, v_K], of the loss |L - L_ref| / |L_ref| and of the gradient.
 #pragma once
 
 #include <cstdint>
@@ -31,49 +45,75 @@
 namespace diffpd::problems {
 
 struct TradeoffOptions {
-  std::vector<Method> methods = {Method::kPd, Method::kPdLbfgs, Method::kNewtonPcg, Method::kNewtonCholesky};
-  // Values of the tolerance sweep (forward and backward relative tolerance).
+  std::vector<Method> methods = {Method::kPd, Method::kPdLbfgs, Method::kNewtonPcg, Method::kNewtonCholesky,
+                                 Method::kNewtonLdlt};
+  // Values of the tolerance sweep (forward relative tolerance).
   std::vector<double> tolerances = {1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8};
-  // Tolerance of the time-step and resolution sweeps.
-  double rel_tolerance = 1e-4;
-  int steps = -1;         // <= 0: the problem's default
-  double time_step = -1;  // h0; <= 0: the problem's default (s)
+  std::vector<double> backward_factors = {1, 0.1, 0.01, 0.001};
+  std::vector<double> screenings = {0, 1e-1, 1e-2};
+  // Tolerance of the time-step and resolution sweeps; <= 0: the problem's.
+  double rel_tolerance = -1;
+  int steps = -1;         // forward scenes: <= 0 the problem's default
+  double time_step = -1;  // forward scenes' h0; <= 0: the problem's default (s)
   int threads = 0;
   int max_iterations = 1000;  // of each step's solve (the references use it too)
-  int refine = 0;             // mesh of the tolerance and time-step sweeps, finest of the resolution sweep
+  int refine = 0;             // cantilever, falling-cube: cell doublings (finest mesh of the resolution sweep)
   int time_step_levels = 4;   // >= 1
   int resolution_levels = 4;  // >= 1
   bool sweep_tolerance = true;
-  bool sweep_time_step = true;
-  bool sweep_resolution = true;
+  bool sweep_solver_options = true;  // tolerance_reference, adjoint_solver, backward_tolerance, screening
+  bool sweep_time_step = true;       // where the problem has the knob
+  bool sweep_resolution = true;      // where the problem has the knob
   std::uint64_t seed = 20211;
+  // Directory of the cached references ("": none).
+  std::string cache_dir;
 
   // Throws InvalidInputError naming the field, its value and the valid range.
   void Validate() const;
 };
 
 struct TradeoffRow {
-  std::string sweep;  // "tolerance", "time_step" or "resolution"
+  // "default", "tolerance", "tolerance_reference", "adjoint_solver",
+  // "backward_tolerance", "screening", "time_step" or "resolution"
+  std::string sweep;
   std::string method;
-  std::string parameter;  // "rel_tolerance", "time_step" (s) or "elements"
+  std::string parameter;  // "rel_tolerance", "time_step" (s), "elements", ...
   double value = 0;
-  std::string failure;  // "" when the run succeeded
-  double seconds = 0;   // forward_s + backward_s
+  std::string setting;       // the value in words where it is not a number ("direct")
+  double rel_tolerance = 0;  // the forward tolerance of the run
+  std::string failure;       // "" when the run succeeded
+  double seconds = 0;        // forward_s + backward_s
   double forward_s = 0, backward_s = 0, iters_per_step = 0;
-  double state_rel_error = 0, grad_rel_error = 0;
+  double state_rel_error = 0, loss_rel_error = 0, grad_rel_error = 0;
   int dofs = 0, steps = 0;
+  bool ok() const { return failure.empty(); }
+  // Runs at the problem's time step and mesh (what the front is made of).
+  bool at_problem_settings() const { return sweep != "time_step" && sweep != "resolution"; }
 };
 
-// Runs the enabled sweeps on the registered problem `problem` (one that
-// MakeRefinedProblem accepts). Progress lines go to `progress` (nullptr:
-// silent). Throws InvalidInputError on bad options and SolverError when a
-// reference fails.
-std::vector<TradeoffRow> RunTradeoff(const std::string& problem, const TradeoffOptions& options,
-                                     std::ostream* progress = nullptr);
+struct TradeoffResult {
+  std::string problem, variables, loss;
+  int dofs = 0, steps = 0;
+  double time_step = 0;
+  std::string default_method;
+  double default_rel_tolerance = 0;
+  bool reference_cached = false;  // the tolerance-sweep reference came from the cache
+  double reference_s = 0;         // seconds the reference took when it was computed
+  std::vector<TradeoffRow> rows;  // rows[0]: the default
+};
 
-// Rows as a JSON list of {sweep, method, parameter, value, seconds,
-// state_rel_error, grad_rel_error, status, forward_s, backward_s,
-// iters_per_step, dofs, steps}; a failed run has null numbers.
+// Runs the enabled sweeps on `problem` (a name of ObjectiveProblemNames()).
+// Progress lines go to `progress` (nullptr: silent). Throws
+// InvalidInputError on bad options, std::runtime_error when the objective's
+// reference fails and SolverError when a time-step or resolution reference
+// fails.
+TradeoffResult RunTradeoff(const std::string& problem, const TradeoffOptions& options,
+                           std::ostream* progress = nullptr);
+
+// The rows as a JSON list of {sweep, method, parameter, value, setting,
+// rel_tolerance, seconds, state_rel_error, loss_rel_error, grad_rel_error,
+// status, forward_s, backward_s, iters_per_step, dofs, steps}; a failed run
+// has null numbers.
 nlohmann::json TradeoffToJson(const std::vector<TradeoffRow>& rows);
 
 // True when a `gnuplot` executable is on PATH.
@@ -85,10 +125,12 @@ std::string GnuplotQuote(const std::string& s);
 // Runs gnuplot on `script`, which writes `png_path`. Throws
 // std::runtime_error when gnuplot cannot start, fails, or writes no file.
 void RunGnuplot(const std::string& script, const std::string& png_path);
-// Writes a PNG of the rows with gnuplot: one column per sweep, top row state
-// error and bottom row gradient error against seconds, log-log, one curve per
-// method (zero errors drawn at 1e-17). Throws std::runtime_error when gnuplot
-// is missing or fails, InvalidInputError for a path gnuplot cannot quote.
+// Writes a PNG of the rows with gnuplot: one column per sweep present
+// (tolerance, time_step, resolution; the solver-option sweeps drawn as points
+// in the tolerance column), top row state error and bottom row gradient
+// error against seconds, log-log, one curve per method (zero errors drawn at
+// 1e-17), the default marked. Throws std::runtime_error when gnuplot is
+// missing or fails, InvalidInputError for a path gnuplot cannot quote.
 void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& png_path, const std::string& title);
 
 }  // namespace diffpd::problems

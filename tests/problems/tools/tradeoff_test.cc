@@ -1,5 +1,6 @@
 // Speed/accuracy sweeps on a tiny cantilever: errors fall as the tolerance,
 // the time step and the mesh are refined; JSON rows and the gnuplot PNG.
+// (tradeoff_problems_test sweeps the other problems' own losses.)
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -23,7 +24,7 @@ TradeoffOptions Tiny() {
   o.steps = 3;
   o.threads = 1;
   o.max_iterations = 10000;  // plain PD needs ~2500 iterations per step at 1e-8 here
-  o.sweep_tolerance = o.sweep_time_step = o.sweep_resolution = false;
+  o.sweep_tolerance = o.sweep_solver_options = o.sweep_time_step = o.sweep_resolution = false;
   return o;
 }
 
@@ -41,8 +42,9 @@ TEST(TradeoffTest, ErrorsFallAsTheToleranceTightens) {
   o.sweep_tolerance = true;
   o.methods = {Method::kPd, Method::kPdLbfgs, Method::kNewtonCholesky};
   o.tolerances = {1e-1, 1e-3, 1e-5, 1e-8};
-  const auto rows = RunTradeoff("cantilever", o);
-  ASSERT_EQ(rows.size(), 12u);
+  const auto rows = RunTradeoff("cantilever", o).rows;
+  ASSERT_EQ(rows.size(), 13u);  // the default and 3 x 4
+  EXPECT_EQ(rows[0].sweep, "default");
   for (Method m : o.methods) {
     const auto r = Select(rows, "tolerance", ToString(m));
     ASSERT_EQ(r.size(), 4u);
@@ -67,7 +69,7 @@ TEST(TradeoffTest, StateErrorFallsWithTheTimeStepAtFixedDuration) {
   o.methods = {Method::kNewtonCholesky};
   o.rel_tolerance = 1e-8;
   o.time_step_levels = 3;  // h = 10, 5, 2.5 ms; reference 1.25 ms
-  const auto r = Select(RunTradeoff("cantilever", o), "time_step", "newton-cholesky");
+  const auto r = Select(RunTradeoff("cantilever", o).rows, "time_step", "newton-cholesky");
   ASSERT_EQ(r.size(), 3u);
   EXPECT_DOUBLE_EQ(r[0].value, 0.01);
   EXPECT_DOUBLE_EQ(r[2].value, 0.0025);
@@ -86,12 +88,12 @@ TEST(TradeoffTest, CornerErrorIsSmallOnTheReferenceMeshAndLargerOnACoarserOne) {
   o.sweep_resolution = true;
   o.methods = {Method::kNewtonCholesky};
   o.resolution_levels = 2;
-  const auto r = Select(RunTradeoff("cantilever", o), "resolution", "newton-cholesky");
+  const auto r = Select(RunTradeoff("cantilever", o).rows, "resolution", "newton-cholesky");
   ASSERT_EQ(r.size(), 2u);
   EXPECT_EQ(r[0].value, 4);
   EXPECT_EQ(r[1].value, 32);
   EXPECT_EQ(r[0].parameter, "elements");
-  // On the reference mesh only the solver tolerance (1e-4) separates them.
+  // On the reference mesh only the solver tolerance (the default 1e-6) separates them.
   EXPECT_LT(r[1].state_rel_error, 1e-2);
   EXPECT_GT(r[0].state_rel_error, 10 * r[1].state_rel_error);
 }
@@ -101,13 +103,15 @@ TEST(TradeoffTest, JsonRowsHaveTheDocumentedFields) {
   o.sweep_tolerance = true;
   o.methods = {Method::kNewtonCholesky};
   o.tolerances = {1e-2, 1e-6};
-  const nlohmann::json rows = nlohmann::json::parse(TradeoffToJson(RunTradeoff("cantilever", o)).dump());
-  ASSERT_EQ(rows.size(), 2u);
-  for (const auto& row : rows) {
+  const nlohmann::json all = nlohmann::json::parse(TradeoffToJson(RunTradeoff("cantilever", o).rows).dump());
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_EQ(all[0].at("sweep"), "default");
+  for (size_t k = 1; k < all.size(); ++k) {
+    const auto& row = all[k];
     EXPECT_EQ(row.at("sweep"), "tolerance");
     EXPECT_EQ(row.at("method"), "newton-cholesky");
     EXPECT_EQ(row.at("parameter"), "rel_tolerance");
-    for (const char* field : {"value", "seconds", "state_rel_error", "grad_rel_error"})
+    for (const char* field : {"value", "seconds", "state_rel_error", "loss_rel_error", "grad_rel_error"})
       EXPECT_TRUE(row.at(field).is_number()) << field;
   }
 }

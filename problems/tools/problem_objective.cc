@@ -1,0 +1,274 @@
+#include "tools/problem_objective.h"
+
+#include <memory>
+
+#include "control/swimmer_control.h"
+#include "diffpd/error.h"
+#include "diffpd/solvers/core/rollout_function.h"
+#include "paper/paper_rows.h"
+#include "paper/row_rollout_function.h"
+#include "problem_registry.h"
+#include "tools/bench.h"
+#if DIFFPD_WITH_CERES
+#include "calibration/calibrate_problem.h"
+#include "diffpd/captured_motion.h"
+#endif
+#if DIFFPD_WITH_IPOPT
+#include "control/trajectory_optimization.h"
+#endif
+
+namespace diffpd::problems {
+namespace {
+
+constexpr const char* kPaperPrefix = "paper-";
+constexpr std::uint64_t kSwimmerSeed = 42;  // the controller's initialisation
+
+// Options of the preparatory simulations and of a converged run.
+SolverOptions Converged(SolverOptions o) {
+  o.method = Method::kNewtonCholesky;
+  o.rel_tolerance = kReferenceRelTolerance;
+  o.backward_rel_tolerance = kReferenceBackwardRelTolerance;
+  o.tolerance_reference = ToleranceReference::kStartResidual;
+  return o;
+}
+
+double ItersPerStep(const Rollout& r) {
+  if (r.reports.empty()) return 0;
+  long total = 0;
+  for (const auto& s : r.reports) total += s.iterations;
+  return static_cast<double>(total) / r.reports.size();
+}
+
+// The loss sum_t weights[t] v_{rows[t]} (least_squares: 1/2 sum_r v_r^2 over
+// `rows`) of f at p and its gradient: one rollout and one adjoint pass.
+ObjectiveMeasurement MeasureFunction(solvers::RolloutFunction* f, const VectorXd& p, const std::vector<int>& rows,
+                                     const std::vector<double>& weights, bool least_squares) {
+  ObjectiveMeasurement m;
+  f->ResetStatistics();
+  VectorXd values;
+  if (!f->Evaluate(p, rows, &values, nullptr)) {
+    m.failure = f->statistics().last_error;
+    return m;
+  }
+  m.forward_s = f->statistics().forward_seconds;
+  VectorXd w = VectorXd::Zero(f->num_rows());
+  for (size_t t = 0; t < rows.size(); ++t) w(rows[t]) += least_squares ? values(t) : weights[t];
+  double value = 0;
+  if (!f->Gradient(p, w, &m.gradient, &value)) {
+    m.failure = f->statistics().last_error;
+    return m;
+  }
+  // Gradient's value is sum_r v_r^2 for the least-squares weights.
+  m.loss = least_squares ? 0.5 * value : value;
+  m.backward_s = f->statistics().backward_seconds;
+  const Rollout* rollout = f->RolloutAt(p);
+  m.final_state = StackState(rollout->states.back());
+  m.iters_per_step = ItersPerStep(*rollout);
+  return m;
+}
+
+bool HasFrictionalContact(const Scene& scene) { return !scene.frictional_contacts.empty(); }
+
+void SetScreening(Scene* scene, double screening) {
+  if (screening >= 0) scene->frictional_contact_options.screening_rel_tolerance = screening;
+}
+
+ProblemObjective PaperRowObjective(const std::string& name, int threads) {
+  auto row = std::make_shared<PaperRow>(MakePaperRow(name.substr(std::string(kPaperPrefix).size()), RowSize::kSmall));
+  row->Prepare(Converged(row->Options(Method::kNewtonCholesky, threads)));
+  ProblemObjective o;
+  o.problem = name;
+  o.variables = "the row's variables (" + std::to_string(row->num_variables()) + ")";
+  o.loss = "the row's loss (" + std::to_string(row->loss.size()) + " terms)";
+  o.defaults = row->Options(Method::kPdLbfgs, threads);  // the method of `diffpd table`'s DiffPD column
+  o.dofs = row->scene.mesh.num_dofs();
+  o.steps = row->steps;
+  o.frictional_contact = HasFrictionalContact(row->scene);
+  o.screening_knob = true;
+  o.measure = [row](const SolverOptions& options_in, double screening) {
+    SolverOptions options = options_in;
+    options.time_step = row->time_step;
+    PaperRow copy = *row;
+    SetScreening(&copy.scene, screening);
+    RowRolloutFunction f = MakeRowRolloutFunction(copy, options);
+    return MeasureFunction(f.function.get(), row->initial(), f.loss_rows, f.loss_weights, false);
+  };
+  return o;
+}
+
+ProblemObjective SwimmerObjective(const SwimmerControl& problem, int threads) {
+  auto swimmer = std::make_shared<Swimmer>(problem.MakeSwimmer(true));
+  ProblemObjective o;
+  o.problem = problem.name();
+  o.loss = "the swim loss";
+  o.defaults = problem.BaseOptions(true);
+  o.defaults.time_step = swimmer->time_step;
+  o.defaults.num_threads = threads;
+  o.dofs = swimmer->scene.mesh.num_dofs();
+  o.steps = swimmer->steps;
+  o.frictional_contact = HasFrictionalContact(swimmer->scene);
+  {
+    const auto f = MakeSwimmerFunction(*swimmer, o.defaults, kSwimmerSeed);
+    o.variables = "the controller's weights (" + std::to_string(f->num_parameters()) + ")";
+  }
+  o.measure = [swimmer](const SolverOptions& options, double) {
+    const auto f = MakeSwimmerFunction(*swimmer, options, kSwimmerSeed);
+    const std::vector<int> rows = f->RowsOf(0);
+    return MeasureFunction(f.get(), f->initial_parameters(), rows, std::vector<double>(rows.size(), 1.0), false);
+  };
+  return o;
+}
+
+#if DIFFPD_WITH_CERES
+ProblemObjective CalibrationObjective(std::shared_ptr<const CalibrationProblem> problem, int threads) {
+  auto motion = std::make_shared<CapturedMotion>(ReadCapturedMotion(problem->DefaultDataPath()));
+  ProblemObjective o;
+  o.problem = problem->name();
+  o.loss = "1/2 |r|^2 of the marker residuals";
+  o.defaults = problem->FitOptions(problem->default_methods().front());
+  o.defaults.num_threads = threads;
+  const Scene scene = problem->MakeScene();
+  o.dofs = scene.mesh.num_dofs();
+  o.frictional_contact = HasFrictionalContact(scene);
+  {
+    const auto f = problem->MakeModel(*motion, o.defaults);
+    o.steps = f->num_steps();
+    o.variables = "the fitted material fields (" + std::to_string(f->num_parameters()) + ")";
+  }
+  o.measure = [problem, motion](const SolverOptions& options_in, double) {
+    SolverOptions options = options_in;
+    options.time_step = problem->default_time_step();
+    const auto f = problem->MakeModel(*motion, options);
+    return MeasureFunction(f.get(), f->initial_parameters(), f->RowsOf(0), {}, true);
+  };
+  return o;
+}
+#endif
+
+#if DIFFPD_WITH_IPOPT
+ProblemObjective NlpObjective(std::shared_ptr<const TrajectoryOptimizationProblem> problem, int threads) {
+  constexpr InstanceSize kSize = InstanceSize::kSmall;
+  ProblemObjective o;
+  o.problem = problem->name();
+  o.loss = "the Ipopt objective";
+  o.defaults = problem->BaseOptions(kSize);
+  o.defaults.time_step = problem->time_step(kSize);
+  o.defaults.num_threads = threads;
+  const Scene scene = problem->MakeScene(kSize);
+  o.dofs = scene.mesh.num_dofs();
+  o.steps = problem->steps(kSize);
+  o.frictional_contact = HasFrictionalContact(scene);
+  {
+    const auto nlp = problem->MakeNlp(o.defaults, kSize);
+    o.variables = "the NLP's variables (" + std::to_string(nlp->num_variables()) + ")";
+  }
+  o.measure = [problem](const SolverOptions& options_in, double) {
+    SolverOptions options = options_in;
+    options.time_step = problem->time_step(kSize);
+    Ipopt::SmartPtr<solvers::RolloutNlp> nlp = problem->MakeNlp(options, kSize);
+    const VectorXd x = nlp->starting_point();
+    ObjectiveMeasurement m;
+    if (!nlp->Objective(x, &m.loss)) {
+      m.failure = nlp->last_error();
+      return m;
+    }
+    m.forward_s = nlp->statistics().forward_seconds;
+    if (!nlp->ObjectiveGradient(x, &m.gradient)) {
+      m.failure = nlp->last_error();
+      return m;
+    }
+    m.backward_s = nlp->statistics().backward_seconds;
+    const Rollout* rollout = nlp->RolloutAt(x);
+    m.final_state = StackState(rollout->states.back());
+    m.iters_per_step = ItersPerStep(*rollout);
+    return m;
+  };
+  return o;
+}
+#endif
+
+// A forward scene: the linear loss of bench.h over [x0, v0, E, nu, rho].
+ProblemObjective SceneObjective(std::shared_ptr<const Problem> problem, int threads, int steps_option) {
+  ProblemObjective o;
+  o.problem = problem->name();
+  o.variables = "x_0, v_0, E, nu, rho";
+  o.loss = "c_x . x_K + c_v . v_K (random c, seed 20211)";
+  o.defaults.time_step = problem->default_time_step();
+  o.defaults.num_threads = threads;
+  auto scene = std::make_shared<Scene>(problem->MakeScene());
+  o.dofs = scene->mesh.num_dofs();
+  o.steps = steps_option > 0 ? steps_option : problem->default_steps();
+  o.variables += " (" + std::to_string(2 * o.dofs + 3) + ")";
+  o.frictional_contact = HasFrictionalContact(*scene);
+  o.screening_knob = true;
+  o.time_step_knob = true;
+  o.resolution_knob = o.problem == "cantilever" || o.problem == "falling-cube";
+  const int steps = o.steps;
+  o.measure = [problem, scene, steps](const SolverOptions& options_in, double screening) {
+    SolverOptions options = options_in;
+    options.time_step = problem->default_time_step();
+    Scene s = *scene;
+    SetScreening(&s, screening);
+    Simulator sim(s, options);
+    const LinearLoss loss = LinearLoss::Random(sim.num_dofs(), 20211);
+    const RolloutMeasurement r = MeasureRollout(s, options, problem->InitialState(sim), problem->Inputs(sim, steps), loss);
+    ObjectiveMeasurement m;
+    m.failure = r.failure;
+    if (!r.ok()) return m;
+    m.forward_s = r.forward_s;
+    m.backward_s = r.backward_s;
+    m.iters_per_step = r.iters_per_step;
+    m.loss = loss.Value(r.final_state);
+    m.gradient = r.gradient.head(2 * sim.num_dofs() + 3);
+    m.final_state = StackState(r.final_state);
+    return m;
+  };
+  return o;
+}
+
+}  // namespace
+
+std::vector<std::string> ObjectiveProblemNames() {
+  std::vector<std::string> names;
+  for (const auto& p : AllProblems()) {
+#if DIFFPD_WITH_CERES
+    if (p->name() == "calibrate-starfish") continue;  // its fit windows have no fixed small instance here
+#endif
+    names.push_back(p->name());
+  }
+  for (const auto& row : PaperRowNames()) names.push_back(kPaperPrefix + row);
+  return names;
+}
+
+ProblemObjective MakeProblemObjective(const std::string& name, int threads, int steps, int refine) {
+  if (name.rfind(kPaperPrefix, 0) == 0) {
+    const std::string row = name.substr(std::string(kPaperPrefix).size());
+    for (const auto& r : PaperRowNames())
+      if (r == row) return PaperRowObjective(name, threads);
+  }
+  for (auto& p : AllProblems()) {
+    if (p->name() != name) continue;
+    if (refine != 0 && name != "cantilever" && name != "falling-cube")
+      throw InvalidInputError("refinement = " + std::to_string(refine) + " is invalid for " + name +
+                              ": only cantilever and falling-cube have a resolution knob (give 0)");
+    std::shared_ptr<const Problem> problem(std::move(p));
+    if (auto swimmer = std::dynamic_pointer_cast<const SwimmerControl>(problem))
+      return SwimmerObjective(*swimmer, threads);
+#if DIFFPD_WITH_CERES
+    if (auto calibration = std::dynamic_pointer_cast<const CalibrationProblem>(problem))
+      return CalibrationObjective(calibration, threads);
+#endif
+#if DIFFPD_WITH_IPOPT
+    if (auto nlp = std::dynamic_pointer_cast<const TrajectoryOptimizationProblem>(problem))
+      return NlpObjective(nlp, threads);
+#endif
+    if (name != "calibrate-starfish")
+      return SceneObjective(refine == 0 ? problem : std::shared_ptr<const Problem>(MakeRefinedProblem(name, refine)),
+                            threads, steps);
+  }
+  std::string valid;
+  for (const auto& n : ObjectiveProblemNames()) valid += (valid.empty() ? "" : ", ") + n;
+  throw InvalidInputError("problem '" + name + "' has no trade-off objective: valid problems are " + valid);
+}
+
+}  // namespace diffpd::problems

@@ -1,0 +1,87 @@
+// A problem's own loss and its gradient with respect to the problem's own
+// optimisation variables, at a fixed point of those variables, as a function
+// of the simulator settings: what `diffpd tradeoff` measures the speed and
+// accuracy of. Every loss is evaluated by the rollout core
+// (solvers::RolloutFunction, or the Ipopt problem built on it), the same
+// code the problem's optimiser calls.
+//
+//  - paper-<row> (cantilever, rolling-sphere, plant, bouncing-ball, bunny,
+//    routing-tendon, torus, quadruped, cow): the DiffPD paper's rows at their
+//    reduced size (RowSize::kSmall), loss and variables of the row at its
+//    starting point x_init, default method pd-lbfgs (`diffpd table`'s DiffPD
+//    column) with the row's settings; preparatory simulations (plant's initial state,
+//    the target motions) run once with newton-cholesky at rel_tolerance 1e-10.
+//  - routing-tendon, bunny, torus, quadruped, cow (Ipopt problems): the small
+//    instance's objective (RolloutNlp::Objective) at its starting point.
+//  - starfish-control, shark-control: the small swimmer's swim loss over the
+//    controller's weights (initialisation seed 42).
+//  - calibrate-cantilever, calibrate-plant, calibrate-bouncing-ball: the fit's
+//    cost 1/2 |r|^2 of the marker residuals against the shipped captured
+//    motion, over the fitted material fields at the fit's initial guess.
+//  - cantilever, falling-cube, cantilever-plane, rolling-sphere,
+//    bouncing-ball (forward scenes, no optimisation of their own): the linear
+//    loss of bench.h, L = c_x . x_K + c_v . v_K, over [x_0, v_0, E, nu, rho].
+//
+// The small instances' sizes are fixed by their problems; `steps` overrides
+// the step count of the forward scenes only.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "diffpd/simulator.h"
+#include "diffpd/solver_options.h"
+
+namespace diffpd::problems {
+
+// One evaluation: loss, gradient and final state at the objective's point.
+struct ObjectiveMeasurement {
+  std::string failure;  // "" on success, else why the rollout or its gradient failed
+  double forward_s = 0, backward_s = 0;  // wall-clock seconds of the rollout and of its gradient
+  double iters_per_step = 0;             // forward solver iterations per step
+  double loss = 0;
+  VectorXd gradient;     // dL/d(variables)
+  VectorXd final_state;  // [x_K; v_K]
+  bool ok() const { return failure.empty(); }
+};
+
+struct ProblemObjective {
+  std::string problem;
+  // What the gradient is taken with respect to, in words ("log E, nu (2)").
+  std::string variables;
+  std::string loss;  // what L is, in words
+  // The problem's own settings (method, tolerances, time step): what a user
+  // gets without choosing.
+  SolverOptions defaults;
+  int dofs = 0, steps = 0;
+  // Whether the scene has frictional contact (a screening tolerance to trade)
+  // and whether Measure can change it (screening >= 0 below).
+  bool frictional_contact = false;
+  bool screening_knob = false;
+  // A forward scene (time-step sweep with bench.h's linear loss), and one
+  // with a mesh-resolution knob (MakeRefinedProblem).
+  bool time_step_knob = false;
+  bool resolution_knob = false;
+  // Evaluates the loss and its gradient with `options` (the time step is the
+  // problem's: options.time_step is ignored) and, where screening_knob,
+  // FrictionalContactOptions::screening_rel_tolerance = screening (< 0: the
+  // scene's). Never throws for a failed rollout (see failure); throws
+  // InvalidInputError for invalid options.
+  std::function<ObjectiveMeasurement(const SolverOptions& options, double screening)> measure;
+};
+
+// The problems that have an objective here: the registered problems (those of
+// this build) and the paper rows (paper-<row>).
+std::vector<std::string> ObjectiveProblemNames();
+
+// The objective of `problem` (a name of ObjectiveProblemNames()) with
+// `threads` element-loop threads (0: OpenMP's default); `steps` > 0 replaces
+// the step count of a forward scene and `refine` the cell doublings of
+// cantilever and falling-cube (MakeRefinedProblem). Builds the instance (reads meshes and
+// recorded data, runs a paper row's preparatory simulations). Throws
+// InvalidInputError for an unknown problem, listing the valid names, and for
+// refine != 0 on a problem without a resolution knob.
+ProblemObjective MakeProblemObjective(const std::string& problem, int threads, int steps = -1, int refine = 0);
+
+}  // namespace diffpd::problems

@@ -1,0 +1,94 @@
+// Trade-off sweeps of problems' own losses and gradients (problem_objective.h)
+// on small instances: every run converges, the errors of the final state,
+// the loss and the gradient with respect to the problem's own variables do
+// not grow as the tolerance tightens (beyond a noise factor of 3), the
+// tightest tolerance agrees with the converged reference, and the reference
+// comes from its cache the second time.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "tools/problem_objective.h"
+#include "tools/tradeoff.h"
+#include "tools/tradeoff_front.h"
+#include "util/temporary_directory.h"
+
+namespace diffpd::problems {
+namespace {
+
+TradeoffOptions Reduced(const std::string& cache) {
+  TradeoffOptions o;
+  o.methods = {Method::kPd, Method::kPdLbfgs, Method::kNewtonCholesky};
+  o.tolerances = {1e-2, 1e-4, 1e-6, 1e-8};
+  o.threads = 1;
+  o.steps = 5;
+  o.refine = 0;
+  o.sweep_solver_options = o.sweep_time_step = o.sweep_resolution = false;
+  o.cache_dir = cache;
+  return o;
+}
+
+class TradeoffProblemsTest : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(TradeoffProblemsTest, ErrorsDoNotGrowAsTheToleranceTightens) {
+  const testing::TemporaryDirectory dir("diffpd-tradeoff-problems");
+  const TradeoffOptions o = Reduced(dir.path().string());
+  const TradeoffResult result = RunTradeoff(GetParam(), o);
+  EXPECT_FALSE(result.reference_cached);
+  ASSERT_EQ(result.rows.size(), 1 + o.methods.size() * o.tolerances.size());
+  for (const auto& r : result.rows) ASSERT_TRUE(r.ok()) << r.method << " " << r.value << ": " << r.failure;
+  for (const auto& v : CheckMonotone(result.rows, 3, 1e-9))
+    ADD_FAILURE() << v.method << " " << v.error << " error " << v.tighter_error << " at " << v.tighter_tolerance
+                  << " > 3 x " << v.looser_error << " at " << v.looser_tolerance;
+  // At 1e-8 every method's gradient is the reference's to 1e-4 (its own
+  // truncation error and the adjoint's tolerance).
+  for (const auto& r : result.rows)
+    if (r.sweep == "tolerance" && r.value == 1e-8) {
+      EXPECT_LT(r.grad_rel_error, 1e-4) << r.method;
+      EXPECT_LT(r.loss_rel_error, 1e-4) << r.method;
+    }
+  // The second sweep reads the reference and measures the same errors for
+  // the deterministic direct method.
+  TradeoffOptions again = o;
+  again.methods = {Method::kNewtonCholesky};
+  again.tolerances = {1e-4};
+  const TradeoffResult second = RunTradeoff(GetParam(), again);
+  EXPECT_TRUE(second.reference_cached);
+  ASSERT_EQ(second.rows.size(), 2u);
+  for (const auto& r : result.rows)
+    if (r.sweep == "tolerance" && r.method == "newton-cholesky" && r.value == 1e-4)
+      EXPECT_EQ(second.rows[1].grad_rel_error, r.grad_rel_error);
+}
+
+// A forward scene, a paper row with contact, a calibration's least-squares
+// fit and a closed-loop swimmer (the others: `diffpd tradeoff --all`).
+INSTANTIATE_TEST_SUITE_P(SmallInstances, TradeoffProblemsTest,
+                         ::testing::Values("cantilever", "paper-bouncing-ball"),
+                         [](const auto& info) {
+                           std::string name = info.param;
+                           for (char& c : name)
+                             if (c == '-') c = '_';
+                           return name;
+                         });
+
+TEST(ProblemObjectiveTest, EveryListedProblemNamesItsVariablesAndLoss) {
+  const auto names = ObjectiveProblemNames();
+  EXPECT_NE(std::find(names.begin(), names.end(), "paper-cow"), names.end());
+  EXPECT_NE(std::find(names.begin(), names.end(), "starfish-control"), names.end());
+  EXPECT_NE(std::find(names.begin(), names.end(), "shark-control"), names.end());
+}
+
+TEST(ProblemObjectiveTest, UnknownProblemListsTheValidOnes) {
+  try {
+    MakeProblemObjective("no-such-problem", 1);
+    FAIL() << "no exception";
+  } catch (const InvalidInputError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("problem 'no-such-problem' has no trade-off objective: valid problems are cantilever, ", 0), 0u)
+        << m;
+    EXPECT_NE(m.find("paper-cow"), std::string::npos) << m;
+  }
+}
+
+}  // namespace
+}  // namespace diffpd::problems
