@@ -208,9 +208,8 @@ Subcommand AddTradeoffCommand(CLI::App* parent) {
   cmd->add_option("--rtol", o.rel_tolerance,
                   "tolerance of the time-step and resolution sweeps (default: the problem's)")
       ->check(Fraction("--rtol"));
-  cmd->add_option("--max-iterations", o.max_iterations, "iteration limit of each step's solve")
-      ->check(IntegerAtLeast("--max-iterations", 1))
-      ->capture_default_str();
+  cmd->add_option("--max-iterations", o.max_iterations, "iteration limit of each step's solve (default: the problem's)")
+      ->check(IntegerAtLeast("--max-iterations", 1));
   cmd->add_option("--steps", o.steps, "forward scenes: number of time steps at --dt (default: the problem's)")
       ->check(IntegerAtLeast("--steps", 1));
   cmd->add_option("--dt", o.time_step, "forward scenes: coarsest time step in seconds (default: the problem's)")

@@ -152,6 +152,7 @@ ProblemObjective NlpObjective(std::shared_ptr<const TrajectoryOptimizationProble
   o.problem = problem->name();
   o.loss = "the Ipopt objective";
   o.defaults = problem->BaseOptions(kSize);
+  o.defaults.method = Method::kPdLbfgs;  // `diffpd run`'s default method
   o.defaults.time_step = problem->time_step(kSize);
   o.defaults.num_threads = threads;
   const Scene scene = problem->MakeScene(kSize);
@@ -194,6 +195,8 @@ ProblemObjective SceneObjective(std::shared_ptr<const Problem> problem, int thre
   o.variables = "x_0, v_0, E, nu, rho";
   o.loss = "c_x . x_K + c_v . v_K (random c, seed 20211)";
   o.defaults.time_step = problem->default_time_step();
+  o.defaults.method = Method::kPdLbfgs;  // `diffpd run`'s defaults for a forward scene
+  o.defaults.rel_tolerance = 1e-4;
   o.defaults.num_threads = threads;
   auto scene = std::make_shared<Scene>(problem->MakeScene());
   o.dofs = scene->mesh.num_dofs();
@@ -211,7 +214,8 @@ ProblemObjective SceneObjective(std::shared_ptr<const Problem> problem, int thre
     SetScreening(&s, screening);
     Simulator sim(s, options);
     const LinearLoss loss = LinearLoss::Random(sim.num_dofs(), 20211);
-    const RolloutMeasurement r = MeasureRollout(s, options, problem->InitialState(sim), problem->Inputs(sim, steps), loss);
+    const RolloutMeasurement r =
+        MeasureRollout(s, options, problem->InitialState(sim), problem->Inputs(sim, steps), loss);
     ObjectiveMeasurement m;
     m.failure = r.failure;
     if (!r.ok()) return m;

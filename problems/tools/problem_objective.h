@@ -12,7 +12,8 @@
 //    column) with the row's settings; preparatory simulations (plant's initial state,
 //    the target motions) run once with newton-cholesky at rel_tolerance 1e-10.
 //  - routing-tendon, bunny, torus, quadruped, cow (Ipopt problems): the small
-//    instance's objective (RolloutNlp::Objective) at its starting point.
+//    instance's objective (RolloutNlp::Objective) at its starting point, with
+//    the problem's settings and `diffpd run`'s method, pd-lbfgs.
 //  - starfish-control, shark-control: the small swimmer's swim loss over the
 //    controller's weights (initialisation seed 42).
 //  - calibrate-cantilever, calibrate-plant, calibrate-bouncing-ball: the fit's
@@ -20,7 +21,8 @@
 //    motion, over the fitted material fields at the fit's initial guess.
 //  - cantilever, falling-cube, cantilever-plane, rolling-sphere,
 //    bouncing-ball (forward scenes, no optimisation of their own): the linear
-//    loss of bench.h, L = c_x . x_K + c_v . v_K, over [x_0, v_0, E, nu, rho].
+//    loss of bench.h, L = c_x . x_K + c_v . v_K, over [x_0, v_0, E, nu, rho];
+//    default settings those of `diffpd run` (pd-lbfgs, rel_tolerance 1e-4).
 //
 // The small instances' sizes are fixed by their problems; `steps` overrides
 // the step count of the forward scenes only.
@@ -37,7 +39,7 @@ namespace diffpd::problems {
 
 // One evaluation: loss, gradient and final state at the objective's point.
 struct ObjectiveMeasurement {
-  std::string failure;  // "" on success, else why the rollout or its gradient failed
+  std::string failure;                   // "" on success, else why the rollout or its gradient failed
   double forward_s = 0, backward_s = 0;  // wall-clock seconds of the rollout and of its gradient
   double iters_per_step = 0;             // forward solver iterations per step
   double loss = 0;

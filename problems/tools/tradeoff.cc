@@ -193,7 +193,7 @@ void RunResolutionSweep(const std::string& problem_name, const TradeoffOptions& 
                         std::ostream* progress, std::vector<TradeoffRow>* rows) {
   SolverOptions defaults;
   defaults.num_threads = o.threads;
-  defaults.max_iterations = o.max_iterations;
+  defaults.max_iterations = o.max_iterations > 0 ? o.max_iterations : 1000;
   const VectorXd corner_weights = LinearLoss::Random(24, o.seed + 1).cx;  // one per corner DoF
   Progress(progress, "[tradeoff] resolution sweep: reference on the finest mesh ...");
   const CornerMeasurement ref =
@@ -233,7 +233,7 @@ void TradeoffOptions::Validate() const {
   for (double r : screenings)
     if (!(r >= 0 && r < 1)) fail("screening", r, "in [0, 1)");
   if (threads < 0 || threads > MaxSolverThreads()) fail("threads", threads, ThreadRange());
-  if (max_iterations < 1) fail("max iterations", max_iterations, ">= 1");
+  if (max_iterations < 1 && max_iterations != -1) fail("max iterations", max_iterations, ">= 1 (or -1: the problem's)");
   if (time_step_levels < 1) fail("time-step levels", time_step_levels, ">= 1");
   if (resolution_levels < 1) fail("resolution levels", resolution_levels, ">= 1");
   if (!std::isfinite(time_step)) fail("dt", time_step, "finite (> 0, or <= 0 for the default)");
@@ -289,6 +289,7 @@ TradeoffResult RunTradeoff(const std::string& problem_name, const TradeoffOption
     throw InvalidInputError("--dt is invalid for " + problem_name + ": the problem fixes its time step");
   SolverOptions defaults = objective.defaults;
   defaults.num_threads = o.threads;
+  if (o.max_iterations > 0) defaults.max_iterations = o.max_iterations;
   if (o.time_step > 0) defaults.time_step = o.time_step;
   const bool tied_backward = defaults.backward_rel_tolerance == defaults.rel_tolerance;
   result.problem = problem_name;
@@ -313,7 +314,7 @@ TradeoffResult RunTradeoff(const std::string& problem_name, const TradeoffOption
         so.backward_rel_tolerance = kReferenceBackwardRelTolerance;
         so.tolerance_reference = ToleranceReference::kStartResidual;
         so.abs_tolerance = std::min(so.abs_tolerance, 1e-10);
-        so.max_iterations = std::max(so.max_iterations, o.max_iterations);
+        so.max_iterations = std::max(so.max_iterations, 1000);
         const ObjectiveMeasurement m = objective.measure(so, 0);
         if (!m.ok())
           throw std::runtime_error("the reference of " + problem_name +

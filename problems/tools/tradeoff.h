@@ -56,7 +56,7 @@ struct TradeoffOptions {
   int steps = -1;         // forward scenes: <= 0 the problem's default
   double time_step = -1;  // forward scenes' h0; <= 0: the problem's default (s)
   int threads = 0;
-  int max_iterations = 1000;  // of each step's solve (the references use it too)
+  int max_iterations = -1;    // of each step's solve; -1: the problem's (references: at least 1000)
   int refine = 0;             // cantilever, falling-cube: cell doublings (finest mesh of the resolution sweep)
   int time_step_levels = 4;   // >= 1
   int resolution_levels = 4;  // >= 1

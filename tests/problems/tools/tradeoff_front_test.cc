@@ -35,14 +35,10 @@ TradeoffResult Made() {
   r.problem = "made-up";
   r.default_method = "pd";
   r.default_rel_tolerance = 1e-4;
-  r.rows = {Row("default", "pd", 1e-4, 1.0, 1e-3),
-            Row("tolerance", "pd", 1e-2, 0.5, 1e-1),
-            Row("tolerance", "pd", 1e-4, 1.0, 1e-3),
-            Row("tolerance", "pd", 1e-6, 2.0, 1e-5),
-            Row("tolerance", "pd-lbfgs", 1e-2, 0.3, 5e-2),
-            Row("tolerance", "pd-lbfgs", 1e-4, 0.6, 8e-4),
-            Row("tolerance", "pd-lbfgs", 1e-6, 1.2, 1e-5),
-            Row("tolerance", "newton-cholesky", 1e-2, 3.0, 1e-2),
+  r.rows = {Row("default", "pd", 1e-4, 1.0, 1e-3), Row("tolerance", "pd", 1e-2, 0.5, 1e-1),
+            Row("tolerance", "pd", 1e-4, 1.0, 1e-3), Row("tolerance", "pd", 1e-6, 2.0, 1e-5),
+            Row("tolerance", "pd-lbfgs", 1e-2, 0.3, 5e-2), Row("tolerance", "pd-lbfgs", 1e-4, 0.6, 8e-4),
+            Row("tolerance", "pd-lbfgs", 1e-6, 1.2, 1e-5), Row("tolerance", "newton-cholesky", 1e-2, 3.0, 1e-2),
             Row("tolerance", "newton-cholesky", 1e-6, 4.0, 1e-6),
             // Off the problem's settings: never on the front however fast.
             Row("time_step", "pd", 1e-4, 0.01, 1e-9)};

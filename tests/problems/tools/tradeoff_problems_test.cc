@@ -6,7 +6,10 @@
 // comes from its cache the second time.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
+
+#include "diffpd/error.h"
 
 #include "tools/problem_objective.h"
 #include "tools/tradeoff.h"
@@ -16,13 +19,16 @@
 namespace diffpd::problems {
 namespace {
 
-TradeoffOptions Reduced(const std::string& cache) {
+TradeoffOptions Reduced(const std::string& problem, const std::string& cache) {
   TradeoffOptions o;
   o.methods = {Method::kPd, Method::kPdLbfgs, Method::kNewtonCholesky};
   o.tolerances = {1e-2, 1e-4, 1e-6, 1e-8};
   o.threads = 1;
   o.steps = 5;
-  o.refine = 0;
+  if (problem == "cantilever") {
+    o.refine = -6;             // 8 x 2 x 2 cells
+    o.max_iterations = 10000;  // plain PD needs thousands of iterations per step at 1e-8 on the stiff beam
+  }
   o.sweep_solver_options = o.sweep_time_step = o.sweep_resolution = false;
   o.cache_dir = cache;
   return o;
@@ -31,8 +37,11 @@ TradeoffOptions Reduced(const std::string& cache) {
 class TradeoffProblemsTest : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(TradeoffProblemsTest, ErrorsDoNotGrowAsTheToleranceTightens) {
+  const auto names = ObjectiveProblemNames();
+  if (std::find(names.begin(), names.end(), GetParam()) == names.end())
+    GTEST_SKIP() << GetParam() << " needs an optimiser adapter this build lacks";
   const testing::TemporaryDirectory dir("diffpd-tradeoff-problems");
-  const TradeoffOptions o = Reduced(dir.path().string());
+  const TradeoffOptions o = Reduced(GetParam(), dir.path().string());
   const TradeoffResult result = RunTradeoff(GetParam(), o);
   EXPECT_FALSE(result.reference_cached);
   ASSERT_EQ(result.rows.size(), 1 + o.methods.size() * o.tolerances.size());
@@ -42,11 +51,12 @@ TEST_P(TradeoffProblemsTest, ErrorsDoNotGrowAsTheToleranceTightens) {
                   << " > 3 x " << v.looser_error << " at " << v.looser_tolerance;
   // At 1e-8 every method's gradient is the reference's to 1e-4 (its own
   // truncation error and the adjoint's tolerance).
-  for (const auto& r : result.rows)
+  for (const auto& r : result.rows) {
     if (r.sweep == "tolerance" && r.value == 1e-8) {
       EXPECT_LT(r.grad_rel_error, 1e-4) << r.method;
       EXPECT_LT(r.loss_rel_error, 1e-4) << r.method;
     }
+  }
   // The second sweep reads the reference and measures the same errors for
   // the deterministic direct method.
   TradeoffOptions again = o;
@@ -55,15 +65,17 @@ TEST_P(TradeoffProblemsTest, ErrorsDoNotGrowAsTheToleranceTightens) {
   const TradeoffResult second = RunTradeoff(GetParam(), again);
   EXPECT_TRUE(second.reference_cached);
   ASSERT_EQ(second.rows.size(), 2u);
-  for (const auto& r : result.rows)
-    if (r.sweep == "tolerance" && r.method == "newton-cholesky" && r.value == 1e-4)
+  for (const auto& r : result.rows) {
+    if (r.sweep == "tolerance" && r.method == "newton-cholesky" && r.value == 1e-4) {
       EXPECT_EQ(second.rows[1].grad_rel_error, r.grad_rel_error);
+    }
+  }
 }
 
-// A forward scene, a paper row with contact, a calibration's least-squares
-// fit and a closed-loop swimmer (the others: `diffpd tradeoff --all`).
-INSTANTIATE_TEST_SUITE_P(SmallInstances, TradeoffProblemsTest,
-                         ::testing::Values("cantilever", "paper-bouncing-ball"),
+// A forward scene (its linear loss over x_0, v_0 and the material) and an
+// Ipopt problem with frictional contact (its objective over the gait
+// parameters); the others: `diffpd tradeoff --all`.
+INSTANTIATE_TEST_SUITE_P(SmallInstances, TradeoffProblemsTest, ::testing::Values("cantilever", "quadruped"),
                          [](const auto& info) {
                            std::string name = info.param;
                            for (char& c : name)
