@@ -283,10 +283,11 @@ std::string ReferenceKey(const std::string& what, const ProblemObjective& object
 TradeoffResult RunTradeoff(const std::string& problem_name, const TradeoffOptions& o, std::ostream* progress) {
   o.Validate();
   TradeoffResult result;
-  Progress(progress, "[tradeoff] " + problem_name + ": building the instance ...");
   const ProblemObjective objective = MakeProblemObjective(problem_name, o.threads, o.steps, o.refine);
   if (o.time_step > 0 && !objective.time_step_knob)
     throw InvalidInputError("--dt is invalid for " + problem_name + ": the problem fixes its time step");
+  Progress(progress, "[tradeoff] " + problem_name + ": " + std::to_string(objective.dofs) + " DoFs, " +
+                         std::to_string(objective.steps) + " steps, gradient w.r.t. " + objective.variables);
   SolverOptions defaults = objective.defaults;
   defaults.num_threads = o.threads;
   if (o.max_iterations > 0) defaults.max_iterations = o.max_iterations;
@@ -452,6 +453,14 @@ bool GnuplotAvailable() {
   return false;
 }
 
+namespace {
+// "adjoint_solver" -> "adjoint solver" (gnuplot's enhanced text makes _ a subscript).
+std::string Spaced(std::string s) {
+  std::replace(s.begin(), s.end(), '_', ' ');
+  return s;
+}
+}  // namespace
+
 void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& png_path, const std::string& title) {
   if (!GnuplotAvailable())
     throw std::runtime_error(
@@ -509,7 +518,7 @@ void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& 
     if (c == "settings") {
       for (const auto& sw : options_sweeps)
         if (write_block("opt_" + sw, [&](const TradeoffRow& r) { return r.sweep == sw; }))
-          by_column[c].push_back({"opt_" + sw, sw});
+          by_column[c].push_back({"opt_" + sw, Spaced(sw)});
       if (write_block("default_point", [](const TradeoffRow& r) { return r.sweep == "default"; }))
         by_column[c].push_back({"default_point", "default"});
     }

@@ -13,6 +13,7 @@
 
 #include "diffpd/solver_options.h"
 #include "problem_registry.h"
+#include "tools/problem_objective.h"
 #include "util/temporary_directory.h"
 
 namespace diffpd::problems {
@@ -63,6 +64,13 @@ void ExpectRefusals(const std::vector<Refusal>& refusals) {
 }
 
 std::string Invalid(const std::string& message) { return "diffpd: invalid input: " + message + "\n"; }
+
+// ObjectiveProblemNames() as the trade-off's message lists them.
+std::string TradeoffProblems() {
+  std::string out;
+  for (const auto& n : ObjectiveProblemNames()) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
 
 TEST(CommandLineTest, RefusesOutOfRangeValuesOfTheSimulatingCommands) {
   const std::string threads = "must be an integer in [0, " + std::to_string(MaxSolverThreads()) +
@@ -222,6 +230,16 @@ TEST(CommandLineTest, RefusesBadMeshSizesThreadsAndProblemsOfTheTools) {
       {{"tradeoff", "cantilever", "--dt-levels", "0"},
        2,
        Invalid("--dt-levels = 0 is invalid: must be an integer >= 1")},
+      {{"tradeoff"}, 2, Invalid("name one problem or give --all (diffpd tradeoff --help lists the problems)")},
+      {{"tradeoff", "cantilever", "--all"},
+       2,
+       Invalid("name one problem or give --all (diffpd tradeoff --help lists the problems)")},
+      {{"tradeoff", "bunny-x"},
+       2,
+       Invalid("problem 'bunny-x' has no trade-off objective: valid problems are " + TradeoffProblems())},
+      {{"tradeoff", "starfish-control", "--dt", "0.01"},
+       2,
+       Invalid("--dt is invalid for starfish-control: the problem fixes its time step")},
       {{"stress", "--problems", "nosuch"}, 2, Invalid("unknown problem 'nosuch': valid problems are " + problems)},
       {{"stress", "--problems", "bouncing-ball"},
        2,
