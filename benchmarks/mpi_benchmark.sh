@@ -5,14 +5,15 @@
 # Runs alternate between the rank counts so that a change in the machine's
 # load affects both. Prints a table, or JSON with --json.
 #
-#   benchmarks/mpi_benchmark.sh [--build DIR] [--recordings N] [--runs K] [--json]
+#   benchmarks/mpi_benchmark.sh [--build DIR] [--recordings N] [--runs K] [--max-iterations I] [--json]
 set -euo pipefail
-build=build recordings=4 runs=3 json=0
+build=build recordings=4 runs=3 iterations=25 json=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) build=$2; shift 2 ;;
     --recordings) recordings=$2; shift 2 ;;
     --runs) runs=$2; shift 2 ;;
+    --max-iterations) iterations=$2; shift 2 ;;
     --json) json=1; shift ;;
     *) echo "mpi_benchmark.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -27,8 +28,8 @@ median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[
 declare -A times evaluations
 for ((k = 1; k <= runs; ++k)); do
   for ranks in 1 2; do
-    out=$(mpiexec -n "$ranks" --oversubscribe "$program" calibrate-plant --recordings "$recordings" --threads 1 --json \
-          2>/dev/null)
+    out=$(mpiexec -n "$ranks" --oversubscribe "$program" calibrate-plant --recordings "$recordings" --threads 1 \
+          --max-iterations "$iterations" --json 2>/dev/null)
     times[$ranks]+="$(echo "$out" | field fit_seconds) "
     evaluations[$ranks]=$(echo "$out" | field evaluations)
     echo "mpi_benchmark: run $k, $ranks rank(s): $(echo "$out" | field fit_seconds) s" >&2

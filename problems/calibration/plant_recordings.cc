@@ -11,7 +11,8 @@ namespace diffpd::problems {
 namespace {
 
 void CheckIndex(int i, int count) {
-  if (count < 1) throw InvalidInputError("plant recordings: count = " + std::to_string(count) + " is invalid: must be >= 1");
+  if (count < 1)
+    throw InvalidInputError("plant recordings: count = " + std::to_string(count) + " is invalid: must be >= 1");
   if (i < 0 || i >= count)
     throw InvalidInputError("plant recording " + std::to_string(i) + " is out of range [0, " + std::to_string(count) +
                             ")");

@@ -47,8 +47,8 @@ RolloutSetFit FitMaterialOverSet(solvers::RolloutSet* set, const std::vector<sol
   fit.initial_cost = summary.initial_cost;
   fit.final_cost = summary.final_cost;
   fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
-  fit.usable = summary.IsSolutionUsable() && summary.termination_type != ceres::FAILURE &&
-               std::isfinite(summary.final_cost);
+  fit.usable =
+      summary.IsSolutionUsable() && summary.termination_type != ceres::FAILURE && std::isfinite(summary.final_cost);
   fit.termination = summary.message;
   if (!set->last_error().empty()) fit.termination += "; last failed evaluation: " + set->last_error();
   return fit;

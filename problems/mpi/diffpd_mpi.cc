@@ -74,16 +74,16 @@ int Run(const Arguments& args, int rank) {
     set.Serve();
     return 0;
   }
-  std::fprintf(stderr, "# %s: %d recordings on %d ranks (%d thread(s) each), %s; set-up %.2f s\n",
-               args.problem.c_str(), args.recordings, set.size(), args.threads, args.method.c_str(), setup_seconds);
+  std::fprintf(stderr, "# %s: %d recordings on %d ranks (%d thread(s) each), %s; set-up %.2f s\n", args.problem.c_str(),
+               args.recordings, set.size(), args.threads, args.method.c_str(), setup_seconds);
   const RolloutSetFit fit = FitMaterialOverSet(&set, PlantCalibration().fitted(), args.max_iterations, stderr);
   set.Stop();
   const nlohmann::json report = Report(args, set, fit, setup_seconds);
   if (args.json) {
     std::printf("%s\n", report.dump(2).c_str());
   } else {
-    std::fprintf(stderr, "# E = %.6g Pa (truth %.6g), nu = %.6g (truth %.6g); cost %.4e -> %.4e\n",
-                 fit.values[0], report["truth"]["youngs_modulus"].get<double>(), fit.values[1],
+    std::fprintf(stderr, "# E = %.6g Pa (truth %.6g), nu = %.6g (truth %.6g); cost %.4e -> %.4e\n", fit.values[0],
+                 report["truth"]["youngs_modulus"].get<double>(), fit.values[1],
                  report["truth"]["poissons_ratio"].get<double>(), fit.initial_cost, fit.final_cost);
     std::fprintf(stderr, "# %d evaluations in %.3f s (%.4f s each); %s\n", fit.evaluations, fit.seconds,
                  report["seconds_per_evaluation"].get<double>(), fit.termination.c_str());
@@ -107,7 +107,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 4096));
   app.add_option("--method", args.method, "simulator method of the fit");
   app.add_option("--threads", args.threads, "threads per rank")->check(CLI::Range(1, 64));
-  app.add_option("--max-iterations", args.max_iterations, "Levenberg-Marquardt iterations")->check(CLI::Range(1, 10000));
+  app.add_option("--max-iterations", args.max_iterations, "Levenberg-Marquardt iterations")
+      ->check(CLI::Range(1, 10000));
   app.add_flag("--json", args.json, "print the report as JSON on stdout");
   int status = 0;
   try {

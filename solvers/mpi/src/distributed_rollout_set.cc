@@ -242,7 +242,8 @@ bool DistributedRolloutSet::Evaluate(const Eigen::Ref<const VectorXd>& p, Vector
     const double* record = gathered.data() + offsets[t];
     values->segment(row, rows_[t]) = Eigen::Map<const VectorXd>(record + 1, rows_[t]);
     if (jacobian)
-      jacobian->middleRows(row, rows_[t]) = Eigen::Map<const MatrixXd>(record + 1 + rows_[t], rows_[t], num_parameters_);
+      jacobian->middleRows(row, rows_[t]) =
+          Eigen::Map<const MatrixXd>(record + 1 + rows_[t], rows_[t], num_parameters_);
     row += rows_[t];
   }
   return true;

@@ -35,7 +35,8 @@ inline solvers::RolloutTerm BeamTerm(int t, int max_iterations = 20000) {
   const Vec3 axes[3] = {Vec3::UnitZ(), Vec3::UnitY(), Vec3::UnitX()};
   for (int r = 0; r < 2 + t % 3; ++r) {
     const int step = r % 2 == 0 ? 2 : 4;
-    term.rows.push_back(f->functional_row(f->AddFunctional(std::make_unique<PointCoordinate>(tip, step, axes[r / 2 % 3]))));
+    term.rows.push_back(
+        f->functional_row(f->AddFunctional(std::make_unique<PointCoordinate>(tip, step, axes[r / 2 % 3]))));
   }
   term.function = std::move(f);
   return term;
