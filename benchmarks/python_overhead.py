@@ -1,0 +1,123 @@
+#!/usr/bin/env python3
+"""Benchmark (not a test): the Python package's overhead on a rollout.
+
+Times the same rollout (a registered problem's default one, the cantilever by
+default) through the C++ API (the rollout_timing program) and through diffpd
+from Python (Simulator.simulate, and the torch Function diffpd.torch.rollout
+with its conversions), in alternating rounds so that both see the same
+machine load, and prints a table and, with --json, one JSON object:
+median seconds of each and the overhead (python / C++ - 1).
+
+Usage: PYTHONPATH=build/python python3 benchmarks/python_overhead.py
+           [--problem cantilever] [--rounds 3] [--repeat 3] [--method pd] [--backward] [--json]
+       (--bin: the directory of rollout_timing, default build/bin)
+"""
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+import diffpd
+
+
+def python_times(problem, method, repeat, backward, use_torch):
+    options = diffpd.SolverOptions(method=diffpd.parse_method(method), time_step=problem.default_time_step)
+    sim = diffpd.Simulator(problem.make_scene(), options)
+    initial = problem.initial_state(sim)
+    steps = problem.default_steps
+    inputs = problem.inputs(sim, steps)
+    dx = np.zeros((steps + 1, sim.num_dofs))
+    dx[-1] = 1.0
+    loss = diffpd.LossGradient(dx)
+    if use_torch:
+        import torch
+        import diffpd.torch as dtorch
+        x0 = torch.from_numpy(initial.x.copy()).requires_grad_(backward)
+        v0 = torch.from_numpy(initial.v.copy())
+
+        def run():
+            t0 = time.perf_counter()
+            positions, _ = dtorch.rollout(sim, x0, v0, steps=steps)
+            forward = time.perf_counter() - t0
+            if not backward:
+                return forward, None
+            t1 = time.perf_counter()
+            positions[-1].sum().backward()
+            return forward, time.perf_counter() - t1
+    else:
+        def run():
+            t0 = time.perf_counter()
+            rollout = sim.simulate(initial, inputs)
+            forward = time.perf_counter() - t0
+            if not backward:
+                return forward, None
+            t1 = time.perf_counter()
+            sim.backward(rollout, loss)
+            return forward, time.perf_counter() - t1
+    run()  # the PD factorisation, as rollout_timing's untimed rollout
+    return [run() for _ in range(repeat)]
+
+
+def cpp_times(binary, name, method, repeat, backward):
+    command = [binary, name, "--method", method, "--repeat", str(repeat)] + (["--backward"] if backward else [])
+    out = json.loads(subprocess.run(command, check=True, capture_output=True, text=True).stdout)
+    backward_times = out.get("backward_seconds", [None] * repeat)
+    return list(zip(out["forward_seconds"], backward_times))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--problem", default="cantilever")
+    parser.add_argument("--method", default="pd")
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--backward", action="store_true")
+    parser.add_argument("--no-torch", action="store_true")
+    parser.add_argument("--bin", default=os.path.join(os.path.dirname(__file__), "..", "build", "bin"))
+    parser.add_argument("--json", action="store_true")
+    args = parser.parse_args()
+
+    problem = diffpd.problems.make(args.problem)
+    binary = os.path.join(args.bin, "rollout_timing")
+    kinds = ["cpp", "python"] + ([] if args.no_torch else ["torch"])
+    times = {kind: [] for kind in kinds}
+    for _ in range(args.rounds):
+        times["cpp"] += cpp_times(binary, args.problem, args.method, args.repeat, args.backward)
+        times["python"] += python_times(problem, args.method, args.repeat, args.backward, False)
+        if "torch" in times:
+            times["torch"] += python_times(problem, args.method, args.repeat, args.backward, True)
+
+    result = {"problem": args.problem, "method": args.method, "steps": problem.default_steps,
+              "runs": args.rounds * args.repeat}
+    for kind in kinds:
+        result[kind + "_forward_median"] = statistics.median(t[0] for t in times[kind])
+        if args.backward:
+            result[kind + "_backward_median"] = statistics.median(t[1] for t in times[kind])
+    for kind in kinds[1:]:
+        result[kind + "_forward_overhead"] = result[kind + "_forward_median"] / result["cpp_forward_median"] - 1
+        if args.backward:
+            result[kind + "_backward_overhead"] = (result[kind + "_backward_median"] /
+                                                   result["cpp_backward_median"] - 1)
+    out = sys.stderr if args.json else sys.stdout
+    print(f"# {args.problem}, {args.method}, {problem.default_steps} steps, median of {result['runs']} runs each",
+          file=out)
+    print(f"{'caller':8} {'forward_s':>10} {'overhead':>9}" + (f" {'backward_s':>11} {'overhead':>9}"
+                                                              if args.backward else ""), file=out)
+    for kind in kinds:
+        row = f"{kind:8} {result[kind + '_forward_median']:10.4f} "
+        row += f"{100 * result.get(kind + '_forward_overhead', 0):8.2f}%"
+        if args.backward:
+            row += f" {result[kind + '_backward_median']:11.4f} {100 * result.get(kind + '_backward_overhead', 0):8.2f}%"
+        print(row, file=out)
+    if args.json:
+        print(json.dumps(result))
+
+
+if __name__ == "__main__":
+    main()
