@@ -9,7 +9,7 @@ machine load, and prints a table and, with --json, one JSON object:
 median seconds of each and the overhead (python / C++ - 1).
 
 Usage: PYTHONPATH=build/python python3 benchmarks/python_overhead.py
-           [--problem cantilever] [--rounds 3] [--repeat 3] [--method pd] [--backward] [--json]
+           [--problem cantilever] [--rtol 1e-4] [--rounds 3] [--repeat 3] [--method pd] [--backward] [--json]
        (--bin: the directory of rollout_timing, default build/bin)
 """
 
@@ -26,8 +26,9 @@ import numpy as np
 import diffpd
 
 
-def python_times(problem, method, repeat, backward, use_torch):
-    options = diffpd.SolverOptions(method=diffpd.parse_method(method), time_step=problem.default_time_step)
+def python_times(problem, method, rtol, repeat, backward, use_torch):
+    options = diffpd.SolverOptions(method=diffpd.parse_method(method), time_step=problem.default_time_step,
+                                   rel_tolerance=rtol)
     sim = diffpd.Simulator(problem.make_scene(), options)
     initial = problem.initial_state(sim)
     steps = problem.default_steps
@@ -38,6 +39,7 @@ def python_times(problem, method, repeat, backward, use_torch):
     if use_torch:
         import torch
         import diffpd.torch as dtorch
+        # The torch variant drives no inputs (the cantilever's default rollout has none).
         x0 = torch.from_numpy(initial.x.copy()).requires_grad_(backward)
         v0 = torch.from_numpy(initial.v.copy())
 
@@ -64,8 +66,9 @@ def python_times(problem, method, repeat, backward, use_torch):
     return [run() for _ in range(repeat)]
 
 
-def cpp_times(binary, name, method, repeat, backward):
-    command = [binary, name, "--method", method, "--repeat", str(repeat)] + (["--backward"] if backward else [])
+def cpp_times(binary, name, method, rtol, repeat, backward):
+    command = [binary, name, "--method", method, "--rtol", repr(rtol), "--repeat", str(repeat)]
+    command += ["--backward"] if backward else []
     out = json.loads(subprocess.run(command, check=True, capture_output=True, text=True).stdout)
     backward_times = out.get("backward_seconds", [None] * repeat)
     return list(zip(out["forward_seconds"], backward_times))
@@ -75,6 +78,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--problem", default="cantilever")
     parser.add_argument("--method", default="pd")
+    parser.add_argument("--rtol", type=float, default=1e-4, help="step tolerance (`diffpd run`'s default)")
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--backward", action="store_true")
@@ -88,10 +92,10 @@ def main():
     kinds = ["cpp", "python"] + ([] if args.no_torch else ["torch"])
     times = {kind: [] for kind in kinds}
     for _ in range(args.rounds):
-        times["cpp"] += cpp_times(binary, args.problem, args.method, args.repeat, args.backward)
-        times["python"] += python_times(problem, args.method, args.repeat, args.backward, False)
+        times["cpp"] += cpp_times(binary, args.problem, args.method, args.rtol, args.repeat, args.backward)
+        times["python"] += python_times(problem, args.method, args.rtol, args.repeat, args.backward, False)
         if "torch" in times:
-            times["torch"] += python_times(problem, args.method, args.repeat, args.backward, True)
+            times["torch"] += python_times(problem, args.method, args.rtol, args.repeat, args.backward, True)
 
     result = {"problem": args.problem, "method": args.method, "steps": problem.default_steps,
               "runs": args.rounds * args.repeat}

@@ -5,7 +5,8 @@
 // package's overhead (benchmarks/python_overhead.py times the same calls
 // through diffpd). One untimed rollout first (the PD factorisation), then
 // `repeat` timed ones; prints one JSON object with every time and the median.
-// Usage: rollout_timing <problem> [--method M] [--steps K] [--repeat R] [--threads T] [--backward]
+// The step tolerance is `diffpd run`'s default, rel_tolerance 1e-4 (--rtol).
+// Usage: rollout_timing <problem> [--method M] [--steps K] [--repeat R] [--threads T] [--rtol R] [--backward]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -33,12 +34,14 @@ double Median(std::vector<double> t) {
 int Main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
-                 "usage: rollout_timing <problem> [--method M] [--steps K] [--repeat R] [--threads T] [--backward]\n");
+                 "usage: rollout_timing <problem> [--method M] [--steps K] [--repeat R] [--threads T] [--rtol R] "
+                 "[--backward]\n");
     return 2;
   }
   const auto problem = problems::MakeProblem(argv[1]);
   SolverOptions options;
   options.time_step = problem->default_time_step();
+  options.rel_tolerance = 1e-4;
   int steps = problem->default_steps(), repeat = 5;
   bool backward = false;
   for (int i = 2; i < argc; ++i) {
@@ -52,6 +55,8 @@ int Main(int argc, char** argv) {
       repeat = std::max(1, std::stoi(argv[++i]));
     } else if (arg == "--threads" && has_value) {
       options.num_threads = std::stoi(argv[++i]);
+    } else if (arg == "--rtol" && has_value) {
+      options.rel_tolerance = std::stod(argv[++i]);
     } else if (arg == "--backward") {
       backward = true;
     } else {
@@ -98,5 +103,8 @@ int main(int argc, char** argv) {
   } catch (const diffpd::InvalidInputError& e) {
     std::fprintf(stderr, "rollout_timing: %s\n", e.what());
     return 2;
+  } catch (const diffpd::SolverError& e) {
+    std::fprintf(stderr, "rollout_timing: %s\n", e.what());
+    return 3;
   }
 }

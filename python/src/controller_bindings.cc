@@ -41,6 +41,9 @@ void BindController(py::module_& m) {
   py::enum_<MlpNonlinearity>(m, "MlpNonlinearity")
       .value("TANH", MlpNonlinearity::kTanh)
       .value("IDENTITY", MlpNonlinearity::kIdentity);
+  py::class_<MlpTape>(m, "MlpTape", "The values of one forward pass that the backward pass needs: z_0..z_L.")
+      .def(py::init<>())
+      .def_readonly("z", &MlpTape::z);
   py::class_<Mlp>(m, "Mlp", "A fully connected network (diffpd/mlp.h).")
       .def(py::init<std::vector<int>, MlpNonlinearity, MlpNonlinearity>(), "widths"_a,
            "hidden"_a = MlpNonlinearity::kTanh, "output"_a = MlpNonlinearity::kIdentity)
@@ -53,7 +56,24 @@ void BindController(py::module_& m) {
                              "theta (read-only view)")
       .def("set_parameters", &Mlp::SetParameters, "parameters"_a)
       .def("initialize_orthogonal", &Mlp::InitializeOrthogonal, "seed"_a, "gain"_a)
-      .def("evaluate", &Mlp::Evaluate, "input"_a);
+      .def("evaluate", &Mlp::Evaluate, "input"_a)
+      .def(
+          "forward",
+          [](const Mlp& self, const VectorXd& input) {
+            MlpTape tape;
+            VectorXd output = self.Forward(input, &tape);
+            return py::make_tuple(output, tape);
+          },
+          "input"_a, "(output, tape): the output, recording the tape for backward().")
+      .def(
+          "backward",
+          [](const Mlp& self, const MlpTape& tape, const VectorXd& g_output) {
+            VectorXd g_input;
+            VectorXd g_parameters = VectorXd::Zero(self.num_parameters());
+            self.Backward(tape, g_output, &g_input, &g_parameters);
+            return py::make_tuple(g_input, g_parameters);
+          },
+          "tape"_a, "g_output"_a, "(dL/dinput, dL/dtheta) at the tape's point, given dL/doutput.");
 
   py::class_<MuscleDelayLine>(m, "MuscleDelayLine", "Strips' activations delayed root to tip (muscle_strip.h).")
       .def(py::init<std::vector<std::vector<int>>, int>(), "strip_muscles"_a, "num_muscles"_a)
