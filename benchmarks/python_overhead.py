@@ -6,10 +6,15 @@ default) through the C++ API (the rollout_timing program) and through diffpd
 from Python (Simulator.simulate, and the torch Function diffpd.torch.rollout
 with its conversions), in alternating rounds so that both see the same
 machine load, and prints a table and, with --json, one JSON object:
-median seconds of each and the overhead (python / C++ - 1).
+median seconds of each and the overhead (python / C++ - 1). As wall times on a
+loaded machine vary by several percent between runs, each run also records
+the time its steps took as the simulator measures them (Rollout's
+forward_seconds, BackwardReport.seconds); wall minus that is the cost around
+the steps (the call, the conversions), and its median excess over the C++
+caller's, relative to the C++ wall time, is the paired overhead reported.
 
 Usage: PYTHONPATH=build/python python3 benchmarks/python_overhead.py
-           [--problem cantilever] [--rtol 1e-4] [--rounds 3] [--repeat 3] [--method pd] [--backward] [--json]
+           [--problem cantilever] [--rtol 1e-4] [--rounds 3] [--repeat 3] [--method pd-lbfgs] [--backward] [--json]
        (--bin: the directory of rollout_timing, default build/bin)
 """
 
@@ -40,28 +45,33 @@ def python_times(problem, method, rtol, repeat, backward, use_torch):
         import torch
         import diffpd.torch as dtorch
         # The torch variant drives no inputs (the cantilever's default rollout has none).
-        x0 = torch.from_numpy(initial.x.copy()).requires_grad_(backward)
+        x0 = torch.from_numpy(initial.x.copy()).requires_grad_()  # so that the rollout keeps its ctx
         v0 = torch.from_numpy(initial.v.copy())
 
         def run():
             t0 = time.perf_counter()
             positions, _ = dtorch.rollout(sim, x0, v0, steps=steps)
             forward = time.perf_counter() - t0
+            function = positions.grad_fn
+            inner = function.rollout.forward_seconds()
             if not backward:
-                return forward, None
+                return forward, None, inner, None
+            # The reverse pass's own time: a second reverse pass of the same
+            # rollout through the simulator (the Function keeps no report).
             t1 = time.perf_counter()
             positions[-1].sum().backward()
-            return forward, time.perf_counter() - t1
+            elapsed = time.perf_counter() - t1
+            return forward, elapsed, inner, sim.backward(function.rollout, loss).report.seconds
     else:
         def run():
             t0 = time.perf_counter()
             rollout = sim.simulate(initial, inputs)
             forward = time.perf_counter() - t0
             if not backward:
-                return forward, None
+                return forward, None, rollout.forward_seconds(), None
             t1 = time.perf_counter()
-            sim.backward(rollout, loss)
-            return forward, time.perf_counter() - t1
+            gradient = sim.backward(rollout, loss)
+            return forward, time.perf_counter() - t1, rollout.forward_seconds(), gradient.report.seconds
     run()  # the PD factorisation, as rollout_timing's untimed rollout
     return [run() for _ in range(repeat)]
 
@@ -71,13 +81,14 @@ def cpp_times(binary, name, method, rtol, repeat, backward):
     command += ["--backward"] if backward else []
     out = json.loads(subprocess.run(command, check=True, capture_output=True, text=True).stdout)
     backward_times = out.get("backward_seconds", [None] * repeat)
-    return list(zip(out["forward_seconds"], backward_times))
+    backward_inner = out.get("backward_inner_seconds", [None] * repeat)
+    return list(zip(out["forward_seconds"], backward_times, out["forward_inner_seconds"], backward_inner))
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--problem", default="cantilever")
-    parser.add_argument("--method", default="pd")
+    parser.add_argument("--method", default="pd-lbfgs", help="`diffpd run`'s default")
     parser.add_argument("--rtol", type=float, default=1e-4, help="step tolerance (`diffpd run`'s default)")
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--repeat", type=int, default=3)
@@ -103,21 +114,29 @@ def main():
         result[kind + "_forward_median"] = statistics.median(t[0] for t in times[kind])
         if args.backward:
             result[kind + "_backward_median"] = statistics.median(t[1] for t in times[kind])
+    passes = [("forward", 0, 2)] + ([("backward", 1, 3)] if args.backward else [])
+    for kind in kinds:
+        for name, wall, inner in passes:
+            result[f"{kind}_{name}_around_steps_median"] = statistics.median(t[wall] - t[inner] for t in times[kind])
     for kind in kinds[1:]:
-        result[kind + "_forward_overhead"] = result[kind + "_forward_median"] / result["cpp_forward_median"] - 1
-        if args.backward:
-            result[kind + "_backward_overhead"] = (result[kind + "_backward_median"] /
-                                                   result["cpp_backward_median"] - 1)
+        for name, wall, inner in passes:
+            result[f"{kind}_{name}_overhead"] = (result[f"{kind}_{name}_median"] / result[f"cpp_{name}_median"] - 1)
+            result[f"{kind}_{name}_paired_overhead"] = (
+                (result[f"{kind}_{name}_around_steps_median"] - result[f"cpp_{name}_around_steps_median"]) /
+                result[f"cpp_{name}_median"])
     out = sys.stderr if args.json else sys.stdout
     print(f"# {args.problem}, {args.method}, {problem.default_steps} steps, median of {result['runs']} runs each",
           file=out)
-    print(f"{'caller':8} {'forward_s':>10} {'overhead':>9}" + (f" {'backward_s':>11} {'overhead':>9}"
-                                                              if args.backward else ""), file=out)
+    header = f"{'caller':8}"
+    for name, _, _ in passes:
+        header += f" {name + '_s':>11} {'wall/C++-1':>10} {'around_s':>9} {'paired':>8}"
+    print(header, file=out)
     for kind in kinds:
-        row = f"{kind:8} {result[kind + '_forward_median']:10.4f} "
-        row += f"{100 * result.get(kind + '_forward_overhead', 0):8.2f}%"
-        if args.backward:
-            row += f" {result[kind + '_backward_median']:11.4f} {100 * result.get(kind + '_backward_overhead', 0):8.2f}%"
+        row = f"{kind:8}"
+        for name, _, _ in passes:
+            row += (f" {result[f'{kind}_{name}_median']:11.4f} {100 * result.get(f'{kind}_{name}_overhead', 0):9.2f}%"
+                    f" {result[f'{kind}_{name}_around_steps_median']:9.5f}"
+                    f" {100 * result.get(f'{kind}_{name}_paired_overhead', 0):7.3f}%")
         print(row, file=out)
     if args.json:
         print(json.dumps(result))

@@ -4,7 +4,11 @@
 // positions, as the C++ API runs them. The reference for the Python
 // package's overhead (benchmarks/python_overhead.py times the same calls
 // through diffpd). One untimed rollout first (the PD factorisation), then
-// `repeat` timed ones; prints one JSON object with every time and the median.
+// `repeat` timed ones; prints one JSON object with every time and the median,
+// and, per run, the time the steps themselves took as the simulator measures
+// them (Rollout::forward_seconds, BackwardReport::seconds): the difference is
+// what the call costs around its steps, a figure a loaded machine disturbs
+// far less than the wall time.
 // The step tolerance is `diffpd run`'s default, rel_tolerance 1e-4 (--rtol).
 // Usage: rollout_timing <problem> [--method M] [--steps K] [--repeat R] [--threads T] [--rtol R] [--backward]
 #include <algorithm>
@@ -72,22 +76,26 @@ int Main(int argc, char** argv) {
 
   Rollout warm = sim.Simulate(initial, inputs);
   if (backward) sim.Backward(warm, loss);
-  std::vector<double> forward_seconds, backward_seconds;
+  std::vector<double> forward_seconds, backward_seconds, forward_inner, backward_inner;
   for (int r = 0; r < repeat; ++r) {
     const auto t0 = Clock::now();
     const Rollout rollout = sim.Simulate(initial, inputs);
     forward_seconds.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+    forward_inner.push_back(rollout.forward_seconds());
     if (backward) {
       const auto t1 = Clock::now();
-      sim.Backward(rollout, loss);
+      const RolloutGradient gradient = sim.Backward(rollout, loss);
       backward_seconds.push_back(std::chrono::duration<double>(Clock::now() - t1).count());
+      backward_inner.push_back(gradient.report.seconds);
     }
   }
   nlohmann::json out = {
       {"problem", problem->name()}, {"method", ToString(options.method)}, {"steps", steps},
       {"dofs", sim.num_dofs()},     {"forward_seconds", forward_seconds}, {"forward_median", Median(forward_seconds)}};
+  out["forward_inner_seconds"] = forward_inner;
   if (backward) {
     out["backward_seconds"] = backward_seconds;
+    out["backward_inner_seconds"] = backward_inner;
     out["backward_median"] = Median(backward_seconds);
   }
   std::printf("%s\n", out.dump().c_str());
