@@ -67,6 +67,8 @@ class Rollout(torch.autograd.Function):
             initial, steps,
             external_force=None if external_force is None else _to_numpy(external_force),
             activation=None if activation is None else _to_numpy(activation))
+        # An output the loss does not use gives None, not zeros (no zero rows to convert and add).
+        ctx.set_materialize_grads(False)
         ctx.simulator = simulator
         ctx.rollout = result
         ctx.inputs = (x0, v0, external_force, activation, material)
@@ -100,6 +102,7 @@ class ClosedLoopRollout(torch.autograd.Function):
         acting.set_parameters(_to_numpy(parameters))
         initial = _native.State(_to_numpy(x0), _to_numpy(v0))
         result = simulator.simulate(initial, acting, steps)
+        ctx.set_materialize_grads(False)
         ctx.simulator = simulator
         ctx.controller = acting
         ctx.rollout = result
