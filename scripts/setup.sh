@@ -11,7 +11,8 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(g++ make cmake pkg-config libeigen3-dev libsuitesparse-dev libmetis-dev libceres-dev
           coinor-libipopt-dev libgtest-dev libgmock-dev libomp-dev libcli11-dev nlohmann-json3-dev
-          gnuplot-nox tetgen clang-format git libopenmpi-dev openmpi-bin)
+          gnuplot-nox tetgen clang-format git libopenmpi-dev openmpi-bin python3-dev pybind11-dev python3-numpy
+          python3-scipy python3-pytest python3-torch)
 
 say() { echo "setup: $*" >&2; }
 
@@ -93,5 +94,7 @@ fi
 
 JOBS="${DIFFPD_BUILD_JOBS:-$(nproc)}"
 say "building (Release) into build/ with $JOBS jobs"
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >&2
+# The Python package is built for Debian's interpreter, the one the packages
+# above (NumPy, pytest, PyTorch) belong to, whatever python3 comes first on PATH.
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >&2
 cmake --build build -j "$JOBS" "$@" >&2
