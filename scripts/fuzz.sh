@@ -8,13 +8,13 @@
 # build-fuzz/artifacts/<reader>/ and printed.
 #
 # DIFFPD_FUZZ_SECONDS: seconds per harness (default 20). Arguments: the
-# readers to run (default all: obj tetgen gmsh captured_motion starfish_recording).
+# readers to run (default all: obj tetgen gmsh captured_motion starfish_recording reference_curve).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 seconds="${DIFFPD_FUZZ_SECONDS:-20}"
 readers=("$@")
-[ ${#readers[@]} -gt 0 ] || readers=(obj tetgen gmsh captured_motion starfish_recording)
+[ ${#readers[@]} -gt 0 ] || readers=(obj tetgen gmsh captured_motion starfish_recording reference_curve)
 build=build-fuzz
 clang=$(command -v clang++ || command -v clang++-14 || true)
 if [ -z "$clang" ]; then
