@@ -30,7 +30,7 @@ cmake --build "$build" -j "${DIFFPD_BUILD_JOBS:-$(nproc)}"
 # halt_on_error: the first report ends the process with a failing status.
 # detect_leaks: LeakSanitizer runs at exit; scripts/lsan.supp lists leaks
 # inside third-party libraries that the project cannot free.
-export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1"
+export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0"
 cd "$build"
