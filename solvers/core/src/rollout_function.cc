@@ -362,6 +362,7 @@ void RolloutFunction::ComputeRows(const std::vector<int>& missing) {
     Eigen::Index j = 0;
     while (j < c.jacobian.cols() && std::isfinite(c.jacobian(r, j))) ++j;
     if (j == c.jacobian.cols()) continue;
+    for (int m : missing) c.have_row[m] = 0;  // never served from the cache
     const Functional& f = functionals_[FunctionalOf(r)];
     std::ostringstream msg;
     msg << "row " << r << " (functional '" << f.functional->name() << "' value " << r - f.row
