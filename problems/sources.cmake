@@ -18,6 +18,7 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/control/evaluation_budget.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_adam.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_control.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/reference_curve.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/starfish_control.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/shark_control.cc
   # paper: the DiffPD paper's table rows as data

@@ -11,8 +11,8 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(g++ make cmake pkg-config libeigen3-dev libsuitesparse-dev libmetis-dev libceres-dev
           coinor-libipopt-dev libgtest-dev libgmock-dev libomp-dev libcli11-dev nlohmann-json3-dev
-          gnuplot-nox tetgen clang-format git libopenmpi-dev openmpi-bin python3-dev pybind11-dev python3-numpy
-          python3-scipy python3-pytest python3-torch)
+          gnuplot-nox tetgen clang-format git libopenmpi-dev openmpi-bin clang libclang-rt-14-dev python3-dev
+          pybind11-dev python3-numpy python3-scipy python3-pytest python3-torch)
 
 say() { echo "setup: $*" >&2; }
 

@@ -8,6 +8,7 @@
 #include "tools/bench.h"
 #include "cli/commands.h"
 #include "cli/option_checks.h"
+#include "diffpd/error.h"
 
 namespace diffpd::problems {
 namespace {
@@ -203,13 +204,20 @@ Subcommand AddBenchCommand(CLI::App* parent) {
   cmd->add_flag("--json", args->json, "print one JSON document (a list) on stdout");
   CLI::Option* scaling =
       cmd->add_flag("--scaling", args->scaling, "time per iteration at --scales x the element count");
-  cmd->add_option("--scales", args->scales, "comma-separated element-count factors, powers of 2 (with --scaling)")
-      ->delimiter(',')
-      ->capture_default_str();
+  CLI::Option* scales =
+      cmd->add_option("--scales", args->scales, "comma-separated element-count factors, powers of 2 (with --scaling)")
+          ->delimiter(',')
+          ->capture_default_str();
   CLI::Option* threads =
       cmd->add_flag("--threads-compare", args->threads_compare, "1 vs 2 threads: whole step, backward and local step");
   scaling->excludes(threads);
-  return {cmd, [args] { return RunBenchArgs(*args); }};
+  return {
+      cmd, [args, scales] {
+        // Without --scaling the bench would run with the scales ignored.
+        if (scales->count() > 0 && !args->scaling)
+          throw InvalidInputError("--scales is not used without --scaling (the element-count factors of --scaling)");
+        return RunBenchArgs(*args);
+      }};
 }
 
 }  // namespace diffpd::problems

@@ -210,30 +210,6 @@ std::vector<EvaluationTiming> TimeEvaluations(const Swimmer& swimmer, const Solv
   return out;
 }
 
-ReferenceCurve ReadReferenceCurve(const std::string& path, const std::string& label) {
-  std::ifstream in(path);
-  if (!in) throw InvalidInputError("cannot open '" + path + "'");
-  ReferenceCurve curve;
-  curve.label = label;
-  std::string line;
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (line.empty()) continue;
-    std::replace(line.begin(), line.end(), ',', ' ');
-    std::istringstream row(line);
-    double x, y;
-    if (!(row >> x >> y) || !std::isfinite(x) || !std::isfinite(y)) {
-      std::ostringstream msg;
-      msg << path << ":" << number << ": expected two finite numbers 'x,y'";
-      throw InvalidInputError(msg.str());
-    }
-    curve.points.emplace_back(x, y);
-  }
-  if (curve.points.empty()) throw InvalidInputError(path + ": no data rows");
-  return curve;
-}
-
 std::vector<std::string> PlotLearningCurves(const std::string& dir, const std::string& title,
                                             const std::vector<const TrainingResult*>& results,
                                             const std::vector<ReferenceCurve>& references) {

@@ -22,6 +22,7 @@
 
 #include "control/adam.h"
 #include "control/evaluation_budget.h"
+#include "control/reference_curve.h"
 #include "control/swim_loss.h"
 #include "diffpd/simulator.h"
 #include "diffpd/solvers/core/rollout_function.h"
@@ -120,15 +121,6 @@ struct EvaluationTiming {
 };
 std::vector<EvaluationTiming> TimeEvaluations(const Swimmer& swimmer, const SolverOptions& options,
                                               const std::vector<Method>& methods, int repeats, std::uint64_t seed);
-
-// A learning curve of the original code (learning_curves/*.csv of the
-// shared paper data: x = simulated steps, y = reward).
-struct ReferenceCurve {
-  std::string label;
-  std::vector<std::pair<double, double>> points;
-};
-// Reads "x,y" rows. Throws InvalidInputError naming the file and line.
-ReferenceCurve ReadReferenceCurve(const std::string& path, const std::string& label);
 
 // Writes the runs' curves (<dir>/learning_curve.dat for one run,
 // learning_curve_<optimizer>.dat for several), the reference curves

@@ -55,6 +55,17 @@ TEST_F(ReadObjTest, ReadsVerticesFacesAndIndexForms) {
   EXPECT_NEAR(EnclosedVolume(surface), 1.0 / 6.0, 1e-15);
 }
 
+TEST_F(ReadObjTest, LinesOfOnlyFormFeedsOrVerticalTabsAreBlank) {
+  // Such a line once left the reader with no token on a non-blank line
+  // (a heap-use-after-free found by fuzz/fuzz_obj.cc).
+  const SurfaceMesh surface =
+      ReadObj(Write("blanks.obj", std::string("\f\nv 0 0 0\n \v \nv 1 0 0\f\nv 0 1 0\n") + "\f \t\r\nf 1 2 3\n\v\n"));
+  ASSERT_EQ(surface.vertices.cols(), 3);
+  ASSERT_EQ(surface.triangles.cols(), 1);
+  EXPECT_EQ(surface.triangles.col(0), Eigen::Vector3i(0, 1, 2));
+  EXPECT_EQ(ErrorOf("v 0 0 0\n\f\nv 1 0\n"), "F:3: expected x y z coordinates, got 'v 1 0'");
+}
+
 TEST_F(ReadObjTest, FanTriangulatesPolygons) {
   const SurfaceMesh surface =
       ReadObj(Write("pentagon.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0.5 2 0\nv 0 1 0\nf 1 2 3 4 5\n"));

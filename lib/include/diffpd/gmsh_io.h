@@ -22,7 +22,7 @@ namespace diffpd {
 //   "<path>:1: not a Gmsh MSH file (expected $MeshFormat, got 'foo')",
 //   "<path>:2: MSH version 2.2 is not supported; only 4.1 (export with 'gmsh -format msh41')",
 //   "<path>:2: binary MSH files are not supported; export ASCII (Gmsh option Mesh.Binary = 0)",
-//   "<path>:9: node tag 3 appears twice",
+//   "<path>:9: node tag 3 appears twice", "<path>:9: node tag -3 is invalid: must be >= 1",
 //   "<path>:20: element 7 references node tag 99, which is not in $Nodes",
 //   "<path>:20: element 7 has 4 node tags, expected 8 for type 5 (hex8)",
 //   "<path>:19: 3D element type 11 is not supported (only 4 = tet4 and 5 = hex8)",

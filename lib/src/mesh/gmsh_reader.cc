@@ -51,6 +51,7 @@ void ReadNodes(internal::LineReader* reader, GmshData* data) {
     for (long n = 0; n < count; ++n) {
       NextLine(reader, "Nodes");
       const long tag = reader->ParseInt(0, "node tag");
+      if (tag < 1) reader->Fail("node tag " + std::to_string(tag) + " is invalid: must be >= 1");
       if (!data->node_of_tag.emplace(tag, static_cast<int>(first + n)).second) {
         reader->Fail("node tag " + std::to_string(tag) + " appears twice");
       }

@@ -36,13 +36,16 @@ bool LineReader::Next() {
       const size_t pos = line_.find(comment_);
       if (pos != std::string::npos) line_.erase(pos);
     }
-    const size_t first = line_.find_first_not_of(" \t\r\n");
+    // The blanks are those operator>> skips (std::isspace), so that a line
+    // left with text has at least one token.
+    const char* const blanks = " \t\r\n\f\v";
+    const size_t first = line_.find_first_not_of(blanks);
     if (first == std::string::npos) continue;
-    line_ = line_.substr(first, line_.find_last_not_of(" \t\r\n") - first + 1);
+    line_ = line_.substr(first, line_.find_last_not_of(blanks) - first + 1);
     tokens_.clear();
     std::istringstream split(line_);
     for (std::string token; split >> token;) tokens_.push_back(token);
-    return true;
+    if (!tokens_.empty()) return true;
   }
   tokens_.clear();
   line_.clear();

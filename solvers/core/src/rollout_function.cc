@@ -358,6 +358,17 @@ void RolloutFunction::ComputeRows(const std::vector<int>& missing) {
     ReverseRows(missing);
   }
   ++stats_.jacobians;
+  for (int r : missing) {
+    Eigen::Index j = 0;
+    while (j < c.jacobian.cols() && std::isfinite(c.jacobian(r, j))) ++j;
+    if (j == c.jacobian.cols()) continue;
+    for (int m : missing) c.have_row[m] = 0;  // never served from the cache
+    const Functional& f = functionals_[FunctionalOf(r)];
+    std::ostringstream msg;
+    msg << "row " << r << " (functional '" << f.functional->name() << "' value " << r - f.row
+        << "): the derivative with respect to parameter " << j << " = " << c.jacobian(r, j) << " is not finite";
+    throw SolverError(SolverStatus::kNonFinite, msg.str());
+  }
 }
 
 void RolloutFunction::ForwardRows(const std::vector<int>& missing) {
@@ -487,6 +498,12 @@ bool RolloutFunction::Gradient(const Eigen::Ref<const VectorXd>& p, const Eigen:
         last = std::max(last, LastNonEmpty(loss));
         c.gradient = last < K ? PullBack(c.rollout.Truncated(last), loss, last) : PullBack(c.rollout, loss, last);
       }
+      for (Eigen::Index j = 0; j < c.gradient.size(); ++j)
+        if (!std::isfinite(c.gradient(j))) {
+          std::ostringstream msg;
+          msg << "the derivative with respect to parameter " << j << " = " << c.gradient(j) << " is not finite";
+          throw SolverError(SolverStatus::kNonFinite, msg.str());
+        }
       ++stats_.gradients;
       c.gradient_ok = true;
     } catch (...) {

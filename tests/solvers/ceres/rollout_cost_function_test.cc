@@ -11,6 +11,7 @@
 #include "diffpd/solvers/core/initial_state_block.h"
 #include "diffpd/solvers/core/trajectory_function.h"
 #include "solvers/ceres/calibration_fixture.h"
+#include "solvers/core/non_finite_pull_back_block.h"
 #include "util/expect_message.h"
 
 namespace diffpd::testing {
@@ -94,6 +95,28 @@ TEST(RolloutCostFunctionTest, EvaluateReturnsFalseWhenTheRolloutFails) {
   EXPECT_FALSE(ok_cost.Evaluate(negative_params, r.data(), nullptr));
   // A good point afterwards evaluates again.
   EXPECT_TRUE(ok_cost.Evaluate(params, r.data(), jac));
+}
+
+TEST(RolloutCostFunctionTest, ANonFiniteJacobianIsAFailedEvaluation) {
+  // A material block whose reverse-mode derivative is NaN: residuals alone
+  // evaluate; with Jacobians Evaluate returns false instead of passing NaN on.
+  Scene scene = SmallBeamScene();
+  RolloutFunction f(scene, TightOptions(Method::kNewtonCholesky), 3);
+  f.AddBlock(std::make_unique<NonFinitePullBackBlock>(std::make_unique<MaterialBlock>(
+      std::vector<MaterialBlock::Entry>{MaterialField::kYoungsModulus, MaterialField::kPoissonsRatio}, scene)));
+  f.AddFunctional(std::make_unique<PointCoordinate>(NodePoint(45, 44), 2, Vec3::UnitZ()));
+  RolloutCostFunction cost(&f, f.AllRows());
+  double material[2] = {2e5, 0.4};
+  const double* params[1] = {material};
+  double residual = 0;
+  std::vector<double> j(2);
+  double* jac[1] = {j.data()};
+  EXPECT_TRUE(cost.Evaluate(params, &residual, nullptr));
+  EXPECT_TRUE(std::isfinite(residual));
+  EXPECT_FALSE(cost.Evaluate(params, &residual, jac));
+  EXPECT_EQ(f.statistics().last_error,
+            "Jacobian failed (non-finite value): row 0 (functional 'point_coordinate' value 0): the derivative with "
+            "respect to parameter 0 = nan is not finite");
 }
 
 // Counts what Ceres announces.

@@ -10,6 +10,7 @@
 
 #include "diffpd/error.h"
 #include "util/expect_message.h"
+#include "solvers/core/non_finite_pull_back_block.h"
 #include "solvers/core/parameter_block_cases.h"
 
 namespace diffpd::testing {
@@ -216,6 +217,28 @@ TEST(RolloutFunctionTest, FailuresReturnFalseWithTheReasonAndLaterPointsEvaluate
   h.AddFunctional(std::make_unique<PointCoordinate>(NodePoint(45, 44), 2, Vec3::UnitZ()));
   EXPECT_FALSE(h.Evaluate(VectorXd(), {1}, &v, nullptr));
   EXPECT_EQ(h.statistics().last_error, "values rejected: row 1 is out of range [0, 1)");
+}
+
+TEST(RolloutFunctionTest, ANonFiniteJacobianOrGradientEntryIsAFailedEvaluationNotPassedOn) {
+  Scene scene = SmallBeamScene();
+  RolloutFunction f(scene, TightOptions(Method::kNewtonCholesky), 3);
+  f.AddBlock(std::make_unique<NonFinitePullBackBlock>(std::make_unique<MaterialBlock>(
+      std::vector<MaterialBlock::Entry>{MaterialField::kYoungsModulus, MaterialField::kPoissonsRatio}, scene)));
+  f.AddFunctional(std::make_unique<PointCoordinate>(NodePoint(45, 44), 2, Vec3::UnitZ()));
+  const Eigen::Vector2d p(2e5, 0.4);
+  VectorXd values;
+  MatrixXd jacobian;
+  EXPECT_TRUE(f.Evaluate(p, f.AllRows(), &values, nullptr));  // the values are finite
+  EXPECT_TRUE(values.allFinite());
+  EXPECT_FALSE(f.Evaluate(p, f.AllRows(), &values, &jacobian));
+  EXPECT_EQ(f.statistics().last_error,
+            "Jacobian failed (non-finite value): row 0 (functional 'point_coordinate' value 0): the derivative with "
+            "respect to parameter 0 = nan is not finite");
+  EXPECT_FALSE(f.Evaluate(p, f.AllRows(), &values, &jacobian));  // and stays failed at this point
+  VectorXd gradient;
+  EXPECT_FALSE(f.Gradient(p, VectorXd::Ones(1), &gradient));
+  EXPECT_EQ(f.statistics().last_error,
+            "gradient failed (non-finite value): the derivative with respect to parameter 0 = nan is not finite");
 }
 
 TEST(RolloutFunctionTest, TheSimulatorFollowsTheSetupsMaterialsAndStateForces) {

@@ -9,6 +9,7 @@
 
 #include "diffpd/error.h"
 #include "diffpd/solvers/core/activation_block.h"
+#include "solvers/core/non_finite_pull_back_block.h"
 #include "solvers/ipopt/test_problems.h"
 #include "util/expect_message.h"
 
@@ -268,6 +269,35 @@ TEST(RolloutNlpTest, FailedRolloutMakesEveryEvaluationReturnFalseAndRecovers) {
   const VectorXd good = VectorXd::Zero(n);
   EXPECT_TRUE(nlp.eval_f(n, good.data(), true, f));
   EXPECT_TRUE(nlp.eval_jac_g(n, good.data(), false, m, nnz, nullptr, nullptr, jac.data()));
+}
+
+TEST(RolloutNlpTest, ANonFiniteGradientOrJacobianIsAFailedEvaluation) {
+  // A material block whose reverse-mode derivative is NaN: the values are
+  // fine, every derivative evaluation returns false instead of passing NaN on.
+  Scene scene = SmallBeamScene();
+  RolloutNlp nlp(std::make_unique<solvers::RolloutFunction>(scene, TightOptions(Method::kNewtonCholesky), 3));
+  nlp.AddVariables(std::make_unique<NonFinitePullBackBlock>(std::make_unique<solvers::MaterialBlock>(
+      std::vector<solvers::MaterialBlock::Entry>{solvers::MaterialField::kYoungsModulus}, scene)));
+  const int n3 = scene.mesh.num_vertices();
+  nlp.AddObjective(
+      std::make_unique<solvers::PointCoordinate>(solvers::NodePoint(n3, n3 - 1), solvers::kFinalState, Vec3::UnitZ()));
+  nlp.AddConstraint(std::make_unique<solvers::PointCoordinate>(solvers::NodePoint(n3, n3 - 1), 2, Vec3::UnitZ()), -1,
+                    1);
+  const int n = nlp.num_variables(), m = nlp.num_constraints();
+  Ipopt::Index nn, mm, nnz, nnz_h;
+  Ipopt::TNLP::IndexStyleEnum style;
+  ASSERT_TRUE(nlp.get_nlp_info(nn, mm, nnz, nnz_h, style));
+  const VectorXd x = VectorXd::Constant(n, 2e5);
+  double f;
+  std::vector<double> grad(n, 0.0), g(m), jac(nnz, 0.0);
+  EXPECT_TRUE(nlp.eval_f(n, x.data(), true, f));
+  EXPECT_TRUE(std::isfinite(f));
+  EXPECT_TRUE(nlp.eval_g(n, x.data(), false, m, g.data()));
+  EXPECT_FALSE(nlp.eval_grad_f(n, x.data(), false, grad.data()));
+  EXPECT_EQ(nlp.last_error(),
+            "gradient failed (non-finite value): the derivative with respect to parameter 0 = nan is not finite");
+  EXPECT_FALSE(nlp.eval_jac_g(n, x.data(), false, m, nnz, nullptr, nullptr, jac.data()));
+  EXPECT_EQ(nlp.last_error().rfind("Jacobian failed (non-finite value): row ", 0), 0u) << nlp.last_error();
 }
 
 TEST(RolloutNlpTest, ConstraintViolationIsTheLargestBoundOrConstraintExcess) {

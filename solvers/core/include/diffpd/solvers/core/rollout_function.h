@@ -165,6 +165,8 @@ class RolloutFunction {
   DerivativeMode ResolvedMode(int num_rows) const;
 
   // ---- evaluation (never throws; false on failure) -----------------------
+  // A non-finite parameter, value, Jacobian entry or gradient entry is a
+  // failure (statistics().last_error names it), never passed on.
   // Makes the cache hold the rollout at p and the values of every row.
   bool Evaluate(const Eigen::Ref<const VectorXd>& p);
   // Evaluate(p), then copies the values of `rows` into *values and, if

@@ -1,0 +1,1 @@
+diffpd_add_test(bad_input_corpus_test ${CMAKE_CURRENT_LIST_DIR}/bad_input_corpus_test.cc LIBS diffpd_problems)
