@@ -1,15 +1,17 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds Release into build/ and runs the whole test
-# suite with CTest; then the checks at the edges: the suite again under
-# AddressSanitizer and UndefinedBehaviorSanitizer (scripts/sanitize.sh, in
-# build-sanitize/) and every file reader's fuzz harness for a fixed time
-# (scripts/fuzz.sh, in build-fuzz/). DIFFPD_EDGE_CHECKS=0 skips those two
-# (the Release suite only). Extra arguments go to the Release suite's ctest.
+# suite with CTest; then every file reader's fuzz harness for a fixed time
+# (scripts/fuzz.sh, in build-fuzz/; DIFFPD_EDGE_CHECKS=0 skips it) and, with
+# DIFFPD_SANITIZE=1, the suite again under AddressSanitizer and
+# UndefinedBehaviorSanitizer (scripts/sanitize.sh, in build-sanitize/). Extra
+# arguments go to the Release suite's ctest.
 set -euo pipefail
 cd "$(dirname "$0")"
 ./scripts/setup.sh
 (cd build && ctest --output-on-failure -j "${DIFFPD_TEST_JOBS:-$(nproc)}" "$@")
 if [ "${DIFFPD_EDGE_CHECKS:-1}" != 0 ]; then
-  ./scripts/sanitize.sh
   ./scripts/fuzz.sh
+fi
+if [ "${DIFFPD_SANITIZE:-0}" = 1 ]; then
+  ./scripts/sanitize.sh
 fi
