@@ -114,9 +114,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
     status = diffpd::problems::Run(args, rank);
-  } catch (const CLI::ParseError& e) {
-    status = rank == 0 ? app.exit(e) : (e.get_exit_code() == 0 ? 0 : 2);
-    if (status != 0) status = 2;
+  } catch (const CLI::ParseError& e) {  // rank 0 prints the help or the error
+    status = (rank == 0 ? app.exit(e) : e.get_exit_code()) == 0 ? 0 : 2;
   } catch (const std::exception& e) {
     if (rank == 0) std::fprintf(stderr, "diffpd-mpi: error: %s\n", e.what());
     status = 2;
