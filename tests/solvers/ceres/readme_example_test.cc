@@ -7,13 +7,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <string>
 
 #include "diffpd/captured_motion.h"
 #include "diffpd/simulator.h"
 #include "diffpd/surface_mesh.h"
 #include "diffpd/voxelizer.h"
+#include "util/readme_block.h"
 #include "util/temporary_directory.h"
 
 namespace diffpd {
@@ -76,20 +76,18 @@ TEST(ReadmeExampleTest, RecoversTheMaterialOfSyntheticCapturedMotion) {
   EXPECT_NE(output.find("iter"), std::string::npos);  // Ceres' progress table
 }
 
-// The README shows the program exactly as it is compiled here (from its
-// first #include to its end), so the two cannot drift apart.
-TEST(ReadmeExampleTest, ReadmeShowsTheExampleProgramVerbatim) {
-  auto read = [](const std::string& path) {
-    std::ifstream in(path);
-    EXPECT_TRUE(in.good()) << path;
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  };
-  const std::string readme = read(std::string(DIFFPD_SOURCE_DIR) + "/README.md");
-  const std::string program = read(std::string(DIFFPD_SOURCE_DIR) + "/tests/solvers/ceres/readme_example.cc");
-  const size_t body = program.find("#include");
-  ASSERT_NE(body, std::string::npos);
-  EXPECT_NE(readme.find(program.substr(body)), std::string::npos)
-      << "README.md must contain tests/solvers/ceres/readme_example.cc from its first #include on";
+// The README's Ceres code block (after its marker) is a contiguous excerpt
+// of the program compiled here, so the two cannot drift apart.
+TEST(ReadmeExampleTest, ReadmeShowsAnExcerptOfTheExampleProgramVerbatim) {
+  const std::string readme = testing::ReadTextFile(std::string(DIFFPD_SOURCE_DIR) + "/README.md");
+  const std::string program =
+      testing::ReadTextFile(std::string(DIFFPD_SOURCE_DIR) + "/tests/solvers/ceres/readme_example.cc");
+  ASSERT_FALSE(program.empty());
+  const std::string block = testing::CodeBlockAfter(readme, "<!-- The Ceres example");
+  EXPECT_GT(block.size(), 200u) << "README.md has no Ceres example block, or it is nearly empty";
+  EXPECT_NE(program.find(block), std::string::npos)
+      << "README.md's Ceres block must be a verbatim excerpt of tests/solvers/ceres/readme_example.cc:\n"
+      << block;
 }
 
 }  // namespace

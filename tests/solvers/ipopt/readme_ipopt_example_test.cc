@@ -5,9 +5,9 @@
 
 #include <array>
 #include <cstdio>
-#include <fstream>
-#include <iterator>
 #include <string>
+
+#include "util/readme_block.h"
 
 namespace diffpd {
 namespace {
@@ -31,25 +31,15 @@ TEST(ReadmeIpoptExampleTest, ThrowsTheCubeToTheTargetOverTheConstraint) {
   EXPECT_NE(output.find("Solve_Succeeded"), std::string::npos) << output;
 }
 
-// The README's Ipopt code block (between its two markers) is a contiguous
-// excerpt of the program compiled here, so the two cannot drift apart.
+// The README's Ipopt code block (after its marker) is a contiguous excerpt
+// of the program compiled here, so the two cannot drift apart.
 TEST(ReadmeIpoptExampleTest, ReadmeShowsAnExcerptOfTheExampleProgramVerbatim) {
-  auto read = [](const std::string& path) {
-    std::ifstream in(path);
-    EXPECT_TRUE(in.good()) << path;
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  };
-  const std::string readme = read(std::string(DIFFPD_SOURCE_DIR) + "/README.md");
-  const std::string program = read(std::string(DIFFPD_SOURCE_DIR) + "/tests/solvers/ipopt/readme_ipopt_example.cc");
-  const size_t section = readme.find("<!-- The Ipopt example");
-  ASSERT_NE(section, std::string::npos) << "README.md has no Ipopt example marker";
-  const std::string fence = "```cpp\n";
-  const size_t begin = readme.find(fence, section);
-  ASSERT_NE(begin, std::string::npos);
-  const size_t end = readme.find("```", begin + fence.size());
-  ASSERT_NE(end, std::string::npos);
-  const std::string block = readme.substr(begin + fence.size(), end - begin - fence.size());
-  EXPECT_GT(block.size(), 200u) << "the README's Ipopt block is nearly empty";
+  const std::string readme = testing::ReadTextFile(std::string(DIFFPD_SOURCE_DIR) + "/README.md");
+  const std::string program =
+      testing::ReadTextFile(std::string(DIFFPD_SOURCE_DIR) + "/tests/solvers/ipopt/readme_ipopt_example.cc");
+  ASSERT_FALSE(program.empty());
+  const std::string block = testing::CodeBlockAfter(readme, "<!-- The Ipopt example");
+  EXPECT_GT(block.size(), 200u) << "README.md has no Ipopt example block, or it is nearly empty";
   EXPECT_NE(program.find(block), std::string::npos)
       << "README.md's Ipopt block must be a verbatim excerpt of tests/solvers/ipopt/readme_ipopt_example.cc:\n"
       << block;
