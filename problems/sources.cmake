@@ -49,6 +49,7 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/tools/reference_cache.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/tradeoff.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/tradeoff_front.cc
+  ${CMAKE_CURRENT_LIST_DIR}/tools/optimiser_tradeoff.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/stress.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/table.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/table_report.cc

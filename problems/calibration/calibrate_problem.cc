@@ -226,8 +226,16 @@ std::unique_ptr<solvers::RolloutFunction> CalibrationProblem::MakeModel(const Ca
 
 CalibrationFit CalibrationProblem::Fit(const CapturedMotion& motion, Method method, int max_iterations,
                                        FILE* log) const {
+  return Fit(motion, FitOptions(method), max_iterations, log);
+}
+
+CalibrationFit CalibrationProblem::Fit(const CapturedMotion& motion, const SolverOptions& solver, int max_iterations,
+                                       FILE* log) const {
   const auto start = std::chrono::steady_clock::now();
-  const std::unique_ptr<solvers::RolloutFunction> model = MakeModel(motion, FitOptions(method));
+  const Method method = solver.method;
+  SolverOptions simulation = solver;
+  simulation.time_step = default_time_step();
+  const std::unique_ptr<solvers::RolloutFunction> model = MakeModel(motion, simulation);
   solvers::RolloutFunction& function = *model;
   const std::vector<MaterialField> fields = fitted();
   constexpr int markers = 0;

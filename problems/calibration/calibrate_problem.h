@@ -93,6 +93,10 @@ class CalibrationProblem : public Problem {
   // iteration table on `log` (nullptr: silent). Throws InvalidInputError for
   // a motion that does not fit the problem's mesh.
   CalibrationFit Fit(const CapturedMotion& motion, Method method, int max_iterations, FILE* log) const;
+  // The same fit with every evaluation at `solver` (method, tolerances,
+  // threads; the time step is the problem's), e.g. to measure what a
+  // tolerance costs the fit.
+  CalibrationFit Fit(const CapturedMotion& motion, const SolverOptions& solver, int max_iterations, FILE* log) const;
 
   // `diffpd run <problem>`: fits the captured motion (--data FILE, default
   // DefaultDataPath()) with each of --methods (default default_methods();

@@ -11,6 +11,7 @@
 #include "cli/option_checks.h"
 #include "diffpd/error.h"
 #include "tools/bench.h"
+#include "tools/optimiser_tradeoff.h"
 #include "tools/problem_objective.h"
 #include "tools/tradeoff.h"
 #include "tools/tradeoff_front.h"
@@ -41,7 +42,13 @@ gradient error, slowdown over the front), the front, for gradient-error
 bounds 1e-3, 1e-2, 1e-1 the fastest setting and how far the default's
 tolerance may be loosened, and the monotonicity violations (a tighter
 tolerance with a larger error than --noise times a looser one's plus 1e-9).
-Exit code 6 with --check when a problem has a monotonicity violation.)";
+Exit code 6 with --check when a problem has a monotonicity violation.
+--optimiser: instead, the problem's own optimiser (Ipopt, Ceres or Adam) from
+its own start with every evaluation at each --tolerances value (default
+method), its wall time and its final point's loss re-evaluated converged;
+--budget N caps each run's iterations (Adam: evaluations; paper rows:
+rollouts). --out DIR writes <problem>_optimiser.json and .png; --all runs
+every problem that has an optimiser.)";
 
 struct TradeoffArgs {
   std::string problem;
@@ -55,6 +62,8 @@ struct TradeoffArgs {
   double noise = 3;
   std::string out;
   std::string plot;
+  bool optimiser = false;
+  int budget = 0;
 };
 
 // The reduced settings of --all and --quick: four tolerances, two time-step
@@ -115,6 +124,58 @@ void PrintTable(const ProblemReport& p) {
                 v.tighter_error, v.tighter_tolerance, v.looser_error, v.looser_tolerance);
 }
 
+void PrintOptimiserTable(const OptimiserTradeoff& t) {
+  std::printf("== %s: %d DoFs, %d steps; %s, every evaluation %s at the tolerance below (default %g)\n",
+              t.problem.c_str(), t.dofs, t.steps, t.optimiser.c_str(), t.method.c_str(), t.default_rel_tolerance);
+  std::printf("%10s %10s %6s %6s %14s %14s %14s %10s %10s  %s\n", "rel_tol", "wall_s", "evals", "iters", "initial_loss",
+              "final_loss", "reported_loss", "shortfall", "violation", "status");
+  for (const auto& r : t.rows) {
+    const OptimiserOutcome& o = r.outcome;
+    if (!o.ok()) {
+      std::printf("%10.3g failed: %s\n", r.rel_tolerance, o.failure.c_str());
+      continue;
+    }
+    std::printf("%10.3g %10.3f %6ld %6d %14.7e %14.7e %14.7e %10.3g %10.3g  %s\n", r.rel_tolerance, o.wall_s,
+                o.evaluations, o.iterations, o.initial_loss, o.final_loss, o.reported_loss, r.shortfall,
+                o.constraint_violation, o.status.c_str());
+  }
+}
+
+int RunOptimiserTradeoffArgs(const TradeoffArgs& args, const std::vector<std::string>& problems) {
+  nlohmann::json summary = nlohmann::json::array();
+  OptimiserTradeoffOptions options;
+  options.max_iterations = args.budget;
+  for (const auto& name : problems) {
+    const ProblemObjective objective = MakeProblemObjective(name, args.options.threads);
+    if (!objective.optimise) {
+      if (args.all) continue;
+      throw InvalidInputError("problem '" + name +
+                              "' has no optimiser of its own (a forward scene): --optimiser needs an optimisation, "
+                              "calibration or control problem");
+    }
+    std::vector<double> tolerances = args.options.tolerances;
+    if (args.all || args.quick) tolerances = {1e-2, 1e-4, 1e-6, 1e-8};
+    const OptimiserTradeoff t = RunOptimiserTradeoff(objective, tolerances, options, &std::cerr);
+    const nlohmann::json report = OptimiserTradeoffJson(t);
+    summary.push_back(report);
+    if (!args.out.empty()) {
+      const auto base = std::filesystem::path(args.out) / (name + "_optimiser");
+      std::ofstream(base.string() + ".json") << report.dump(1) << "\n";
+      if (GnuplotAvailable()) {
+        WriteOptimiserTradeoffPlot(t, base.string() + ".png");
+        std::cerr << "[tradeoff] wrote " << base.string() << ".png" << std::endl;
+      }
+    }
+    if (!args.plot.empty()) WriteOptimiserTradeoffPlot(t, args.plot);
+    if (!args.json) PrintOptimiserTable(t);
+    std::fflush(stdout);
+  }
+  if (!args.out.empty() && args.all)
+    std::ofstream((std::filesystem::path(args.out) / "optimiser_summary.json").string()) << summary.dump(1) << "\n";
+  if (args.json) std::printf("%s\n", (args.all ? summary : summary[0]).dump(2).c_str());
+  return 0;
+}
+
 int RunTradeoffArgs(const TradeoffArgs& args) {
   if (args.all == !args.problem.empty())
     throw InvalidInputError("name one problem or give --all (diffpd tradeoff --help lists the problems)");
@@ -150,6 +211,7 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
       throw InvalidInputError("--plot " + args.plot + " is invalid: directory " + dir.string() + " does not exist");
   }
   const std::vector<std::string> problems = args.all ? ObjectiveProblemNames() : std::vector<std::string>{args.problem};
+  if (args.optimiser) return RunOptimiserTradeoffArgs(args, problems);
   std::vector<ProblemReport> reports;
   nlohmann::json summary = nlohmann::json::array();
   bool monotone = true;
@@ -232,6 +294,11 @@ Subcommand AddTradeoffCommand(CLI::App* parent) {
   cmd->add_flag("--check", args->check, "exit code 6 when a tolerance sweep is not monotone");
   cmd->add_flag("--json", args->json, "print the report as JSON on stdout");
   cmd->add_option("--plot", args->plot, "write a log-log PNG of time vs. error (needs gnuplot)");
+  cmd->add_flag("--optimiser", args->optimiser,
+                "the problem's own optimiser at each tolerance: wall time and final loss (see below)");
+  cmd->add_option("--budget", args->budget, "--optimiser: iterations of each run (0: the problem's own budget)")
+      ->check(IntegerAtLeast("--budget", 0))
+      ->capture_default_str();
   return {cmd, [args] { return RunTradeoffArgs(*args); }};
 }
 

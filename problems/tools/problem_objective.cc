@@ -1,6 +1,8 @@
 #include "tools/problem_objective.h"
 
+#include <exception>
 #include <memory>
+#include <numeric>
 
 #include "control/swimmer_control.h"
 #include "diffpd/error.h"
@@ -15,6 +17,8 @@
 #endif
 #if DIFFPD_WITH_IPOPT
 #include "control/trajectory_optimization.h"
+#include "diffpd/solvers/ipopt/ipopt_solve.h"
+#include "paper/row_optimisation.h"
 #endif
 
 namespace diffpd::problems {
@@ -67,6 +71,32 @@ ObjectiveMeasurement MeasureFunction(solvers::RolloutFunction* f, const VectorXd
   return m;
 }
 
+// The loss of MeasureFunction at p, without its gradient; false (and
+// *failure) when the rollout fails.
+bool LossAt(solvers::RolloutFunction* f, const VectorXd& p, const std::vector<int>& rows,
+            const std::vector<double>& weights, bool least_squares, double* loss, std::string* failure) {
+  VectorXd values;
+  if (!f->Evaluate(p, rows, &values, nullptr)) {
+    *failure = f->statistics().last_error;
+    return false;
+  }
+  *loss = least_squares ? 0.5 * values.squaredNorm() : 0.0;
+  if (!least_squares)
+    for (size_t t = 0; t < rows.size(); ++t) *loss += weights[t] * values(t);
+  return true;
+}
+
+// Runs `body` and turns an exception into the outcome's failure.
+OptimiserOutcome Guarded(const std::function<void(OptimiserOutcome*)>& body) {
+  OptimiserOutcome out;
+  try {
+    body(&out);
+  } catch (const std::exception& e) {
+    out.failure = e.what();
+  }
+  return out;
+}
+
 bool HasFrictionalContact(const Scene& scene) { return !scene.frictional_contacts.empty(); }
 
 void SetScreening(Scene* scene, double screening) {
@@ -93,6 +123,28 @@ ProblemObjective PaperRowObjective(const std::string& name, int threads) {
     RowRolloutFunction f = MakeRowRolloutFunction(copy, options);
     return MeasureFunction(f.function.get(), row->initial(), f.loss_rows, f.loss_weights, false);
   };
+#if DIFFPD_WITH_IPOPT
+  o.optimiser = "Ipopt with a limited-memory Hessian and the row's bounds (the row's evaluation budget)";
+  o.optimise = [row](const SolverOptions& options_in, int max_evaluations) {
+    return Guarded([&](OptimiserOutcome* out) {
+      SolverOptions options = options_in;
+      options.time_step = row->time_step;
+      RowOptimisationOptions budget;
+      budget.max_evaluations = max_evaluations;
+      const RowOptimisationResult r = OptimiseRow(*row, options, budget);
+      out->status = r.status + " (" + r.stopped_by + ")";
+      out->wall_s = r.total_s;
+      out->evaluations = r.evaluations;
+      out->iterations = r.iterations;
+      out->reported_loss = r.final_loss;
+      RowRolloutFunction ref = MakeRowRolloutFunction(*row, Converged(options));
+      if (!LossAt(ref.function.get(), row->initial(), ref.loss_rows, ref.loss_weights, false, &out->initial_loss,
+                  &out->failure))
+        return;
+      LossAt(ref.function.get(), r.x, ref.loss_rows, ref.loss_weights, false, &out->final_loss, &out->failure);
+    });
+  };
+#endif
   return o;
 }
 
@@ -115,6 +167,26 @@ ProblemObjective SwimmerObjective(const SwimmerControl& problem, int threads) {
     const auto f = MakeSwimmerFunction(*swimmer, options, kSwimmerSeed);
     const std::vector<int> rows = f->RowsOf(0);
     return MeasureFunction(f.get(), f->initial_parameters(), rows, std::vector<double>(rows.size(), 1.0), false);
+  };
+  o.optimiser = "Adam (the original's settings)";
+  const int budget = problem.small_evaluations();
+  o.optimise = [swimmer, budget](const SolverOptions& options, int max_evaluations) {
+    return Guarded([&](OptimiserOutcome* out) {
+      TrainingSettings settings;
+      settings.evaluations = max_evaluations > 0 ? max_evaluations : budget;
+      settings.seed = kSwimmerSeed;
+      const TrainingResult r = TrainSwimmer(*swimmer, options, settings);
+      out->status = std::to_string(settings.evaluations) + " evaluations";
+      out->wall_s = r.total_seconds;
+      out->evaluations = static_cast<long>(r.history.size());
+      out->iterations = settings.evaluations;
+      out->reported_loss = -r.final_reward();
+      const auto ref = MakeSwimmerFunction(*swimmer, Converged(options), kSwimmerSeed);
+      const std::vector<int> rows = ref->RowsOf(0);
+      const std::vector<double> ones(rows.size(), 1.0);
+      if (!LossAt(ref.get(), r.initial_parameters, rows, ones, false, &out->initial_loss, &out->failure)) return;
+      LossAt(ref.get(), r.final_parameters, rows, ones, false, &out->final_loss, &out->failure);
+    });
   };
   return o;
 }
@@ -140,6 +212,26 @@ ProblemObjective CalibrationObjective(std::shared_ptr<const CalibrationProblem> 
     options.time_step = problem->default_time_step();
     const auto f = problem->MakeModel(*motion, options);
     return MeasureFunction(f.get(), f->initial_parameters(), f->RowsOf(0), {}, true);
+  };
+  o.optimiser = "Ceres Levenberg-Marquardt (log E, nu in [0.01, 0.49])";
+  o.optimise = [problem, motion](const SolverOptions& options, int max_iterations) {
+    return Guarded([&](OptimiserOutcome* out) {
+      const CalibrationFit fit =
+          problem->Fit(*motion, options, max_iterations > 0 ? max_iterations : problem->max_iterations(), nullptr);
+      out->status = fit.termination;
+      out->wall_s = fit.total_seconds;
+      out->evaluations = fit.statistics.rollouts;
+      out->iterations = fit.iterations;
+      out->reported_loss = fit.final_cost;
+      SolverOptions converged = Converged(options);
+      converged.time_step = problem->default_time_step();
+      const auto ref = problem->MakeModel(*motion, converged);
+      const std::vector<int> rows = ref->RowsOf(0);
+      const Eigen::Map<const VectorXd> initial(fit.initial.data(), static_cast<Eigen::Index>(fit.initial.size()));
+      const Eigen::Map<const VectorXd> fitted(fit.values.data(), static_cast<Eigen::Index>(fit.values.size()));
+      if (!LossAt(ref.get(), initial, rows, {}, true, &out->initial_loss, &out->failure)) return;
+      LossAt(ref.get(), fitted, rows, {}, true, &out->final_loss, &out->failure);
+    });
   };
   return o;
 }
@@ -183,6 +275,27 @@ ProblemObjective NlpObjective(std::shared_ptr<const TrajectoryOptimizationProble
     m.final_state = StackState(rollout->states.back());
     m.iters_per_step = ItersPerStep(*rollout);
     return m;
+  };
+  o.optimiser = "Ipopt with a limited-memory Hessian (the problem's settings)";
+  o.optimise = [problem](const SolverOptions& options_in, int max_iterations) {
+    return Guarded([&](OptimiserOutcome* out) {
+      SolverOptions options = options_in;
+      options.time_step = problem->time_step(kSize);
+      Ipopt::SmartPtr<solvers::RolloutNlp> nlp = problem->MakeNlp(options, kSize);
+      solvers::IpoptOptions ipopt = problem->DefaultIpoptOptions(kSize);
+      if (max_iterations > 0) ipopt.int_options.push_back({"max_iter", max_iterations});
+      const solvers::IpoptSummary s = solvers::SolveWithIpopt(nlp, ipopt);
+      out->status = s.status_name;
+      out->wall_s = s.total_seconds;
+      out->evaluations = s.evaluations;
+      out->iterations = s.iterations;
+      out->reported_loss = s.objective;
+      out->constraint_violation = s.constraint_violation;
+      SolverOptions converged = Converged(options);
+      Ipopt::SmartPtr<solvers::RolloutNlp> ref = problem->MakeNlp(converged, kSize);
+      if (!ref->Objective(ref->starting_point(), &out->initial_loss) || !ref->Objective(s.x, &out->final_loss))
+        out->failure = ref->last_error();
+    });
   };
   return o;
 }

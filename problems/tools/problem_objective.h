@@ -48,6 +48,23 @@ struct ObjectiveMeasurement {
   bool ok() const { return failure.empty(); }
 };
 
+// One run of a problem's own optimiser from its own start (optimiser_tradeoff.h).
+struct OptimiserOutcome {
+  std::string failure;   // "" when the optimiser ran to its end; else why it could not
+  std::string status;    // how the optimiser ended, in its own words
+  double wall_s = 0;     // wall-clock seconds of the whole optimisation
+  long evaluations = 0;  // rollouts the optimiser asked for
+  int iterations = 0;    // its iterations (Adam: updates)
+  // The loss at the start and at the returned point, both re-evaluated with
+  // converged settings (newton-cholesky, rel_tolerance 1e-10), and the
+  // optimiser's own last value at its tolerance.
+  double initial_loss = 0, final_loss = 0, reported_loss = 0;
+  // The largest constraint or bound violation at the returned point, as the
+  // optimiser saw it (0 for an unconstrained problem).
+  double constraint_violation = 0;
+  bool ok() const { return failure.empty(); }
+};
+
 struct ProblemObjective {
   std::string problem;
   // What the gradient is taken with respect to, in words ("log E, nu (2)").
@@ -71,6 +88,12 @@ struct ProblemObjective {
   // scene's). Never throws for a failed rollout (see failure); throws
   // InvalidInputError for invalid options.
   std::function<ObjectiveMeasurement(const SolverOptions& options, double screening)> measure;
+  // The problem's own optimiser (in words; "" for a forward scene) and one
+  // run of it from the problem's start with `options` for every evaluation,
+  // stopped after `max_iterations` iterations (<= 0: the problem's own
+  // budget). Empty for a forward scene. Never throws for a failed run.
+  std::string optimiser;
+  std::function<OptimiserOutcome(const SolverOptions& options, int max_iterations)> optimise;
 };
 
 // The problems that have an objective here: the registered problems (those of

@@ -24,6 +24,7 @@ if(TARGET diffpd_ipopt)
   diffpd_add_test(routing_tendon_opt_test ${_dir}/control/routing_tendon_opt_test.cc LIBS diffpd_problems)
   diffpd_add_test(trajectory_optimization_test ${_dir}/control/trajectory_optimization_test.cc LIBS diffpd_problems)
   diffpd_add_test(row_optimisation_test ${_dir}/paper/row_optimisation_test.cc LIBS diffpd_problems)
+  diffpd_add_test(optimiser_tradeoff_test ${_dir}/tools/optimiser_tradeoff_test.cc LIBS diffpd_problems)
 endif()
 diffpd_add_test(command_line_test ${_dir}/cli/command_line_test.cc LIBS diffpd_problems)
 # Closed-loop swimming (Adam needs neither adapter).
