@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <sstream>
 
@@ -36,7 +37,12 @@ OptimiserTradeoff RunOptimiserTradeoff(const ProblemObjective& objective, const 
   result.default_rel_tolerance = objective.defaults.rel_tolerance;
   result.dofs = objective.dofs;
   result.steps = objective.steps;
-  for (double tolerance : tolerances) {
+  // The default's tolerance is always measured; loose to tight.
+  std::vector<double> sweep = tolerances;
+  if (std::find(sweep.begin(), sweep.end(), result.default_rel_tolerance) == sweep.end())
+    sweep.push_back(result.default_rel_tolerance);
+  std::sort(sweep.begin(), sweep.end(), std::greater<double>());
+  for (double tolerance : sweep) {
     SolverOptions o = objective.defaults;
     o.rel_tolerance = tolerance;
     if (progress)
@@ -105,8 +111,8 @@ void WriteOptimiserTradeoffPlot(const OptimiserTradeoff& t, const std::string& p
     if (!r.outcome.ok() || !std::isfinite(r.outcome.final_loss)) continue;
     std::ostringstream label;
     label << r.rel_tolerance;
-    const std::string line = std::to_string(r.outcome.wall_s) + " " + std::to_string(r.outcome.final_loss) + " \"" +
-                             label.str() + "\"\n";
+    const std::string line =
+        std::to_string(r.outcome.wall_s) + " " + std::to_string(r.outcome.final_loss) + " \"" + label.str() + "\"\n";
     data << line;
     if (r.rel_tolerance == t.default_rel_tolerance) marked << line;
     ++n;

@@ -46,10 +46,11 @@ struct OptimiserTradeoff {
   std::string method;     // the method every run's evaluations use (the problem's default)
   double default_rel_tolerance = 0;
   int dofs = 0, steps = 0;
-  std::vector<OptimiserTradeoffRow> rows;  // one per tolerance, in the order given
+  std::vector<OptimiserTradeoffRow> rows;  // one per tolerance, loosest first
 };
 
-// Throws InvalidInputError when the problem has no optimiser here, for an
+// Runs the tolerances and the problem's default tolerance (added when not
+// among them), loosest first. Throws InvalidInputError when the problem has no optimiser here, for an
 // empty tolerance list or a tolerance outside (0, 1). A failed run is a
 // row with outcome.failure set; progress lines go to `progress` (may be null).
 OptimiserTradeoff RunOptimiserTradeoff(const ProblemObjective& objective, const std::vector<double>& tolerances,

@@ -124,6 +124,7 @@ ProblemObjective PaperRowObjective(const std::string& name, int threads) {
     return MeasureFunction(f.function.get(), row->initial(), f.loss_rows, f.loss_weights, false);
   };
 #if DIFFPD_WITH_IPOPT
+  if (!row->budget.optimised) return o;  // a timing-only row (its loss has no minimum to find)
   o.optimiser = "Ipopt with a limited-memory Hessian and the row's bounds (the row's evaluation budget)";
   o.optimise = [row](const SolverOptions& options_in, int max_evaluations) {
     return Guarded([&](OptimiserOutcome* out) {

@@ -480,7 +480,15 @@ std::vector<Row> StepRows() {
                     Simulator sim(testing::SmallBeamScene(), testing::TightOptions(Method::kPd));
                     sim.Simulate(sim.RestState(), std::vector<StepInput>(1, StepInput{VectorXd::Zero(2), {}}));
                   },
-                  "external_force has 2 entries, expected 135 (3 x number of nodes)"});
+                  "Simulate: inputs[0]: external_force has 2 entries, expected 135 (3 x number of nodes)"});
+  rows.push_back({"simulate with an activation at its third step on a scene without muscles",
+                  [] {
+                    Simulator sim(testing::SmallBeamScene(), testing::TightOptions(Method::kPd));
+                    std::vector<StepInput> inputs(4);
+                    inputs[2].activation = VectorXd::Constant(1, kNaN);
+                    sim.Simulate(sim.RestState(), inputs);
+                  },
+                  "Simulate: inputs[2]: activation has 1 entries, expected 0 (one per muscle)"});
   return rows;
 }
 

@@ -61,7 +61,10 @@ class Simulator {
   // kNonFinite for a residual or state that overflows, kDiverged for a body
   // stretched beyond SolverOptions::max_extent_ratio).
   State Step(const State& state, const StepInput& input, StepReport* report = nullptr);
-  // K = inputs.size() steps from `initial`, recorded for Backward().
+  // K = inputs.size() steps from `initial`, recorded for Backward(). Every
+  // input is checked first: InvalidInputError names one of the wrong size
+  // or with a non-finite entry ("Simulate: inputs[2]: external_force has a
+  // non-finite entry"); the step's own exceptions otherwise.
   Rollout Simulate(const State& initial, const std::vector<StepInput>& inputs);
   // Closed loop (controller.h): `steps` steps from `initial`, each driven by
   // the action the controller chooses from the step's state and its memory.

@@ -182,6 +182,16 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
 }
 
 Rollout Simulator::Simulate(const State& initial, const std::vector<StepInput>& inputs) {
+  // Every input is checked before the first step, so that a bad one is
+  // named by its index and costs no simulation.
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    try {
+      CheckVector(inputs[i].external_force, impl_->num_dofs(), "external_force", true);
+      internal::CheckActivation(inputs[i].activation, impl_->aux.num_muscles());
+    } catch (const InvalidInputError& e) {
+      throw InvalidInputError("Simulate: inputs[" + std::to_string(i) + "]: " + e.what());
+    }
+  }
   Rollout r;
   r.material = impl_->scene.material;
   for (const MaterialRegion& region : impl_->scene.material_regions) r.region_materials.push_back(region.material);
