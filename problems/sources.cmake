@@ -21,6 +21,7 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/control/reference_curve.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/starfish_control.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/shark_control.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_starts.cc
   # paper: the DiffPD paper's table rows as data
   ${CMAKE_CURRENT_LIST_DIR}/paper/numpy_random.cc
   ${CMAKE_CURRENT_LIST_DIR}/paper/paper_meshes.cc
