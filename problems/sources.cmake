@@ -83,6 +83,7 @@ set(DIFFPD_PROBLEMS_CALIBRATION_SOURCES
   # calibration over several recordings (a rollout set)
   ${CMAKE_CURRENT_LIST_DIR}/calibration/plant_recordings.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/rollout_set_fit.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_recordings_fit.cc
   # the swimmers' L-BFGS training
   ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_lbfgs.cc)
 # control: trajectory and control optimisation with Ipopt

@@ -73,12 +73,16 @@ solvers::RolloutTerm SwimmerStartTerm(const Swimmer& swimmer, const SolverOption
   return term;
 }
 
-MultiStartTraining TrainOverStarts(solvers::RolloutSet* set, int steps_per_start, const TrainingSettings& settings) {
-  if (settings.optimizer == ControlOptimizer::kIpopt)
+void CheckSetOptimizer(ControlOptimizer optimizer) {
+  if (optimizer == ControlOptimizer::kIpopt)
     throw InvalidInputError("optimizer 'ipopt' does not train over a rollout set: valid optimizers are adam, lbfgs");
-  if (!ControlOptimizerAvailable(settings.optimizer))
-    throw InvalidInputError(std::string("optimizer '") + ToString(settings.optimizer) +
+  if (!ControlOptimizerAvailable(optimizer))
+    throw InvalidInputError(std::string("optimizer '") + ToString(optimizer) +
                             "' needs the Ceres adapter, which this build lacks");
+}
+
+MultiStartTraining TrainOverStarts(solvers::RolloutSet* set, int steps_per_start, const TrainingSettings& settings) {
+  CheckSetOptimizer(settings.optimizer);
   settings.adam.Validate();
   MultiStartTraining result;
   result.optimizer = ToString(settings.optimizer);

@@ -39,6 +39,11 @@ State SwimmerStartState(const Swimmer& swimmer, int i, const SwimmerStartsOption
 solvers::RolloutTerm SwimmerStartTerm(const Swimmer& swimmer, const SolverOptions& options, std::uint64_t seed, int i,
                                       const SwimmerStartsOptions& starts);
 
+// Throws InvalidInputError unless `optimizer` trains over a rollout set
+// and this build has it ("optimizer 'ipopt' does not train over a rollout
+// set: valid optimizers are adam, lbfgs").
+void CheckSetOptimizer(ControlOptimizer optimizer);
+
 // A training over a set of starts (computing only; see TrainOverStarts).
 struct MultiStartTraining {
   std::string optimizer;
@@ -62,10 +67,9 @@ struct MultiStartTraining {
 // settings.optimizer (Adam or L-BFGS; settings.seed is not read, the terms
 // were made with theirs) within settings.evaluations evaluations of the
 // whole set (each: every start's rollout and reverse pass). Call it on rank
-// 0 of a distributed set. Throws InvalidInputError for bad settings or
-// Ipopt ("optimizer 'ipopt' does not train over a rollout set: valid
-// optimizers are adam, lbfgs"), an optimiser this build lacks, SolverError
-// when an Adam evaluation or the final one fails.
+// 0 of a distributed set. Throws InvalidInputError for bad settings or an
+// optimiser CheckSetOptimizer refuses, SolverError when an Adam evaluation
+// or the final one fails.
 MultiStartTraining TrainOverStarts(solvers::RolloutSet* set, int steps_per_start, const TrainingSettings& settings);
 
 }  // namespace diffpd::problems

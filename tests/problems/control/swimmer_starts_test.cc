@@ -62,8 +62,7 @@ TEST(SwimmerStartsTest, RefusesBadStartsWithTheirMessages) {
   const Swimmer swimmer = ShortStarfish();
   SwimmerStartsOptions starts;
   starts.count = 0;
-  EXPECT_THROW_MESSAGE(SwimmerStartState(swimmer, 0, starts), InvalidInputError,
-                       "starts = 0 is invalid: must be >= 1");
+  EXPECT_THROW_MESSAGE(SwimmerStartState(swimmer, 0, starts), InvalidInputError, "starts = 0 is invalid: must be >= 1");
   starts.count = 4;
   starts.speed = -1;
   EXPECT_THROW_MESSAGE(SwimmerStartState(swimmer, 0, starts), InvalidInputError,

@@ -25,3 +25,5 @@ function(diffpd_add_mpi_program_test name)
 endfunction()
 diffpd_add_mpi_program_test(diffpd_mpi_train_starfish_ranks_test
                             train-starfish --starts 3 --small --steps 10 --evaluations 2 --json)
+diffpd_add_mpi_program_test(diffpd_mpi_calibrate_starfish_ranks_test
+                            calibrate-starfish --start 1.15 --seconds 0.15 --substeps 1 --max-iterations 2 --json)
