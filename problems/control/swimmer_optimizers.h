@@ -42,5 +42,8 @@ VectorXd MinimizeWithLbfgs(solvers::RolloutSet* set, EvaluationBudget* budget, s
 // Defined with the Ipopt adapter only.
 VectorXd MinimizeWithIpopt(std::unique_ptr<solvers::RolloutFunction> function, int loss, EvaluationBudget* budget,
                            std::string* report);
+// The same over a rollout set's scalar loss (solvers/ipopt's RolloutSetNlp),
+// from the set's initial parameters.
+VectorXd MinimizeWithIpopt(solvers::RolloutSet* set, EvaluationBudget* budget, std::string* report);
 
 }  // namespace diffpd::problems

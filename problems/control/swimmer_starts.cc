@@ -74,11 +74,10 @@ solvers::RolloutTerm SwimmerStartTerm(const Swimmer& swimmer, const SolverOption
 }
 
 void CheckSetOptimizer(ControlOptimizer optimizer) {
-  if (optimizer == ControlOptimizer::kIpopt)
-    throw InvalidInputError("optimizer 'ipopt' does not train over a rollout set: valid optimizers are adam, lbfgs");
   if (!ControlOptimizerAvailable(optimizer))
-    throw InvalidInputError(std::string("optimizer '") + ToString(optimizer) +
-                            "' needs the Ceres adapter, which this build lacks");
+    throw InvalidInputError(std::string("optimizer '") + ToString(optimizer) + "' needs the " +
+                            (optimizer == ControlOptimizer::kLbfgs ? "Ceres" : "Ipopt") +
+                            " adapter, which this build lacks");
 }
 
 MultiStartTraining TrainOverStarts(solvers::RolloutSet* set, int steps_per_start, const TrainingSettings& settings) {
@@ -105,6 +104,9 @@ MultiStartTraining TrainOverStarts(solvers::RolloutSet* set, int steps_per_start
 #endif
       break;
     case ControlOptimizer::kIpopt:
+#if DIFFPD_WITH_IPOPT
+      result.final_parameters = MinimizeWithIpopt(set, &budget, &result.optimizer_report);
+#endif
       break;
   }
   budget.Finish();

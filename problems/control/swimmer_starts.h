@@ -39,15 +39,14 @@ State SwimmerStartState(const Swimmer& swimmer, int i, const SwimmerStartsOption
 solvers::RolloutTerm SwimmerStartTerm(const Swimmer& swimmer, const SolverOptions& options, std::uint64_t seed, int i,
                                       const SwimmerStartsOptions& starts);
 
-// Throws InvalidInputError unless `optimizer` trains over a rollout set
-// and this build has it ("optimizer 'ipopt' does not train over a rollout
-// set: valid optimizers are adam, lbfgs").
+// Throws InvalidInputError unless this build has the optimiser's adapter
+// ("optimizer 'ipopt' needs the Ipopt adapter, which this build lacks").
 void CheckSetOptimizer(ControlOptimizer optimizer);
 
 // A training over a set of starts (computing only; see TrainOverStarts).
 struct MultiStartTraining {
   std::string optimizer;
-  std::string optimizer_report;  // Ceres' brief report (L-BFGS); Adam: empty
+  std::string optimizer_report;  // Ceres' brief report (L-BFGS), Ipopt's status; Adam: empty
   int starts = 0, parameters = 0, steps_per_start = 0;
   // One row per evaluation (reward = -L, the sum over the starts;
   // simulated_steps counts every start's steps) and a last one for the
@@ -64,7 +63,7 @@ struct MultiStartTraining {
 };
 
 // Trains the set's controller from its initial parameters with
-// settings.optimizer (Adam or L-BFGS; settings.seed is not read, the terms
+// settings.optimizer (Adam, L-BFGS or Ipopt; settings.seed is not read, the terms
 // were made with theirs) within settings.evaluations evaluations of the
 // whole set (each: every start's rollout and reverse pass). Call it on rank
 // 0 of a distributed set. Throws InvalidInputError for bad settings or an

@@ -13,7 +13,7 @@
 // real recordings (starfish_recordings_fit.h; default the shared cyclic1 and
 // cyclic2) by Levenberg-Marquardt; train-starfish trains the
 // starfish's controller over several initial states (swimmer_starts.h) with
-// Adam or L-BFGS. Prints the iteration table or learning curve and a report
+// Adam, L-BFGS or Ipopt. Prints the iteration table or learning curve and a report
 // on rank 0's stderr; --json prints the report as one JSON object on stdout,
 // its "run" member holding what depends on the run (ranks, threads, seconds)
 // and the rest what the computation gave (equal on any number of ranks).
@@ -331,7 +331,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 100000));
   starfish->add_option("--evaluations", args.evaluations, "evaluations of the whole set (Adam: epochs)")
       ->check(CLI::Range(1, 1000000));
-  starfish->add_option("--optimizer", args.optimizer, "adam or lbfgs");
+  starfish->add_option("--optimizer", args.optimizer, "adam, lbfgs or ipopt");
   starfish->add_option("--speed", args.speed, "lateral speed of the starts 1.. (m/s)");
   starfish->add_option("--seed", args.seed, "the network's initialisation");
   starfish->add_option("--adjoint-solver", args.adjoint_solver,

@@ -31,7 +31,8 @@ class StarfishRecordingsFitTest : public ::testing::Test {
   }
   solvers::LocalRolloutSet Set(const std::vector<std::string>& paths) const {
     std::vector<solvers::RolloutTerm> terms;
-    for (const std::string& path : paths) terms.push_back(StarfishRecordingTerm(starfish_, path, Options(), recordings_));
+    for (const std::string& path : paths)
+      terms.push_back(StarfishRecordingTerm(starfish_, path, Options(), recordings_));
     return solvers::LocalRolloutSet(std::move(terms), solvers::TermObjective::kLeastSquares);
   }
   StarfishCalibration starfish_;

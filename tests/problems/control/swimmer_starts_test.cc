@@ -71,9 +71,9 @@ TEST(SwimmerStartsTest, RefusesBadStartsWithTheirMessages) {
   EXPECT_THROW_MESSAGE(SwimmerStartState(swimmer, 4, starts), InvalidInputError, "start 4 is out of range [0, 4)");
   solvers::LocalRolloutSet set = Starts(swimmer, Options(), 1);
   TrainingSettings settings;
-  settings.optimizer = ControlOptimizer::kIpopt;
+  settings.evaluations = 0;
   EXPECT_THROW_MESSAGE(TrainOverStarts(&set, kSteps, settings), InvalidInputError,
-                       "optimizer 'ipopt' does not train over a rollout set: valid optimizers are adam, lbfgs");
+                       "evaluations = 0 is invalid: must be >= 1");
 }
 
 // The gradient of L = L_0 + L_1 (the rest start and a pushed one) along a
@@ -121,7 +121,7 @@ TEST(SwimmerStartsTest, OneStartTrainsExactlyAsTheSingleRolloutTraining) {
 
 TEST(SwimmerStartsTest, MultiStartTrainingCountsEveryStartAndItsRewardsAddUp) {
   const Swimmer swimmer = ShortStarfish();
-  for (ControlOptimizer optimizer : {ControlOptimizer::kAdam, ControlOptimizer::kLbfgs}) {
+  for (ControlOptimizer optimizer : {ControlOptimizer::kAdam, ControlOptimizer::kLbfgs, ControlOptimizer::kIpopt}) {
     if (!ControlOptimizerAvailable(optimizer)) continue;
     solvers::LocalRolloutSet set = Starts(swimmer, Options(), 2);
     TrainingSettings settings;

@@ -2,7 +2,8 @@
 // (swimmer_starts.h) on 2 MPI ranks (CTest runs it under mpiexec -n 2): the
 // same training code over a DistributedRolloutSet gives the learning curve,
 // the per-start rewards and the final weights of the training over a
-// LocalRolloutSet of the same starts, bit for bit, with Adam and L-BFGS.
+// LocalRolloutSet of the same starts, bit for bit, with Adam, L-BFGS and
+// Ipopt.
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -55,7 +56,7 @@ TEST_P(DistributedSwimmerTrainingTest, EqualsTheLocalTrainingBitForBit) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Optimizers, DistributedSwimmerTrainingTest,
-                         ::testing::Values(ControlOptimizer::kAdam, ControlOptimizer::kLbfgs),
+                         ::testing::Values(ControlOptimizer::kAdam, ControlOptimizer::kLbfgs, ControlOptimizer::kIpopt),
                          [](const ::testing::TestParamInfo<ControlOptimizer>& info) { return ToString(info.param); });
 
 }  // namespace
