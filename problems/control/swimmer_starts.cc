@@ -89,11 +89,12 @@ MultiStartTraining TrainOverStarts(solvers::RolloutSet* set, int steps_per_start
   result.parameters = set->num_parameters();
   result.steps_per_start = steps_per_start;
   result.initial_parameters = set->initial_parameters();
+  EvaluationBudget budget(set, settings.evaluations, steps_per_start * set->num_terms(), settings.log);
   const auto start = Clock::now();
-  // The initial rollouts (the optimiser's first evaluation finds them cached).
+  // The initial rollouts (the optimiser's first evaluation finds them cached
+  // and the budget counts their time as its first row's forward time).
   if (!StartRewards(set, result.initial_parameters, &result.initial_start_rewards))
     throw SolverError(SolverStatus::kNonFinite, "the initial controller's rollouts: " + set->last_error());
-  EvaluationBudget budget(set, settings.evaluations, steps_per_start * set->num_terms(), settings.log);
   switch (settings.optimizer) {
     case ControlOptimizer::kAdam:
       result.final_parameters = MinimizeWithAdam(set, settings.adam, &budget);

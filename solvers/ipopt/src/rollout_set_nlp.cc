@@ -82,10 +82,9 @@ bool RolloutSetNlp::intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index, Ip
   return true;
 }
 
-void RolloutSetNlp::finalize_solution(Ipopt::SolverReturn, Ipopt::Index n, const Ipopt::Number* x,
-                                      const Ipopt::Number*, const Ipopt::Number*, Ipopt::Index, const Ipopt::Number*,
-                                      const Ipopt::Number*, Ipopt::Number, const Ipopt::IpoptData*,
-                                      Ipopt::IpoptCalculatedQuantities*) {
+void RolloutSetNlp::finalize_solution(Ipopt::SolverReturn, Ipopt::Index n, const Ipopt::Number* x, const Ipopt::Number*,
+                                      const Ipopt::Number*, Ipopt::Index, const Ipopt::Number*, const Ipopt::Number*,
+                                      Ipopt::Number, const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) {
   has_solution_ = x != nullptr;
   if (has_solution_) solution_ = Eigen::Map<const VectorXd>(x, n);
 }
