@@ -27,3 +27,19 @@ diffpd_add_mpi_program_test(diffpd_mpi_train_starfish_ranks_test
                             train-starfish --starts 3 --small --steps 10 --evaluations 2 --json)
 diffpd_add_mpi_program_test(diffpd_mpi_calibrate_starfish_ranks_test
                             calibrate-starfish --start 1.15 --seconds 0.15 --substeps 1 --max-iterations 2 --json)
+
+# Bad input: exit status 2 and the message once, from rank 0, before any rollout.
+function(diffpd_add_mpi_error_test name message)
+  list(JOIN ARGN "|" args)
+  add_test(NAME ${name}
+           COMMAND ${CMAKE_COMMAND} -DMPIEXEC=${MPIEXEC_EXECUTABLE} -DNUMPROC_FLAG=${MPIEXEC_NUMPROC_FLAG}
+                   -DPROGRAM=$<TARGET_FILE:diffpd_mpi_cli> "-DARGS=${args}" "-DMESSAGE=${message}"
+                   -P ${_dir}/expect_error.cmake)
+  set_tests_properties(${name} PROPERTIES ENVIRONMENT "${_mpi_env}")
+endfunction()
+diffpd_add_mpi_error_test(diffpd_mpi_refuses_bad_start_speed_test
+                          "start speed = -1 is invalid: must be finite and >= 0" train-starfish --speed -1)
+diffpd_add_mpi_error_test(diffpd_mpi_refuses_missing_recording_test
+                          "DistributedRolloutSet: term 1 (rank 1): cannot open 'missing.csv'"
+                          calibrate-starfish --recordings ${PROJECT_SOURCE_DIR}/../shared/data/starfish/data_horizontal_cyclic1.csv
+                          missing.csv --seconds 0.1)
