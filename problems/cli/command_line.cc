@@ -110,9 +110,12 @@ parameters): the relative error of the gradient against central differences,
 the noise floor of the differences (from the forward's achieved residuals and
 from differences at several steps), the margin tolerance / max(error, floor)
 and a verdict: pass, fail, or unresolved (the differences cannot resolve the
-derivative to the tolerance; the reason gives the floor). For the iterative
-methods the gradient is also compared with a Newton-Cholesky rollout's at
-rel_tolerance 1e-12 (the reference column). Exit code 4 when an input fails.)");
+derivative to the tolerance; the reason gives the floor). Where the
+differences do not pass with a margin of 3, the forward-mode tangent of the
+same states (the tangent column) decides; the basis column says which did.
+For the iterative methods the gradient is also compared with a
+Newton-Cholesky rollout's at rel_tolerance 1e-12 (the reference column).
+Exit code 4 when an input fails.)");
   const auto bench = AddBenchCommand(&app);
   const auto tradeoff = AddTradeoffCommand(&app);
   const auto stress = AddStressCommand(&app);

@@ -33,9 +33,11 @@ Exit code 4 when any case is a violation. JSON: a list of {problem, method,
 youngs_modulus, poissons_ratio, time_step, outcome, message, steps_completed,
 rounding_floor_steps, newton_fallback_steps, max_energy_excess,
 gradcheck_run, gradcheck_error, gradcheck_floor, gradcheck_margin,
-gradcheck_unresolved, seconds}; the margin is tolerance / max(error,
-floor) over the resolved inputs. The table ends with the number of cases
-with unresolved inputs and the smallest margin.
+gradcheck_unresolved, gradcheck_tangent, seconds}; the error is on each
+input's basis (the differences, or the forward-mode tangent where the
+differences could not decide: gradcheck_tangent), the margin tolerance /
+max(error, floor) over the resolved inputs. The table ends with the number
+of cases with unresolved inputs and the smallest margin.
 Solves stop at |grad g| <= --abs-tol + --rtol |grad g(x0)|; by default
 --abs-tol is 10x an estimate of the rounding floor of |grad g| (never below
 1e-9 N), which grows with stiffness and 1/dt^2. Steps whose line search
@@ -72,6 +74,11 @@ int RunStressArgs(const StressArgs& args) {
         message += std::to_string(c.rounding_floor_steps) + " steps at the rounding floor, " +
                    std::to_string(c.newton_fallback_steps) + " finished by Newton";
       }
+      if (!c.gradcheck_tangent.empty()) {
+        message += message.empty() ? "" : "; ";
+        message += "decided by the tangent:";
+        for (const auto& input : c.gradcheck_tangent) message += " " + input;
+      }
       if (!c.gradcheck_unresolved.empty()) {
         message += message.empty() ? "" : "; ";
         message += "gradient unresolved:";
@@ -84,8 +91,10 @@ int RunStressArgs(const StressArgs& args) {
     }
     std::printf("# %d cases: %d ok, %d failed with a solver error, %d violations\n", summary.cases, summary.ok,
                 summary.failed, summary.violations);
-    std::printf("# gradient checks: %d run, %d with unresolved inputs, smallest margin of a resolved input %.3g\n",
-                summary.gradchecks, summary.unresolved_cases, summary.min_gradcheck_margin);
+    std::printf(
+        "# gradient checks: %d run, %d with unresolved inputs, %d with inputs decided by the tangent, smallest margin "
+        "of a resolved input %.3g\n",
+        summary.gradchecks, summary.unresolved_cases, summary.tangent_cases, summary.min_gradcheck_margin);
   }
   if (summary.violations > 0) {
     std::fprintf(stderr, "diffpd stress: %d case(s) violated the stability contract (see the table)\n",

@@ -35,22 +35,44 @@ CheckVerdict Worse(CheckVerdict a, CheckVerdict b) { return Rank(a) >= Rank(b) ?
 
 DerivativeJudgement JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences,
                                     double tolerance) {
+  std::vector<FiniteDifferenceVector> vectors;
+  vectors.reserve(differences.size());
+  for (const FiniteDifference& d : differences) vectors.push_back({d.step, {d.value}, d.noise, d.bound});
+  return JudgeDerivative(std::vector<double>{analytic}, vectors, tolerance);
+}
+
+DerivativeJudgement JudgeDerivative(const std::vector<double>& analytic,
+                                    const std::vector<FiniteDifferenceVector>& differences, double tolerance) {
   if (differences.empty()) throw std::invalid_argument("JudgeDerivative: no differences");
   if (!(tolerance > 0))
     throw std::invalid_argument("JudgeDerivative: tolerance = " + Format(tolerance) + " must be > 0");
+  for (const FiniteDifferenceVector& d : differences)
+    if (d.value.size() != analytic.size())
+      throw std::invalid_argument("JudgeDerivative: a difference has " + std::to_string(d.value.size()) +
+                                  " entries, the derivative " + std::to_string(analytic.size()));
+  auto distance = [](const std::vector<double>& a, const std::vector<double>& b) {
+    double sum = 0;
+    for (size_t i = 0; i < a.size(); ++i) sum += (a[i] - b[i]) * (a[i] - b[i]);
+    return std::sqrt(sum);
+  };
+  auto norm = [](const std::vector<double>& a) {
+    double sum = 0;
+    for (double v : a) sum += v * v;
+    return std::sqrt(sum);
+  };
   const size_t n = differences.size();
   // The uncertainty of fd(e_k) (see the header); the smallest step only
   // probes its neighbour's noise unless it is the only one.
   auto uncertainty = [&](size_t k) {
-    const FiniteDifference& d = differences[k];
+    const FiniteDifferenceVector& d = differences[k];
     double u = d.noise;
     if (k > 0) {
       const double r = differences[k - 1].step / d.step;
-      u = std::max(u, std::abs(differences[k - 1].value - d.value) / (r * r - 1));
+      u = std::max(u, distance(differences[k - 1].value, d.value) / (r * r - 1));
     } else if (n > 1) {
-      u = std::max(u, std::abs(differences[1].value - d.value));
+      u = std::max(u, distance(differences[1].value, d.value));
     }
-    if (k + 1 < n) u = std::max(u, std::abs(differences[k + 1].value - d.value) * differences[k + 1].step / d.step);
+    if (k + 1 < n) u = std::max(u, distance(differences[k + 1].value, d.value) * differences[k + 1].step / d.step);
     return std::isfinite(u) ? u : std::numeric_limits<double>::infinity();
   };
   const size_t candidates = n > 1 ? n - 1 : 1;
@@ -63,13 +85,13 @@ DerivativeJudgement JudgeDerivative(double analytic, const std::vector<FiniteDif
       best = k;
     }
   }
-  const FiniteDifference& d = differences[best];
+  const FiniteDifferenceVector& d = differences[best];
   DerivativeJudgement j;
   j.step = d.step;
   j.tolerance = tolerance;
-  const double scale = std::max(std::abs(d.value), std::abs(analytic));
-  const double difference = std::abs(d.value - analytic);
-  if (!std::isfinite(d.value)) {
+  const double scale = std::max(norm(d.value), norm(analytic));
+  const double difference = distance(d.value, analytic);
+  if (!std::isfinite(norm(d.value))) {
     j.error = j.floor = j.bound = std::numeric_limits<double>::infinity();
   } else if (scale > 0) {
     j.error = difference / scale;

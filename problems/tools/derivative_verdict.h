@@ -70,4 +70,16 @@ struct DerivativeJudgement {
 DerivativeJudgement JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences,
                                     double tolerance);
 
+// The same for a vector-valued derivative (a Jacobian-vector product, a
+// whole Jacobian flattened): every |.| above is a 2-norm. Throws
+// std::invalid_argument also when a value's size differs from analytic's.
+struct FiniteDifferenceVector {
+  double step = 0;
+  std::vector<double> value;
+  double noise = 0;  // of the whole vector (2-norm), like FiniteDifference::noise
+  double bound = 0;
+};
+DerivativeJudgement JudgeDerivative(const std::vector<double>& analytic,
+                                    const std::vector<FiniteDifferenceVector>& differences, double tolerance);
+
 }  // namespace diffpd::problems

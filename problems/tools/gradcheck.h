@@ -31,15 +31,37 @@
 // is unresolved, never a failure. An input kind's verdict is the worst over
 // its directions.
 //
+// Wider steps: where the six steps leave a direction unresolved, the
+// differences are also taken at 3 and 30 x largest_step (noise falls as 1/e;
+// where the loss is nearly linear in the input, e.g. a material parameter
+// over a few tiny steps, truncation stays small) and judged again.
+//
+// Tangent (by default): each direction's derivative is also computed in
+// forward mode (Simulator::Tangents) on the checked rollout itself: the
+// linearisation of the same steps at the same states, pushed forwards
+// instead of transposed, with no truncation and no difference noise. It
+// separates "the adjoint is wrong" from "the differences are noisy" where
+// the differences cannot: where they resolve the derivative with a margin
+// of at least decisive_margin they decide (the tangent is reported); where
+// they do not (the loss's rounding, e.g. v = (x_k+1 - x_k) / h at h = 1e-5 s,
+// buries a material derivative, or the forward's solves stop at their
+// rounding floor, where the computed trajectory is not a smooth function of
+// the inputs), the tangent decides when it gives the larger margin: pass
+// with margin tolerance / tangent error when the gradient agrees with it
+// within the tolerance; fail when it does not and the method is a direct
+// Newton one (adjoint and tangent then solve with the same exact Hessian,
+// so one of them is wrong); otherwise (iterative solves in both) the input
+// stays unresolved, the reason giving the floor and the comparisons.
+//
 // Reference: for the iterative methods (pd, pd-lbfgs, newton-pcg) by
 // default, the same loss's gradient from a Newton-Cholesky rollout at
 // rel_tolerance reference_rel_tolerance is compared too, per direction:
-// a reference error above the tolerance fails the input (the adjoint, not
-// the differences, is wrong) unless the differences are unresolved (the
-// forward's noise or its residuals' worst case covers the derivative, and
-// the method's gradient is that of its inexact trajectory): then the input
-// stays unresolved and the reason gives both. Differences that are unresolved while the
-// reference agrees point at a noisy forward, not a wrong gradient.
+// a reference error above the tolerance fails the input where the
+// differences decided (the adjoint, not the differences, is wrong). Where
+// they did not, the method's gradient is that of its own inexact trajectory
+// (e.g. solves stopped at their rounding floor): the tangent decides as
+// above and the reason gives the reference error, which says how far that
+// trajectory's gradient is from the converged one.
 #pragma once
 
 #include <cstdint>
@@ -67,6 +89,17 @@ struct GradCheckOptions {
   // discretisation differs).
   std::optional<bool> reference;
   double reference_rel_tolerance = 1e-12;  // of the reference's forward and adjoint solves
+  // Where the differences leave an input unresolved, also take them at two
+  // larger steps (3 and 30 x largest_step), evaluations that fail counting
+  // as non-finite: noise falls as 1/e, and the Richardson estimate tells
+  // whether truncation allows the larger step.
+  bool widen_steps = true;
+  // Compare with the forward-mode tangent (Simulator::Tangents) of the
+  // checked rollout; where the differences do not decide, it does (see above).
+  bool tangent = true;
+  // Differences that pass with at least this margin decide alone; below it,
+  // or unresolved, the tangent decides where it gives the larger margin.
+  double decisive_margin = 3;
 
   // Throws InvalidInputError naming the field, its value and the valid range.
   void Validate() const;
@@ -84,6 +117,12 @@ struct GradCheckInput {
   double step = 0;                             // the step of the worst direction (units of the scale)
   // Largest relative difference from the reference gradient; NaN: not compared.
   double reference_error = 0;
+  // Largest relative difference from the forward-mode tangent; NaN: not
+  // compared (or its pass failed).
+  double tangent_error = 0;
+  // What the verdict rests on: "differences", or "tangent" where the
+  // differences could not resolve some direction (worst direction's basis).
+  std::string basis = "differences";
   std::string reason;  // empty for a pass: why the worst direction failed or is unresolved
 };
 
@@ -91,6 +130,7 @@ struct GradCheckResult {
   std::string method;             // the checked method (ToString)
   double tolerance = 0;           // GradCheckOptions::tolerance
   bool reference = false;         // whether the Newton-Cholesky reference was compared
+  bool tangent = false;           // whether the forward-mode tangent was compared
   std::string reference_failure;  // non-empty: the reference rollout failed (its error); not compared
   std::vector<GradCheckInput> inputs;
   CheckVerdict verdict = CheckVerdict::kPass;  // worst over the inputs

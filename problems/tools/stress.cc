@@ -211,9 +211,13 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
       for (const auto& input : check.inputs) {
         if (input.verdict == CheckVerdict::kUnresolved) {
           c.gradcheck_unresolved.push_back(input.input);
+          if (progress)
+            *progress << "  gradient check: " << input.input << " unresolved: " << input.reason << std::endl;
           continue;
         }
-        c.gradcheck_error = std::max(c.gradcheck_error, input.error);
+        const bool by_tangent = input.basis == "tangent";
+        if (by_tangent) c.gradcheck_tangent.push_back(input.input);
+        c.gradcheck_error = std::max(c.gradcheck_error, by_tangent ? input.tangent_error : input.error);
         c.gradcheck_floor = std::max(c.gradcheck_floor, input.floor);
         c.gradcheck_margin = std::min(c.gradcheck_margin, input.margin);
       }
@@ -266,6 +270,7 @@ StressSummary SummarizeStress(const std::vector<StressCase>& cases) {
     if (!c.gradcheck_run) continue;
     ++s.gradchecks;
     s.unresolved_cases += !c.gradcheck_unresolved.empty();
+    s.tangent_cases += !c.gradcheck_tangent.empty();
     s.min_gradcheck_margin = std::min(s.min_gradcheck_margin, c.gradcheck_margin);
   }
   return s;
@@ -291,6 +296,7 @@ nlohmann::json StressToJson(const std::vector<StressCase>& cases) {
                    {"gradcheck_floor", c.gradcheck_floor},
                    {"gradcheck_margin", number(c.gradcheck_margin)},
                    {"gradcheck_unresolved", c.gradcheck_unresolved},
+                   {"gradcheck_tangent", c.gradcheck_tangent},
                    {"seconds", c.seconds}});
   return out;
 }

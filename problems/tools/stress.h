@@ -10,9 +10,10 @@
 //    only dissipates; the backward pass of the whole rollout returned finite
 //    gradients; and on the first gradcheck_steps steps the reverse-mode
 //    gradient passes CheckRolloutGradient (gradcheck.h: one direction per
-//    input kind, six steps, the Newton-Cholesky reference for the iterative
-//    methods; solves at rel_tolerance gradcheck_rel_tolerance) within
-//    gradcheck_tolerance, or is unresolved (listed, not a violation);
+//    input kind, six steps (two more where needed), the forward-mode tangent
+//    where the differences cannot decide, the Newton-Cholesky reference for
+//    the iterative methods; solves at rel_tolerance gradcheck_rel_tolerance)
+//    within gradcheck_tolerance, or is unresolved (listed, not a violation);
 //  - "failed": a SolverError stopped the rollout, its backward pass or the
 //    gradient check; `message` carries its status, its text and where;
 //  - "violation": anything else (a non-finite value returned without an
@@ -88,14 +89,17 @@ struct StressCase {
   // where the parts are kinetic, elastic and gravitational (relative to T_0).
   double max_energy_excess = 0;
   // The gradient check (gradcheck.h; zeros and empty when not run): the
-  // largest relative error and noise floor, the smallest margin
-  // (tolerance / max(error, floor)) over the resolved inputs (infinite
-  // when none), and the inputs it could not resolve.
+  // largest relative error on each resolved input's basis (against the
+  // differences, or the forward-mode tangent where it decided) and the
+  // largest noise floor of the differences, the smallest margin over the
+  // resolved inputs (infinite when none), the inputs it could not resolve
+  // and those the tangent decided (the differences could not).
   bool gradcheck_run = false;
   double gradcheck_error = 0;
   double gradcheck_floor = 0;
   double gradcheck_margin = 0;
   std::vector<std::string> gradcheck_unresolved;
+  std::vector<std::string> gradcheck_tangent;
   double seconds = 0;
 };
 
@@ -124,6 +128,7 @@ std::vector<StressCase> RunStress(const StressOptions& options, std::ostream* pr
 struct StressSummary {
   int cases = 0, ok = 0, failed = 0, violations = 0;
   int gradchecks = 0, unresolved_cases = 0;
+  int tangent_cases = 0;            // checks where the tangent decided some input
   double min_gradcheck_margin = 0;  // infinite when no input was resolved
 };
 StressSummary SummarizeStress(const std::vector<StressCase>& cases);

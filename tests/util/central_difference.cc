@@ -6,6 +6,9 @@
 #include <cstdlib>
 #include <iostream>
 #include <stdexcept>
+#include <vector>
+
+#include "tools/derivative_verdict.h"
 
 namespace diffpd::testing {
 namespace {
@@ -50,6 +53,26 @@ std::string Format(double v) {
   return buffer;
 }
 
+std::vector<double> Entries(const MatrixXd& m) { return std::vector<double>(m.data(), m.data() + m.size()); }
+
+// The verdict of differences `fd` at `steps` (decreasing) on `c`, judged
+// against c's own absolute tolerance; `noise_at_unit_step` is the declared
+// noise floor times the step.
+void Judge(const std::vector<double>& steps, const std::vector<MatrixXd>& fd, const MatrixXd& analytic,
+           double noise_at_unit_step, DifferenceCheck* c) {
+  const double scale = std::max(analytic.norm(), fd[steps.size() > 1 ? 1 : 0].norm());
+  if (!(c->tolerance > 0) || !(scale > 0)) return;
+  std::vector<problems::FiniteDifferenceVector> differences;
+  for (size_t k = 0; k < steps.size(); ++k)
+    differences.push_back({steps[k], Entries(fd[k]), noise_at_unit_step / steps[k], 0.0});
+  const problems::DerivativeJudgement j =
+      problems::JudgeDerivative(Entries(analytic), differences, c->tolerance / scale);
+  c->verdict = problems::ToString(j.verdict);
+  c->verdict_step = j.step;
+  c->measured_floor = j.floor * scale;
+  c->verdict_margin = j.margin;
+}
+
 }  // namespace
 
 double DifferenceCheck::margin() const {
@@ -65,6 +88,8 @@ std::string DifferenceCheck::Describe() const {
   std::string s = "central difference ";
   if (!passed()) {
     s += "FAILS";
+  } else if (verdict == "fail") {
+    s += "FAILS on the verdict of three steps";
   } else if (marginal()) {
     s += "passes marginally";
   } else {
@@ -75,6 +100,10 @@ std::string DifferenceCheck::Describe() const {
   s += "; |an| = " + Format(analytic) + ", |fd| = " + Format(numeric) + ", h = " + Format(step) + ", noise floor " +
        Format(noise_floor);
   s += std::isnan(truncation) ? std::string(", truncation not measured") : ", truncation ~" + Format(truncation);
+  if (!verdict.empty()) {
+    s += "; verdict " + verdict + " (margin " + Format(verdict_margin) + " at step " + Format(verdict_step) +
+         ", measured floor " + Format(measured_floor) + ")";
+  }
   if (floor > rtol * scale) {
     s += floor_given ? "; the given floor sets the tolerance (" + Format(floor / scale) + " relative)"
                      : "; the noise floor sets the tolerance: the differences resolve the derivative only to " +
@@ -101,12 +130,19 @@ DifferenceCheck CheckDirectionalDerivative(const std::function<VectorXd(const Ve
   const VectorXd plus = f(x + h * d), minus = f(x - h * d);
   const VectorXd fd = (plus - minus) / (2 * h);
   double truncation = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> steps = {h};
+  std::vector<MatrixXd> fds = {fd};
   if (options.estimate_truncation) {
     const VectorXd fd2 = (f(x + 2 * h * d) - f(x - 2 * h * d)) / (4 * h);
+    const VectorXd half = (f(x + 0.5 * h * d) - f(x - 0.5 * h * d)) / h;
     truncation = (fd2 - fd).norm() / 3;
+    steps = {2 * h, h, 0.5 * h};
+    fds = {fd2, fd, half};
   }
-  return Verdict((fd - analytic).norm(), analytic.norm(), fd.norm(), h, std::max(plus.norm(), minus.norm()), 1,
-                 truncation, options);
+  DifferenceCheck c = Verdict((fd - analytic).norm(), analytic.norm(), fd.norm(), h,
+                              std::max(plus.norm(), minus.norm()), 1, truncation, options);
+  Judge(steps, fds, analytic, c.noise_floor * h, &c);
+  return c;
 }
 
 DifferenceCheck CheckDirectionalDerivative(const std::function<double(const VectorXd&)>& f, const VectorXd& x,
@@ -120,7 +156,7 @@ DifferenceCheck CheckJacobian(const std::function<VectorXd(const VectorXd&)>& f,
   const int n = static_cast<int>(x.size());
   if (analytic.cols() != n) throw std::invalid_argument("CheckJacobian: the Jacobian's columns must match x");
   const double h = options.step > 0 ? options.step : CentralDifferenceStep(options.noise, InputScale(options, x));
-  MatrixXd fd(analytic.rows(), n), fd2(analytic.rows(), n);
+  MatrixXd fd(analytic.rows(), n), fd2(analytic.rows(), n), half(analytic.rows(), n);
   double values = 0;
   for (int j = 0; j < n; ++j) {
     VectorXd plus = x, minus = x;
@@ -133,11 +169,19 @@ DifferenceCheck CheckJacobian(const std::function<VectorXd(const VectorXd&)>& f,
       plus(j) += h;
       minus(j) -= h;
       fd2.col(j) = (f(plus) - f(minus)) / (4 * h);
+      plus(j) = x(j) + 0.5 * h;
+      minus(j) = x(j) - 0.5 * h;
+      half.col(j) = (f(plus) - f(minus)) / h;
     }
   }
   const double truncation =
       options.estimate_truncation ? (fd2 - fd).norm() / 3 : std::numeric_limits<double>::quiet_NaN();
-  return Verdict((fd - analytic).norm(), analytic.norm(), fd.norm(), h, values, n, truncation, options);
+  DifferenceCheck c = Verdict((fd - analytic).norm(), analytic.norm(), fd.norm(), h, values, n, truncation, options);
+  if (options.estimate_truncation)
+    Judge({2 * h, h, 0.5 * h}, {fd2, fd, half}, analytic, c.noise_floor * h, &c);
+  else
+    Judge({h}, {fd}, analytic, c.noise_floor * h, &c);
+  return c;
 }
 
 DifferenceCheck CheckGradient(const std::function<double(const VectorXd&)>& f, const VectorXd& x,
@@ -149,8 +193,11 @@ DifferenceCheck CheckGradient(const std::function<double(const VectorXd&)>& f, c
 DifferenceCheck CompareCentralDifference(const VectorXd& f_plus, const VectorXd& f_minus, double h,
                                          const VectorXd& analytic, const DifferenceOptions& options) {
   const VectorXd fd = (f_plus - f_minus) / (2 * h);
-  return Verdict((fd - analytic).norm(), analytic.norm(), fd.norm(), h, std::max(f_plus.norm(), f_minus.norm()), 1,
-                 std::numeric_limits<double>::quiet_NaN(), options);
+  DifferenceCheck c =
+      Verdict((fd - analytic).norm(), analytic.norm(), fd.norm(), h, std::max(f_plus.norm(), f_minus.norm()), 1,
+              std::numeric_limits<double>::quiet_NaN(), options);
+  Judge({h}, {fd}, analytic, c.noise_floor * h, &c);
+  return c;
 }
 
 DifferenceCheck CompareCentralDifference(double f_plus, double f_minus, double h, double analytic,
@@ -161,7 +208,11 @@ DifferenceCheck CompareCentralDifference(double f_plus, double f_minus, double h
 
 ::testing::AssertionResult Passes(const DifferenceCheck& check) {
   if (std::getenv("DIFFPD_PRINT_DIFFERENCE_CHECKS")) std::cout << "[ CHECK ] " << check.Describe() << std::endl;
-  if (!check.passed()) return ::testing::AssertionFailure() << check.Describe();
+  std::cout << "[ VERDICT ] " << (check.verdict.empty() ? std::string("not judged") : check.verdict) << ", margin "
+            << Format(check.verdict_margin) << " (policy margin " << Format(check.margin()) << ", error "
+            << Format(check.error) << ", measured floor " << Format(check.measured_floor) << ", tolerance "
+            << Format(check.tolerance) << ")" << std::endl;
+  if (!check.passed() || check.verdict == "fail") return ::testing::AssertionFailure() << check.Describe();
   if (check.marginal()) std::cout << "[ MARGINAL ] " << check.Describe() << std::endl;
   return ::testing::AssertionSuccess() << check.Describe();
 }

@@ -32,10 +32,21 @@
 // A test that had its own, tighter-than-policy tolerance keeps it by passing
 // rtol, derivative_scale or floor explicitly.
 //
+// Verdict. The checks that evaluate f themselves also take differences at
+// 2h and h/2 and judge them with the gradient check's verdict
+// (JudgeDerivative, problems/tools/derivative_verdict.h) against the same
+// tolerance: the truncation of each difference measured from the larger
+// step (Richardson), its noise from the smaller one, the step of least
+// uncertainty, and "pass", "fail" (a disagreement the differences resolve)
+// or "unresolved" (the measured floor exceeds the tolerance) with the
+// margin tolerance / max(error, measured floor).
+//
 // Every check returns a DifferenceCheck stating the error, the tolerance,
 // the noise floor, a measured truncation estimate (Richardson: fd at 2h
-// against fd at h) and the margin; Passes() turns it into a gtest assertion
-// that prints all of it on failure and notes a marginal pass on stdout.
+// against fd at h), the verdict and the margin; Passes() turns it into a
+// gtest assertion (failing on an error above the tolerance or a "fail"
+// verdict) that prints all of it on failure and one line with the verdict
+// and its margin for every check.
 //
 //   const DifferenceCheck c = CheckDirectionalDerivative(energy, x, d, grad.dot(d));
 //   EXPECT_TRUE(Passes(c)) << "state " << k;
@@ -86,6 +97,14 @@ struct DifferenceCheck {
   double tolerance = 0;      // max(rtol * scale, floor)
   // |fd(2h) - fd(h)| / 3, the truncation error of fd at h (NaN: not measured).
   double truncation = std::numeric_limits<double>::quiet_NaN();
+  // The verdict from the differences at 2h, h and h/2 (at h alone, with the
+  // declared noise, when only that one was taken): "pass", "fail" or
+  // "unresolved"; empty when not judged (a zero tolerance).
+  std::string verdict;
+  double verdict_step = 0;                                           // the judged step
+  double measured_floor = std::numeric_limits<double>::quiet_NaN();  // its uncertainty (absolute)
+  // tolerance / max(the error at the judged step, measured_floor).
+  double verdict_margin = std::numeric_limits<double>::quiet_NaN();
 
   bool passed() const { return error <= tolerance; }
   // tolerance / error: how many times the error fits in the tolerance (>= 1
@@ -127,10 +146,11 @@ DifferenceCheck CompareCentralDifference(const VectorXd& f_plus, const VectorXd&
 DifferenceCheck CompareCentralDifference(double f_plus, double f_minus, double h, double analytic,
                                          const DifferenceOptions& options = DifferenceOptions());
 
-// Success when check.passed(); the failure message is check.Describe(). A
-// marginal pass prints "[ MARGINAL ] <Describe()>" on stdout; with the
-// environment variable DIFFPD_PRINT_DIFFERENCE_CHECKS set, every check prints
-// "[ CHECK ] <Describe()>" (to see the margins of a whole test).
+// Success when check.passed() and the verdict is not "fail"; the failure
+// message is check.Describe(). Every check prints "[ VERDICT ] <verdict>,
+// margin <m> ..." on stdout, a marginal pass also "[ MARGINAL ]
+// <Describe()>"; with the environment variable DIFFPD_PRINT_DIFFERENCE_CHECKS
+// set, every check prints "[ CHECK ] <Describe()>".
 ::testing::AssertionResult Passes(const DifferenceCheck& check);
 
 }  // namespace diffpd::testing

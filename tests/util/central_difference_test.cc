@@ -37,6 +37,10 @@ TEST(CentralDifferenceTest, ExactDerivativesPassWithTheirNumbersStated) {
   EXPECT_GT(along.margin(), 100.0);
   EXPECT_FALSE(along.marginal());
   EXPECT_LT(along.truncation, 1e-8);  // measured
+  // The verdict of the differences at 2h, h and h/2: resolved and agreeing.
+  EXPECT_EQ(along.verdict, "pass");
+  EXPECT_GT(along.verdict_margin, 100.0);
+  EXPECT_LT(along.measured_floor, along.tolerance);
   const DifferenceCheck jacobian = CheckJacobian(F, x, J(x));
   EXPECT_TRUE(Passes(jacobian));
   const auto g = [](const VectorXd& y) { return y(0) * y(0) * y(1); };
@@ -53,6 +57,8 @@ TEST(CentralDifferenceTest, AWrongDerivativeFailsAndSaysSo) {
   EXPECT_LT(c.margin(), 1.0);
   EXPECT_FALSE(Passes(c));
   EXPECT_EQ(c.Describe().rfind("central difference FAILS (margin ", 0), 0u) << c.Describe();
+  EXPECT_EQ(c.verdict, "fail");  // resolved: the measured floor is far below the error
+  EXPECT_LT(c.verdict_margin, 1.0);
   EXPECT_FALSE(CheckDirectionalDerivative(F, x, d, wrong * d).passed());
   // A zero derivative where there is one: the tolerance is relative to |an|
   // = 0 and the noise floor, so it fails.

@@ -1,7 +1,9 @@
 // The rollout gradient check: on a small beam, pd-lbfgs and newton-cholesky
 // at the recommended solve tolerance pass every input kind with a margin of
 // at least 10 (pd-lbfgs also against the Newton-Cholesky reference); an
-// inaccurate adjoint fails, and says against what; the reports carry the
+// inaccurate adjoint fails, and says against what; where the differences
+// cannot resolve a derivative with margin (h = 1e-5 s) the forward-mode
+// tangent decides it; the reports carry the
 // result's numbers; bad options are refused with exact messages.
 #include "tools/gradcheck.h"
 
@@ -91,6 +93,38 @@ TEST(GradCheckTest, AnInaccurateAdjointFails) {
     }
 }
 
+// At h = 1e-5 s the final velocity carries the positions' rounding times
+// 1/h, which buries the material derivatives of three steps: the
+// differences resolve the material derivatives with margins below 3 at
+// best, and the forward-mode tangent on the same states decides them (the
+// gradient agrees with it to rounding).
+TEST(GradCheckTest, TheTangentDecidesWhatTheDifferencesCannotResolve) {
+  SolverOptions options = CheckOptions(Method::kNewtonCholesky);
+  options.time_step = 1e-5;
+  GradCheckOptions check;
+  check.directions = 1;
+  const GradCheckResult r = Check(options, check);
+  EXPECT_TRUE(r.tangent);
+  EXPECT_EQ(r.verdict, CheckVerdict::kPass) << GradCheckTable(r);
+  EXPECT_GE(r.min_margin, 10.0) << GradCheckTable(r);
+  int by_tangent = 0;
+  for (const auto& e : r.inputs) {
+    EXPECT_LE(e.tangent_error, 1e-8) << e.input;  // the adjoint is exact for these states
+    if (e.basis == "tangent") {
+      ++by_tangent;
+      EXPECT_GT(e.floor, check.tolerance / 3) << e.input << ": the differences did not decide";
+      EXPECT_EQ(e.reason.rfind("differences ", 0), 0u) << e.reason;
+    }
+  }
+  EXPECT_GE(by_tangent, 1) << GradCheckTable(r);
+  // Without the tangent the differences alone (widened to 0.3 of the
+  // scale) resolve the material derivatives only barely: margins below 3.
+  check.tangent = false;
+  const GradCheckResult d = Check(options, check);
+  EXPECT_EQ(d.Count(CheckVerdict::kFail), 0) << GradCheckTable(d);
+  EXPECT_LT(d.min_margin, 3.0) << GradCheckTable(d);
+}
+
 TEST(GradCheckTest, TableAndJsonReportTheResult) {
   GradCheckOptions check;
   check.directions = 1;
@@ -102,6 +136,9 @@ TEST(GradCheckTest, TableAndJsonReportTheResult) {
   EXPECT_EQ(j.at("unresolved").get<int>(), 0);
   EXPECT_DOUBLE_EQ(j.at("inputs").at("x0").at("error").get<double>(), r.inputs[0].error);
   EXPECT_TRUE(j.at("inputs").at("x0").at("reference_error").is_null());  // not compared
+  EXPECT_DOUBLE_EQ(j.at("inputs").at("x0").at("tangent_error").get<double>(), r.inputs[0].tangent_error);
+  EXPECT_EQ(j.at("inputs").at("x0").at("basis"), "differences");
+  EXPECT_EQ(j.at("tangent"), true);
   const std::string table = GradCheckTable(r);
   EXPECT_NE(table.find("youngs_modulus"), std::string::npos) << table;
   EXPECT_NE(table.find("# newton-cholesky: pass (tolerance 0.0001; 6 pass, 0 fail, 0 unresolved"), std::string::npos)
@@ -123,6 +160,10 @@ TEST(GradCheckTest, InvalidOptionsAreRefusedWithExactMessages) {
   o.reference_rel_tolerance = 1;
   EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }),
             "reference_rel_tolerance = 1 is invalid: must be in (0, 1)");
+  o = GradCheckOptions();
+  o.decisive_margin = 0.5;
+  EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }),
+            "decisive_margin = 0.5 is invalid: must be finite and >= 1");
 }
 
 }  // namespace

@@ -91,9 +91,7 @@ TEST(StressTest, EveryExtremeCaseIsOkOrAClearSolverError) {
           if (std::find(c.gradcheck_unresolved.begin(), c.gradcheck_unresolved.end(), input) ==
               c.gradcheck_unresolved.end())
             tested_inputs.insert(input);
-        if (e == 1e6) {
-          EXPECT_TRUE(c.gradcheck_unresolved.empty()) << "a typical case resolves every input";
-        }
+        EXPECT_TRUE(c.gradcheck_unresolved.empty()) << "every input resolved, by the differences or the tangent";
       }
   // Measured: 13 of 18 ok (Newton-Cholesky 9 of 10, PD 4 of 8); the rest
   // stop at PD's iteration limit or Newton's line search at E = 1e10 Pa,
