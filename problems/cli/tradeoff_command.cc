@@ -64,6 +64,7 @@ struct TradeoffArgs {
   std::string plot;
   bool optimiser = false;
   int budget = 0;
+  std::string replot;
 };
 
 // The reduced settings of --all and --quick: four tolerances, two time-step
@@ -177,6 +178,20 @@ int RunOptimiserTradeoffArgs(const TradeoffArgs& args, const std::vector<std::st
 }
 
 int RunTradeoffArgs(const TradeoffArgs& args) {
+  if (!args.replot.empty()) {
+    if (args.plot.empty()) throw InvalidInputError("--replot needs --plot FILE.png (where to draw the report)");
+    std::ifstream in(args.replot);
+    if (!in) throw InvalidInputError("--replot " + args.replot + " is invalid: the file cannot be read");
+    nlohmann::json report;
+    try {
+      in >> report;
+    } catch (const nlohmann::json::exception& e) {
+      throw InvalidInputError("--replot " + args.replot + " is invalid: not JSON (" + e.what() + ")");
+    }
+    WriteOptimiserTradeoffPlot(OptimiserTradeoffFromJson(report), args.plot);
+    std::cerr << "[tradeoff] wrote " << args.plot << std::endl;
+    return 0;
+  }
   if (args.all == !args.problem.empty())
     throw InvalidInputError("name one problem or give --all (diffpd tradeoff --help lists the problems)");
   TradeoffOptions options = args.options;
@@ -296,6 +311,7 @@ Subcommand AddTradeoffCommand(CLI::App* parent) {
   cmd->add_option("--plot", args->plot, "write a log-log PNG of time vs. error (needs gnuplot)");
   cmd->add_flag("--optimiser", args->optimiser,
                 "the problem's own optimiser at each tolerance: wall time and final loss (see below)");
+  cmd->add_option("--replot", args->replot, "--optimiser: draw a saved <problem>_optimiser.json again (with --plot)");
   cmd->add_option("--budget", args->budget, "--optimiser: iterations of each run (0: the problem's own budget)")
       ->check(IntegerAtLeast("--budget", 0))
       ->capture_default_str();

@@ -100,36 +100,78 @@ nlohmann::json OptimiserTradeoffJson(const OptimiserTradeoff& t) {
           {"runs", rows}};
 }
 
+OptimiserTradeoff OptimiserTradeoffFromJson(const nlohmann::json& j) {
+  auto number = [](const nlohmann::json& v) {
+    return v.is_number() ? v.get<double>() : std::numeric_limits<double>::quiet_NaN();
+  };
+  try {
+    OptimiserTradeoff t;
+    t.problem = j.at("problem").get<std::string>();
+    t.optimiser = j.at("optimiser").get<std::string>();
+    t.loss = j.at("loss").get<std::string>();
+    t.method = j.at("method").get<std::string>();
+    t.default_rel_tolerance = j.at("default_rel_tolerance").get<double>();
+    t.dofs = j.at("dofs").get<int>();
+    t.steps = j.at("steps").get<int>();
+    for (const auto& r : j.at("runs")) {
+      OptimiserTradeoffRow row;
+      row.rel_tolerance = r.at("rel_tolerance").get<double>();
+      const std::string status = r.at("status").get<std::string>();
+      if (r.at("wall_s").is_null() && status.rfind("failed: ", 0) == 0) {
+        row.outcome.failure = status.substr(8);
+      } else {
+        row.outcome.status = status;
+        row.outcome.wall_s = number(r.at("wall_s"));
+        row.outcome.initial_loss = number(r.at("initial_loss"));
+        row.outcome.final_loss = number(r.at("final_loss"));
+        row.outcome.reported_loss = number(r.at("reported_loss"));
+        row.outcome.constraint_violation = number(r.at("constraint_violation"));
+      }
+      row.outcome.evaluations = r.at("evaluations").get<long>();
+      row.outcome.iterations = r.at("iterations").get<int>();
+      row.shortfall = number(r.at("shortfall"));
+      t.rows.push_back(row);
+    }
+    return t;
+  } catch (const nlohmann::json::exception& e) {
+    throw InvalidInputError(std::string("optimiser trade-off report: ") + e.what());
+  }
+}
+
 void WriteOptimiserTradeoffPlot(const OptimiserTradeoff& t, const std::string& png_path) {
   if (!GnuplotAvailable())
     throw std::runtime_error(
         "the optimiser trade-off plot needs the gnuplot program, which is not on PATH (Debian: apt-get install "
         "gnuplot-nox)");
+  constexpr double kZero = 1e-16;  // where a shortfall of 0 is drawn
   std::ostringstream data, marked;
+  data.precision(17);
+  marked.precision(17);
   int n = 0;
   for (const auto& r : t.rows) {
-    if (!r.outcome.ok() || !std::isfinite(r.outcome.final_loss)) continue;
-    std::ostringstream label;
+    if (!r.outcome.ok() || !std::isfinite(r.shortfall)) continue;
+    std::ostringstream line;
+    line.precision(17);
+    std::ostringstream label;  // default precision: 1e-04, 0.01
     label << r.rel_tolerance;
-    const std::string line =
-        std::to_string(r.outcome.wall_s) + " " + std::to_string(r.outcome.final_loss) + " \"" + label.str() + "\"\n";
-    data << line;
-    if (r.rel_tolerance == t.default_rel_tolerance) marked << line;
+    line << r.outcome.wall_s << " " << std::max(r.shortfall, kZero) << " \"" << label.str() << "\"\n";
+    data << line.str();
+    if (r.rel_tolerance == t.default_rel_tolerance) marked << line.str();
     ++n;
   }
-  if (n == 0) throw std::runtime_error("nothing to plot: every optimiser run failed");
+  if (n == 0) throw std::runtime_error("nothing to plot: no optimiser run improved on the start");
   std::ostringstream script;
   script << "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) { set terminal pngcairo size 800,550 } else { set "
             "terminal png size 800,550 }\n";
   script << "set output " << GnuplotQuote(png_path) << "\n";
-  script << "set logscale x\nset grid\nset key below\n";
+  script << "set logscale xy\nset format y '10^{%L}'\nset grid\nset key below\n";
   script << "set title " << GnuplotQuote("diffpd tradeoff --optimiser: " + t.problem + " (" + t.method + ")") << "\n";
   script << "set xlabel 'wall time of the whole optimisation (s)'\n";
-  script << "set ylabel " << GnuplotQuote("final loss, re-evaluated converged") << "\n";
+  script << "set ylabel " << GnuplotQuote("shortfall of the converged final loss (0 drawn at 1e-16)") << "\n";
   script << "$runs << EOD\n" << data.str() << "EOD\n";
   script << "$default << EOD\n" << marked.str() << "EOD\n";
-  script << "plot $runs using 1:2 with linespoints pt 7 title 'one run per rel\\_tolerance', "
-            "$runs using 1:2:3 with labels offset 1,1 font ',9' notitle";
+  script << "plot $runs using 1:2 with points pt 7 ps 1.5 title 'one run per rel\\_tolerance (labelled)', "
+            "$runs using 1:2:3 with labels offset 0,1 font ',9' notitle";
   if (!marked.str().empty()) script << ", $default using 1:2 with points pt 6 ps 3 lw 2 title 'default'";
   script << "\n";
   RunGnuplot(script.str(), png_path);

@@ -58,10 +58,14 @@ OptimiserTradeoff RunOptimiserTradeoff(const ProblemObjective& objective, const 
 
 nlohmann::json OptimiserTradeoffJson(const OptimiserTradeoff& tradeoff);
 
-// Final loss (converged re-evaluation) against wall time, one point per
-// tolerance, labelled, the default's tolerance marked; log-scaled time.
-// Needs gnuplot (GnuplotAvailable); throws std::runtime_error when the plot
-// cannot be written.
+// The report OptimiserTradeoffJson wrote, read back (to re-plot it).
+// Throws InvalidInputError naming what is missing or mistyped.
+OptimiserTradeoff OptimiserTradeoffFromJson(const nlohmann::json& report);
+
+// Shortfall (0 drawn at 1e-16) against wall time, log-log, one labelled
+// point per tolerance, the default's tolerance marked. Needs gnuplot
+// (GnuplotAvailable); throws std::runtime_error when the plot cannot be
+// written or no run improved on the start.
 void WriteOptimiserTradeoffPlot(const OptimiserTradeoff& tradeoff, const std::string& png_path);
 
 }  // namespace diffpd::problems

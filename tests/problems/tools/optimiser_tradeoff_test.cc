@@ -41,6 +41,16 @@ TEST(OptimiserTradeoffTest, ConvergedReevaluationMatchesATightRunAndShortfallsAr
   int best = 0;
   for (const auto& r : t.rows) best += r.shortfall == 0;
   EXPECT_GE(best, 1);
+  // The JSON report reads back to the same numbers.
+  const OptimiserTradeoff back = OptimiserTradeoffFromJson(OptimiserTradeoffJson(t));
+  ASSERT_EQ(back.rows.size(), t.rows.size());
+  EXPECT_EQ(back.problem, t.problem);
+  EXPECT_EQ(back.default_rel_tolerance, t.default_rel_tolerance);
+  for (size_t i = 0; i < t.rows.size(); ++i) {
+    EXPECT_EQ(back.rows[i].outcome.final_loss, t.rows[i].outcome.final_loss);
+    EXPECT_EQ(back.rows[i].outcome.evaluations, t.rows[i].outcome.evaluations);
+    EXPECT_EQ(back.rows[i].shortfall, t.rows[i].shortfall);
+  }
 }
 
 TEST(OptimiserTradeoffTest, RejectsForwardScenesAndBadTolerancesWithExactMessages) {
@@ -54,6 +64,8 @@ TEST(OptimiserTradeoffTest, RejectsForwardScenesAndBadTolerancesWithExactMessage
                        "tolerances is empty: give at least one relative tolerance");
   EXPECT_THROW_MESSAGE(RunOptimiserTradeoff(quadruped, {1e-4, 1.5}, {}, nullptr), InvalidInputError,
                        "tolerance = 1.5 is invalid: must be in (0, 1)");
+  EXPECT_THROW_MESSAGE(OptimiserTradeoffFromJson(nlohmann::json{{"problem", "cow"}}), InvalidInputError,
+                       "optimiser trade-off report: [json.exception.out_of_range.403] key 'optimiser' not found");
 }
 
 }  // namespace
