@@ -146,12 +146,17 @@ bool SameMaterial(const MaterialParameters& a, const MaterialParameters& b) {
 
 }  // namespace
 
+bool MadeWithCurrentSettings(const SimulatorImpl& sim, const MaterialParameters& material,
+                             const std::vector<MaterialParameters>& region_materials, const SolverOptions& options) {
+  if (!SameMaterial(material, sim.scene.material)) return false;
+  if (region_materials.size() != sim.scene.material_regions.size()) return false;
+  for (size_t r = 0; r < region_materials.size(); ++r)
+    if (!SameMaterial(region_materials[r], sim.scene.material_regions[r].material)) return false;
+  return options.time_step == sim.h() && options.method == sim.options.method;
+}
+
 bool MadeWithCurrentSettings(const SimulatorImpl& sim, const Rollout& rollout) {
-  if (!SameMaterial(rollout.material, sim.scene.material)) return false;
-  if (rollout.region_materials.size() != sim.scene.material_regions.size()) return false;
-  for (size_t r = 0; r < rollout.region_materials.size(); ++r)
-    if (!SameMaterial(rollout.region_materials[r], sim.scene.material_regions[r].material)) return false;
-  return rollout.options.time_step == sim.h() && rollout.options.method == sim.options.method;
+  return MadeWithCurrentSettings(sim, rollout.material, rollout.region_materials, rollout.options);
 }
 
 VectorXd GravityPerDof(const SimulatorImpl& sim) {

@@ -123,6 +123,9 @@ class SimulatorImpl {
 // True when `rollout` was made with the simulator's current materials (base
 // and regions), time step and method: the condition of Backward and Tangents.
 bool MadeWithCurrentSettings(const SimulatorImpl& sim, const Rollout& rollout);
+// The same for a rollout's recorded materials and options.
+bool MadeWithCurrentSettings(const SimulatorImpl& sim, const MaterialParameters& material,
+                             const std::vector<MaterialParameters>& region_materials, const SolverOptions& options);
 // Gravity's acceleration at every DoF (3n, m/s^2; zero without gravity).
 VectorXd GravityPerDof(const SimulatorImpl& sim);
 
