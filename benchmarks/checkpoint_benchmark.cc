@@ -237,9 +237,9 @@ const CaseResult* Find(const BenchmarkResult& r, const std::string& mode, int ho
 void PrintTable(const BenchmarkResult& r, std::ostream& os) {
   const double mib = 1024.0 * 1024.0;
   char line[512];
-  os << "cantilever (" << r.baseline.dofs << " DoFs), pd-lbfgs rtol " << r.settings.rtol << ", "
-     << r.settings.threads << " threads, " << r.settings.checkpoints << " checkpoints; baseline peak RSS "
-     << r.baseline.peak_rss_bytes / mib << " MiB\n";
+  os << "cantilever (" << r.baseline.dofs << " DoFs), pd-lbfgs rtol " << r.settings.rtol << ", " << r.settings.threads
+     << " threads, " << r.settings.checkpoints << " checkpoints; baseline peak RSS " << r.baseline.peak_rss_bytes / mib
+     << " MiB\n";
   os << "| mode | steps | ms/step | forward s | backward s | recomputed | states held | state MiB | peak RSS MiB | "
         "RSS - baseline MiB |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const CaseResult& c : r.cases) {
@@ -278,9 +278,9 @@ void PrintTable(const BenchmarkResult& r, std::ostream& os) {
 
 json ToJson(const BenchmarkResult& r) {
   json j;
-  j["settings"] = {{"horizons", r.settings.horizons}, {"modes", r.settings.modes},
-                   {"checkpoints", r.settings.checkpoints}, {"threads", r.settings.threads},
-                   {"rtol", r.settings.rtol}, {"refine", r.settings.refine}};
+  j["settings"] = {
+      {"horizons", r.settings.horizons}, {"modes", r.settings.modes}, {"checkpoints", r.settings.checkpoints},
+      {"threads", r.settings.threads},   {"rtol", r.settings.rtol},   {"refine", r.settings.refine}};
   j["baseline"] = ToJson(r.baseline);
   j["cases"] = json::array();
   for (const CaseResult& c : r.cases) j["cases"].push_back(ToJson(c));

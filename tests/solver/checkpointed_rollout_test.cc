@@ -139,11 +139,10 @@ void CheckIdenticalGradients(const Scene& scene, const SolverOptions& options, c
   CheckpointOptions c;
   c.num_checkpoints = checkpoints;
   std::vector<State> observed;
-  const CheckpointedRollout r =
-      sim.SimulateCheckpointed(start, inputs, c, [&observed](int k, const State& s) {
-        EXPECT_EQ(k, static_cast<int>(observed.size()));
-        observed.push_back(s);
-      });
+  const CheckpointedRollout r = sim.SimulateCheckpointed(start, inputs, c, [&observed](int k, const State& s) {
+    EXPECT_EQ(k, static_cast<int>(observed.size()));
+    observed.push_back(s);
+  });
   ASSERT_EQ(static_cast<int>(observed.size()), steps + 1);
   for (int k = 0; k <= steps; ++k) ASSERT_EQ(observed[k].x, stored.states[k].x) << what << " state " << k;
   EXPECT_EQ(r.final.x, stored.states.back().x) << what;
@@ -270,8 +269,8 @@ TEST(CheckpointedRolloutTest, BadCheckpointsAndLossesAreRejectedWithTheirMessage
   Simulator sim(scene, testing::TightOptions(Method::kPd));
   CheckpointOptions none;
   none.num_checkpoints = 0;
-  ASSERT_THROW_MESSAGE(sim.SimulateCheckpointed(sim.RestState(), std::vector<StepInput>(3), none),
-                       InvalidInputError, "checkpoint options: num_checkpoints = 0 is invalid: must be >= 1");
+  ASSERT_THROW_MESSAGE(sim.SimulateCheckpointed(sim.RestState(), std::vector<StepInput>(3), none), InvalidInputError,
+                       "checkpoint options: num_checkpoints = 0 is invalid: must be >= 1");
   CheckpointOptions two;
   two.num_checkpoints = 2;
   const CheckpointedRollout r = sim.SimulateCheckpointed(sim.RestState(), std::vector<StepInput>(9), two);

@@ -5,7 +5,7 @@
 // The checkpoints follow the binomial schedule of Griewank's "revolve": with
 // c checkpoints, a horizon of K steps is reversed with every step recomputed
 // at most t times, t the least integer with (c + t)! / (c! t!) >= K (c = 48:
-// t = 2 up to 1224 steps, t = 3 up to 20825). The recomputed steps repeat the
+// t = 2 up to 1225 steps, t = 3 up to 20825). The recomputed steps repeat the
 // forward's solves exactly (same states, options and initial guesses), so the
 // gradients are those of the stored rollout (Simulator::Simulate) bit for bit
 // wherever the backward itself is deterministic (a fixed
@@ -35,17 +35,17 @@ struct CheckpointOptions {
 
 // A forward rollout of K steps of which only the checkpoints are kept.
 struct CheckpointedRollout {
-  State initial;                     // x_0, v_0
-  State final;                       // x_K, v_K
+  State initial;                      // x_0, v_0
+  State final;                        // x_K, v_K
   std::vector<int> checkpoint_steps;  // ascending, in (0, K)
-  std::vector<State> checkpoints;    // the states at those steps
+  std::vector<State> checkpoints;     // the states at those steps
   // The report of the step that reached each checkpoint, and of the last
   // step (frictional contact's active sets, the residuals the adjoint
   // tolerance follows).
   std::vector<StepReport> checkpoint_reports;
   StepReport final_report;
-  std::vector<StepInput> inputs;     // K inputs, as given (empty ones cost nothing)
-  MaterialParameters material;       // the base material (Scene::material)
+  std::vector<StepInput> inputs;  // K inputs, as given (empty ones cost nothing)
+  MaterialParameters material;    // the base material (Scene::material)
   // One per Scene::material_regions entry, in order (empty without regions).
   std::vector<MaterialParameters> region_materials;
   SolverOptions options;  // the forward's; recomputed steps use them again

@@ -10,6 +10,7 @@
 // for every step, iteration and rollout). It is not thread-safe; use one per thread.
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -155,6 +156,10 @@ class Simulator {
   // pays per (mesh, h, material weights, Dirichlet set), shared by every
   // iteration, step and rollout after it.
   double pd_factorization_seconds() const;
+  // Bytes of the PD factor's copy for parallel solves in use: 0 before a PD
+  // method has stepped, or where the copy would exceed
+  // SolverOptions::pd_factor_copy_max_bytes and CHOLMOD solves instead.
+  std::size_t pd_factor_copy_bytes() const;
 
  private:
   // Backward after the rollout's checks, with an optional controller

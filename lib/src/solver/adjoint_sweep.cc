@@ -10,9 +10,8 @@
 
 namespace diffpd::internal {
 
-AdjointSweep::AdjointSweep(SimulatorImpl& sim, int steps, const SolverOptions& forward_options,
-                           const VectorXd& dx_last, const VectorXd& dv_last, const Controller* controller,
-                           bool keep_step_gradients)
+AdjointSweep::AdjointSweep(SimulatorImpl& sim, int steps, const SolverOptions& forward_options, const VectorXd& dx_last,
+                           const VectorXd& dv_last, const Controller* controller, bool keep_step_gradients)
     : sim_(sim),
       forward_rel_tolerance_(forward_options.rel_tolerance),
       controller_(controller),

@@ -111,6 +111,8 @@ int Simulator::num_pd_factorizations() const {
 
 double Simulator::pd_factorization_seconds() const { return impl_->pd_factorization_seconds(); }
 
+std::size_t Simulator::pd_factor_copy_bytes() const { return impl_->pd_factor_copy_bytes(); }
+
 State Simulator::Step(const State& state, const StepInput& input, StepReport* report) {
   SimulatorImpl& sim = *impl_;
   const int n = sim.num_dofs();

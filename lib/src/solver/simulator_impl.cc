@@ -112,6 +112,7 @@ PdSystem& SimulatorImpl::pd_system() {
     weights.push_back(scale * elastic.PdWeight(m.mu(), m.lambda()));
   }
   pd_->SetSolveThreads(threads() > 0 ? threads() : omp_get_max_threads());
+  pd_->SetCopyMaxBytes(options.pd_factor_copy_max_bytes);
   pd_->Update(h(), densities, weights);
   return *pd_;
 }

@@ -106,6 +106,7 @@ class SimulatorImpl {
   void ResetAdjointCostModels();
   int pd_factorizations() const { return pd_ ? pd_->num_factorizations() : 0; }
   double pd_factorization_seconds() const { return pd_ ? pd_->factorization_seconds() : 0.0; }
+  std::size_t pd_factor_copy_bytes() const { return pd_ ? pd_->copy_bytes() : 0; }
 
  private:
   void MaterialsChanged();
