@@ -62,6 +62,8 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/cli/table_command.cc)
 # calibration: system identification with Ceres
 set(DIFFPD_PROBLEMS_CALIBRATION_SOURCES
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/iteration_table.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/material_fit_settings.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_problem.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_cantilever.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_plant.cc
@@ -73,6 +75,9 @@ set(DIFFPD_PROBLEMS_CALIBRATION_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_trace.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_fit.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_starfish.cc
+  # calibration over several recordings (a rollout set)
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/plant_recordings.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/rollout_set_fit.cc
   # the swimmers' L-BFGS training
   ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_lbfgs.cc)
 # control: trajectory and control optimisation with Ipopt

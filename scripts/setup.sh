@@ -11,7 +11,7 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(g++ make cmake pkg-config libeigen3-dev libsuitesparse-dev libmetis-dev libceres-dev
           coinor-libipopt-dev libgtest-dev libgmock-dev libomp-dev libcli11-dev nlohmann-json3-dev
-          gnuplot-nox tetgen clang-format git)
+          gnuplot-nox tetgen clang-format git libopenmpi-dev openmpi-bin)
 
 say() { echo "setup: $*" >&2; }
 

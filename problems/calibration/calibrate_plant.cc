@@ -67,13 +67,14 @@ Scene PlantCalibration::MakeScene() const {
   return scene;
 }
 
-State PlantCalibration::InitialState(const Simulator& sim) const {
+State PlantCalibration::InitialState(const Simulator& sim) const { return GustState(sim, Vec3(0.3, 0.15, 0)); }
+
+State PlantCalibration::GustState(const Simulator& sim, const Vec3& gust) {
   State s = sim.RestState();
   const Mesh& mesh = sim.scene().mesh;
   const double z0 = LowestZ(mesh);
   const double height = mesh.vertices.row(2).maxCoeff() - z0;
-  for (int i = 0; i < mesh.num_vertices(); ++i)
-    s.v.segment<3>(3 * i) = Vec3(0.3, 0.15, 0) * (mesh.vertices(2, i) - z0) / height;
+  for (int i = 0; i < mesh.num_vertices(); ++i) s.v.segment<3>(3 * i) = gust * (mesh.vertices(2, i) - z0) / height;
   for (int d : sim.scene().dirichlet.dofs) s.v(d) = 0;
   return s;
 }

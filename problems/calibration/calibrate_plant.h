@@ -40,6 +40,10 @@ class PlantCalibration : public CalibrationProblem {
   // The plant mesh (see the file comment); throws what SharedDataPath and
   // ReadObj throw.
   static Mesh PlantMesh();
+  // At rest with the velocity gust * (height above the lowest node / plant
+  // height) (m/s), zero at the clamped nodes; InitialState's gust is
+  // (0.3, 0.15, 0).
+  static State GustState(const Simulator& sim, const Vec3& gust);
 };
 
 }  // namespace diffpd::problems

@@ -10,10 +10,11 @@
 
 #include <ceres/ceres.h>
 
+#include "calibration/iteration_table.h"
+#include "calibration/material_fit_settings.h"
 #include "cli/commands.h"
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
-#include "diffpd/solvers/ceres/coordinate_manifold.h"
 #include "diffpd/solvers/ceres/rollout_cost_function.h"
 #include "diffpd/solvers/ceres/rollout_evaluation_callback.h"
 #include "diffpd/solvers/core/marker_residuals.h"
@@ -39,33 +40,6 @@ double Value(const MaterialParameters& m, MaterialField p) {
   }
   return 0;
 }
-
-// Ceres' iteration table with the current parameter values appended.
-class IterationTable : public ceres::IterationCallback {
- public:
-  IterationTable(FILE* log, const std::vector<MaterialField>& fitted, const double* block)
-      : log_(log), fitted_(fitted), block_(block) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    if (s.iteration == 0) {
-      std::fprintf(log_, "%4s %13s %11s %11s %11s %10s %9s %9s", "iter", "cost", "cost_change", "|gradient|", "|step|",
-                   "tr_radius", "iter_time", "total_t");
-      for (MaterialField p : fitted_) std::fprintf(log_, " %14s", ToString(p));
-      std::fprintf(log_, "\n");
-    }
-    std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %11.3e %10.3e %9.2e %9.2e", s.iteration, s.cost, s.cost_change,
-                 s.gradient_max_norm, s.step_norm, s.trust_region_radius, s.iteration_time_in_seconds,
-                 s.cumulative_time_in_seconds);
-    for (size_t i = 0; i < fitted_.size(); ++i) std::fprintf(log_, " %14.6g", block_[i]);
-    std::fprintf(log_, "%s\n", s.step_is_successful || s.iteration == 0 ? "" : "  (rejected)");
-    std::fflush(log_);
-    return ceres::SOLVER_CONTINUE;
-  }
-
- private:
-  FILE* log_;
-  std::vector<MaterialField> fitted_;
-  const double* block_;
-};
 
 std::string Stem(const std::string& file) {
   const size_t dot = file.rfind('.');
@@ -262,30 +236,8 @@ CalibrationFit CalibrationProblem::Fit(const CapturedMotion& motion, Method meth
   problem_options.evaluation_callback = &callback;
   ceres::Problem problem(problem_options);
   const size_t frames = solvers::AddMarkerResidualBlocks(&problem, &function, markers, {block.data()}).size();
-  // E and rho step in log space; nu linearly within bounds [0.01, 0.49].
-  std::vector<solvers::CoordinateMap> maps;
-  for (size_t i = 0; i < fields.size(); ++i) {
-    if (fields[i] == MaterialField::kPoissonsRatio) {
-      maps.push_back(solvers::CoordinateMap::Linear());
-    } else {
-      maps.push_back(solvers::CoordinateMap::Log());
-    }
-  }
-  problem.SetManifold(block.data(), new solvers::CoordinateManifold(maps));
-  for (size_t i = 0; i < fields.size(); ++i)
-    if (fields[i] == MaterialField::kPoissonsRatio) {
-      problem.SetParameterLowerBound(block.data(), static_cast<int>(i), 0.01);
-      problem.SetParameterUpperBound(block.data(), static_cast<int>(i), 0.49);
-    }
-
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
-  options.max_num_iterations = max_iterations;
-  options.function_tolerance = 1e-9;   // above the forward solves' noise
-  options.parameter_tolerance = 1e-6;  // relative: far below the noise's effect
-  options.gradient_tolerance = 1e-14;
-  options.update_state_every_iteration = true;
-  options.logging_type = ceres::SILENT;
+  SetMaterialCoordinates(&problem, block.data(), fields);
+  ceres::Solver::Options options = MaterialFitOptions(max_iterations);
   IterationTable table(log, fields, block.data());
   if (log) {
     options.callbacks.push_back(&table);

@@ -10,6 +10,7 @@ diffpd_add_test(gradcheck_test ${_dir}/tools/gradcheck_test.cc LIBS diffpd_probl
 if(TARGET diffpd_ceres)
   diffpd_add_test(calibrate_cantilever_test ${_dir}/calibration/calibrate_cantilever_test.cc LIBS diffpd_problems)
   diffpd_add_test(calibrate_plant_test ${_dir}/calibration/calibrate_plant_test.cc LIBS diffpd_problems)
+  diffpd_add_test(plant_recordings_test ${_dir}/calibration/plant_recordings_test.cc LIBS diffpd_problems)
   diffpd_add_test(calibrate_bouncing_ball_test ${_dir}/calibration/calibrate_bouncing_ball_test.cc LIBS diffpd_problems)
   diffpd_add_test(calibrate_starfish_test ${_dir}/calibration/calibrate_starfish_test.cc LIBS diffpd_problems)
 endif()
