@@ -58,7 +58,8 @@ TEST(FactorCopyTest, EstimateBoundsTheCopyAndALimitBelowItLeavesNoCopy) {
     copied.set_solve_threads(2);
     ASSERT_TRUE(copied.Factorize(a));
     ASSERT_NE(copied.parallel_copy(), nullptr);
-    const double estimate = internal::ParallelTriangularSolve::EstimatedBytes(static_cast<int>(a.rows()), copied.factor_nonzeros());
+    const double estimate =
+        internal::ParallelTriangularSolve::EstimatedBytes(static_cast<int>(a.rows()), copied.factor_nonzeros());
     EXPECT_GE(estimate, static_cast<double>(copied.parallel_copy()->bytes()));
     EXPECT_LE(estimate, 2.0 * static_cast<double>(copied.parallel_copy()->bytes()));
     internal::CholmodSolver lean(layout, CholmodOrdering::kNestedDissection, CholmodSolveKernel::kParallelCopy);
@@ -67,7 +68,8 @@ TEST(FactorCopyTest, EstimateBoundsTheCopyAndALimitBelowItLeavesNoCopy) {
     ASSERT_TRUE(lean.Factorize(a));
     EXPECT_EQ(lean.parallel_copy(), nullptr);
     std::mt19937_64 rng(1);
-    const MatrixXd b = MatrixXd::NullaryExpr(a.rows(), 3, [&rng]() { return std::uniform_real_distribution<double>(-1, 1)(rng); });
+    const MatrixXd b =
+        MatrixXd::NullaryExpr(a.rows(), 3, [&rng]() { return std::uniform_real_distribution<double>(-1, 1)(rng); });
     const MatrixXd x = copied.Solve(b), y = lean.Solve(b);
     EXPECT_LT((x - y).norm() / x.norm(), 1e-13);
   }
