@@ -195,6 +195,16 @@ struct SolverOptions {
   // - x_i) / h. > 1; infinity: only a non-finite state is an error.
   double max_extent_ratio = 1e3;
 
+  // PD methods solve with their factor of A through a copy of it laid out
+  // for parallel triangular solves (twice L's entries: about 20 bytes per
+  // entry, 1.2 GiB for a 421 k-DoF cantilever). When that copy's estimated
+  // size exceeds this many bytes the copy is not made and CHOLMOD's own
+  // solves serve instead (the same solutions to rounding; slower on two or
+  // more threads, serial). 0 (default): half the physical memory free when
+  // the factor is made (sysconf's available pages). >= 0.
+  // Simulator::pd_factor_copy_bytes() says which path is in use.
+  double pd_factor_copy_max_bytes = 0;
+
   // Threads for the element loops and PD's triangular solves (0: OpenMP's
   // default), at most MaxSolverThreads(). Never changes the process-wide
   // OpenMP setting. Results do not depend on it beyond rounding (the solves'

@@ -1,5 +1,7 @@
 #include "solver/cholmod_solver.h"
 
+#include <unistd.h>
+
 #include <omp.h>
 
 #include <chrono>
@@ -106,6 +108,10 @@ void CholmodSolver::MakeCopy() {
   const cholmod_factor* f = impl_->With(layout_, [](auto& llt) { return llt.factor(); });
   if (f == nullptr || !f->is_ll || f->xtype != CHOLMOD_REAL || f->itype != CHOLMOD_INT) return;
   const int n = static_cast<int>(f->n);
+  double limit = copy_max_bytes_;
+  if (limit <= 0)
+    limit = 0.5 * static_cast<double>(sysconf(_SC_AVPHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+  if (ParallelTriangularSolve::EstimatedBytes(n, factor_nonzeros()) > limit) return;  // the lean path: CHOLMOD solves
   std::vector<int> node_of_column;
   if (f->is_super) {
     node_of_column.resize(n);
