@@ -1,11 +1,15 @@
 // Checkpointed rollouts (checkpointed_rollout.h): the binomial schedule's
 // bounds (every step advanced at most t times, at most c checkpoints held),
-// gradients bit-identical to the stored rollout's (muscles, state forces,
-// frictional contact, horizons not a multiple of anything), the streaming
-// loss form, the memory bound, and the input checks' messages.
+// gradients bit-identical to those of a stored rollout with cold SVDs
+// (SolverOptions::svd_warm_start = false; muscles, state forces, frictional
+// contact, horizons not a multiple of anything) and equal to the default
+// (warm) stored rollout's to rounding, the streaming loss form, the memory
+// bound, and the input checks' messages.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <functional>
 #include <random>
 
@@ -127,15 +131,42 @@ LossGradient SomeLoss(int n, int steps, unsigned seed) {
   return loss;
 }
 
-// Simulate + Backward (and Tangents) against SimulateCheckpointed + Backward
-// (and Tangents) on one scene.
+// ||a - b|| / ||b|| over the initial state's gradient, the material's and the
+// per-step forces'.
+double RelativeGradientDifference(const RolloutGradient& a, const RolloutGradient& b) {
+  double diff = (a.x0 - b.x0).squaredNorm() + (a.v0 - b.v0).squaredNorm();
+  double norm = b.x0.squaredNorm() + b.v0.squaredNorm();
+  for (const auto& [p, q] : {std::pair{a.youngs_modulus, b.youngs_modulus}, std::pair{a.density, b.density}}) {
+    diff += (p - q) * (p - q);
+    norm += q * q;
+  }
+  for (size_t k = 0; k < a.external_force.size(); ++k) {
+    diff += (a.external_force[k] - b.external_force[k]).squaredNorm();
+    norm += b.external_force[k].squaredNorm();
+  }
+  return std::sqrt(diff / norm);
+}
+
+// Simulate + Backward (and Tangents) with cold SVDs against
+// SimulateCheckpointed + Backward (and Tangents) on one scene: bit for bit;
+// against the default stored rollout (warm SVDs): within `warm_tolerance`
+// (relative), the forward's solves stopping at their tolerance from other
+// rounding.
 void CheckIdenticalGradients(const Scene& scene, const SolverOptions& options, const State& start,
-                             const std::vector<StepInput>& inputs, int checkpoints, const std::string& what) {
-  Simulator sim(scene, options);
+                             const std::vector<StepInput>& inputs, int checkpoints, const std::string& what,
+                             double warm_tolerance) {
+  ASSERT_TRUE(options.svd_warm_start);
+  SolverOptions cold = options;
+  cold.svd_warm_start = false;
+  Simulator sim(scene, cold);
   const int steps = static_cast<int>(inputs.size());
   const Rollout stored = sim.Simulate(start, inputs);
   const LossGradient loss = SomeLoss(sim.num_dofs(), steps, 7);
   const RolloutGradient expected = sim.Backward(stored, loss);
+  Simulator warm_sim(scene, options);
+  const RolloutGradient warm = warm_sim.Backward(warm_sim.Simulate(start, inputs), loss);
+  // The checkpointed rollout runs cold whatever the simulator's option.
+  sim.SetOptions(options);
   CheckpointOptions c;
   c.num_checkpoints = checkpoints;
   std::vector<State> observed;
@@ -147,8 +178,13 @@ void CheckIdenticalGradients(const Scene& scene, const SolverOptions& options, c
   for (int k = 0; k <= steps; ++k) ASSERT_EQ(observed[k].x, stored.states[k].x) << what << " state " << k;
   EXPECT_EQ(r.final.x, stored.states.back().x) << what;
   EXPECT_LE(static_cast<int>(r.checkpoints.size()), checkpoints) << what;
+  EXPECT_TRUE(sim.options().svd_warm_start) << what;
+  EXPECT_FALSE(r.options.svd_warm_start) << what;
   const RolloutGradient g = sim.Backward(r, loss);
   ExpectIdentical(g, expected, what);
+  const double warm_difference = RelativeGradientDifference(g, warm);
+  EXPECT_LT(warm_difference, warm_tolerance) << what;
+  std::printf("%s: checkpointed vs warm stored gradient, relative difference %.2e\n", what.c_str(), warm_difference);
   // Forward mode: the same tangents as over the stored rollout, kept or streamed.
   InputDirection e = InputDirection::YoungsModulus();
   InputDirection v0;
@@ -203,7 +239,7 @@ TEST(CheckpointedRolloutTest, MuscleBeamGradientsAreBitIdenticalToTheStoredRollo
     const State start = testing::MovingStart(probe);
     for (int c : method == Method::kPdLbfgs ? std::vector<int>{2, 5, 48} : std::vector<int>{3})
       CheckIdenticalGradients(scene, options, start, inputs, c,
-                              std::string(ToString(method)) + ", " + std::to_string(c) + " checkpoints");
+                              std::string(ToString(method)) + ", " + std::to_string(c) + " checkpoints", 1e-9);
   }
 }
 
@@ -229,7 +265,7 @@ TEST(CheckpointedRolloutTest, FrictionalContactGradientsAreBitIdenticalToTheStor
     for (const StepReport& r : stored.reports) contact_steps += !r.contact_nodes.empty();
     ASSERT_GE(contact_steps, 5) << ToString(method);
     CheckIdenticalGradients(scene, options, start, std::vector<StepInput>(steps), 2,
-                            std::string(ToString(method)) + " on contact");
+                            std::string(ToString(method)) + " on contact", 1e-9);
   }
 }
 
@@ -293,6 +329,14 @@ TEST(CheckpointedRolloutTest, BadCheckpointsAndLossesAreRejectedWithTheirMessage
   ASSERT_THROW_MESSAGE(sim.Backward(r, bad), InvalidInputError,
                        "Backward: the loss's dL/dx_3 has 5 entries, expected 0 or " + std::to_string(sim.num_dofs()) +
                            " finite ones (3 x number of nodes)");
+  CheckpointedRollout warm = r;
+  warm.options.svd_warm_start = true;
+  ASSERT_THROW_MESSAGE(sim.Backward(warm, LossGradient(9)), InvalidInputError,
+                       "Backward: the checkpointed rollout's options have svd_warm_start = true; its steps cannot be "
+                       "recomputed bit for bit (SimulateCheckpointed sets it false)");
+  ASSERT_THROW_MESSAGE(sim.Tangents(warm, {InputDirection::YoungsModulus()}), InvalidInputError,
+                       "Tangents: the checkpointed rollout's options have svd_warm_start = true; its steps cannot be "
+                       "recomputed bit for bit (SimulateCheckpointed sets it false)");
   SolverOptions other = sim.options();
   other.time_step = 0.02;
   sim.SetOptions(other);

@@ -28,7 +28,7 @@ TEST(FactorCopyTest, LeanPathSkipsTheCopyAndGivesTheSameStepsAndGradients) {
     SolverOptions options = testing::TightOptions(method);
     options.num_threads = 2;
     Simulator copied(scene, options);
-    options.pd_factor_copy_max_bytes = 1;  // no copy fits
+    options.pd_factor_copy_max_bytes = 0;  // never a copy
     Simulator lean(scene, options);
     EXPECT_EQ(copied.pd_factor_copy_bytes(), 0u);  // no PD step yet
     const State start = testing::MovingStart(copied);
@@ -76,8 +76,8 @@ TEST(FactorCopyTest, EstimateBoundsTheCopyAndALimitBelowItLeavesNoCopy) {
   SolverOptions options;
   options.pd_factor_copy_max_bytes = -1;
   ASSERT_THROW_MESSAGE(options.Validate(), InvalidInputError,
-                       "solver options: pd_factor_copy_max_bytes = -1 is invalid: must be finite and >= 0 (0: "
-                       "automatic)");
+                       "solver options: pd_factor_copy_max_bytes = -1 is invalid: must be >= 0 (0: never a copy, "
+                       "infinity: always)");
 }
 
 }  // namespace

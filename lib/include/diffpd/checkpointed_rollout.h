@@ -6,10 +6,13 @@
 // c checkpoints, a horizon of K steps is reversed with every step recomputed
 // at most t times, t the least integer with (c + t)! / (c! t!) >= K (c = 48:
 // t = 2 up to 1225 steps, t = 3 up to 20825). The recomputed steps repeat the
-// forward's solves exactly (same states, options and initial guesses), so the
-// gradients are those of the stored rollout (Simulator::Simulate) bit for bit
-// wherever the backward itself is deterministic (a fixed
-// SolverOptions::adjoint_solver; kAuto picks solvers by measured times).
+// forward's solves exactly (same states, options and initial guesses; every
+// step's SVDs start cold, SolverOptions::svd_warm_start = false), so the
+// gradients are those of a stored rollout (Simulator::Simulate) made with
+// svd_warm_start = false bit for bit wherever the backward itself is
+// deterministic (a fixed SolverOptions::adjoint_solver; kAuto picks solvers
+// by measured times), and those of the default (warm) stored rollout to
+// rounding.
 #pragma once
 
 #include <functional>
@@ -48,7 +51,9 @@ struct CheckpointedRollout {
   MaterialParameters material;    // the base material (Scene::material)
   // One per Scene::material_regions entry, in order (empty without regions).
   std::vector<MaterialParameters> region_materials;
-  SolverOptions options;  // the forward's; recomputed steps use them again
+  // The forward's, with svd_warm_start false whatever the simulator's;
+  // recomputed steps use them again.
+  SolverOptions options;
   CheckpointOptions checkpoint_options;
   // The forward pass's wall seconds and solver iterations, all steps.
   double forward_seconds = 0;

@@ -108,13 +108,15 @@ class Simulator {
                                            const std::function<void(int k, const State& state)>& observer = nullptr);
   // Backward over a checkpointed rollout: the steps between checkpoints are
   // recomputed with the rollout's forward options, and the gradient is the
-  // stored rollout's (bit for bit with a fixed SolverOptions::adjoint_solver).
+  // stored rollout's (bit for bit with a fixed SolverOptions::adjoint_solver
+  // and svd_warm_start = false, to rounding with warm SVDs).
   // BackwardReport::recomputed_steps and peak_states say what it cost. The
   // same preconditions as Backward on a stored rollout (open loop), and
   // InvalidInputError for checkpoints other than SimulateCheckpointed's
   // ("Backward: the checkpointed rollout's checkpoints are not those
   // SimulateCheckpointed keeps for its number of steps and checkpoint
-  // options") or a state with the wrong size or a non-finite entry.
+  // options"), options with svd_warm_start = true, or a state with the
+  // wrong size or a non-finite entry.
   RolloutGradient Backward(const CheckpointedRollout& rollout, const LossGradient& loss);
   // The same with the loss's state derivatives asked for as the states are
   // recomputed, and the per-step gradients passed on (StateLossGradient):
@@ -135,7 +137,8 @@ class Simulator {
   // Forward mode over a checkpointed rollout: its states are recomputed from
   // the initial one alongside the tangents (one forward step per step, with
   // the rollout's forward options), so the tangents are the stored
-  // rollout's, bit for bit with a fixed SolverOptions::adjoint_solver. With
+  // rollout's, bit for bit with a fixed SolverOptions::adjoint_solver and
+  // svd_warm_start = false. With
   // a consumer (tangent_rollout.h) every state and its tangents go to it as
   // they are computed and TangentRollout::dx and dv stay empty (memory
   // independent of K); without, they hold every state's tangents. The

@@ -37,8 +37,9 @@ class ElasticForces {
 
   // Resets the SVDs' warm start (every sample's V) to the identity, so that
   // what follows depends on its inputs alone, not on earlier evaluations.
-  // Simulator::Step calls it first: a step is then a function of its state
-  // and input, recomputed bit for bit (checkpointed_rollout.h).
+  // Every step calls it first when SolverOptions::svd_warm_start is false: a
+  // step is then a function of its state and input, recomputed bit for bit
+  // (checkpointed_rollout.h).
   void ResetWarmStart();
 
   // Returns E(x) (J) and, if grad != nullptr, sets *grad = dE/dx (3n, N).

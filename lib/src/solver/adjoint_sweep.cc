@@ -14,6 +14,7 @@ AdjointSweep::AdjointSweep(SimulatorImpl& sim, int steps, const SolverOptions& f
                            const VectorXd& dv_last, const Controller* controller, bool keep_step_gradients)
     : sim_(sim),
       forward_rel_tolerance_(forward_options.rel_tolerance),
+      svd_warm_start_(forward_options.svd_warm_start),
       controller_(controller),
       keep_(keep_step_gradients),
       recycling_(sim.options.adjoint_guess_solutions) {
@@ -42,10 +43,10 @@ void AdjointSweep::Step(int i, const State& s0, const State& s1, const StepInput
   const bool implicit = sim.options.method != Method::kSemiImplicit;
   const bool contact = !sim.scene.frictional_contacts.empty() && implicit;
   const ActivationScope activation(sim, input.activation);
-  // The SVDs start cold: the step's gradient depends on its states alone, not
-  // on what was evaluated before (a checkpointed backward recomputes steps
-  // in between).
-  sim.elastic.ResetWarmStart();
+  // Cold SVDs where the forward had them: the step's gradient depends on its
+  // states alone, not on what was evaluated before (a checkpointed backward
+  // recomputes steps in between).
+  if (!svd_warm_start_) sim.elastic.ResetWarmStart();
   VectorXd part_mu, part_lambda;
   VectorXd gx_prev, gv_prev;
   activation_.resize(0);

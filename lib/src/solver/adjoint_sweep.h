@@ -21,7 +21,8 @@ namespace diffpd::internal {
 class AdjointSweep {
  public:
   // A sweep over `steps` steps of a rollout made with `forward_options`
-  // (its rel_tolerance sets the adjoint tolerance, adjoint_tolerance.h),
+  // (its rel_tolerance sets the adjoint tolerance, adjoint_tolerance.h, and
+  // its svd_warm_start whether every step's SVDs start cold),
   // starting from dL/dx_K = dx_last and dL/dv_K = dv_last (3n each, or empty
   // for zero). `controller` (not owned; nullptr: open loop) made the rollout.
   // With keep_step_gradients false the per-step gradients are not kept in
@@ -47,6 +48,7 @@ class AdjointSweep {
  private:
   SimulatorImpl& sim_;
   double forward_rel_tolerance_;
+  bool svd_warm_start_;  // the forward's SolverOptions::svd_warm_start
   const Controller* controller_;
   bool keep_;
   RolloutGradient out_;

@@ -42,7 +42,9 @@ CheckpointedRollout Simulator::SimulateCheckpointed(const State& initial, const 
   CheckpointedRollout r;
   r.material = impl_->scene.material;
   for (const MaterialRegion& region : impl_->scene.material_regions) r.region_materials.push_back(region.material);
+  // Cold SVDs: a recomputed step repeats the forward's bit for bit.
   r.options = impl_->options;
+  r.options.svd_warm_start = false;
   r.checkpoint_options = checkpoints;
   r.inputs = inputs;
   r.initial = initial;
@@ -50,6 +52,7 @@ CheckpointedRollout Simulator::SimulateCheckpointed(const State& initial, const 
   r.checkpoint_steps = internal::FirstDescentSteps(steps, checkpoints.num_checkpoints);
   r.checkpoints.reserve(r.checkpoint_steps.size());
   r.checkpoint_reports.reserve(r.checkpoint_steps.size());
+  const internal::ForwardOptionsScope forward(*impl_, r.options);
   State state = initial;
   if (observer) observer(0, state);
   size_t next = 0;

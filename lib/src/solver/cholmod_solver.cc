@@ -1,7 +1,5 @@
 #include "solver/cholmod_solver.h"
 
-#include <unistd.h>
-
 #include <omp.h>
 
 #include <chrono>
@@ -108,10 +106,8 @@ void CholmodSolver::MakeCopy() {
   const cholmod_factor* f = impl_->With(layout_, [](auto& llt) { return llt.factor(); });
   if (f == nullptr || !f->is_ll || f->xtype != CHOLMOD_REAL || f->itype != CHOLMOD_INT) return;
   const int n = static_cast<int>(f->n);
-  double limit = copy_max_bytes_;
-  if (limit <= 0)
-    limit = 0.5 * static_cast<double>(sysconf(_SC_AVPHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
-  if (ParallelTriangularSolve::EstimatedBytes(n, factor_nonzeros()) > limit) return;  // the lean path: CHOLMOD solves
+  // The lean path: CHOLMOD solves.
+  if (ParallelTriangularSolve::EstimatedBytes(n, factor_nonzeros()) > copy_max_bytes_) return;
   std::vector<int> node_of_column;
   if (f->is_super) {
     node_of_column.resize(n);

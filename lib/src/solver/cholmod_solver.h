@@ -9,6 +9,7 @@
 // factorised once and solved with at every iteration; see PdSystem).
 #pragma once
 
+#include <limits>
 #include <memory>
 
 #include "diffpd/types.h"
@@ -60,9 +61,8 @@ class CholmodSolver {
   void set_solve_threads(int threads);
   // kParallelCopy: the most bytes the copy may take (its size estimated from
   // the factor's entries before it is made: ParallelTriangularSolve::
-  // EstimatedBytes); above it no copy is made and CHOLMOD solves. 0: half the
-  // physical memory available at the factorisation. Takes effect at the next
-  // factorisation.
+  // EstimatedBytes); above it no copy is made and CHOLMOD solves. >= 0;
+  // default: no bound. Takes effect at the next factorisation.
   void set_copy_max_bytes(double bytes) { copy_max_bytes_ = bytes; }
   // kParallelCopy: the copy in use (null before a factorisation, or where the
   // factor was not in the form the copy needs and CHOLMOD solves instead).
@@ -86,7 +86,7 @@ class CholmodSolver {
   CholmodLayout layout_;
   CholmodSolveKernel kernel_;
   int solve_threads_ = 1;
-  double copy_max_bytes_ = 0;
+  double copy_max_bytes_ = std::numeric_limits<double>::infinity();
   std::unique_ptr<ParallelTriangularSolve> copy_;
   Eigen::Index rows_ = -1;
   Eigen::Index nonzeros_ = -1;

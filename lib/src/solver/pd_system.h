@@ -53,7 +53,7 @@ class PdSystem {
   // (solver/parallel_triangular_solve.h).
   void SetSolveThreads(int threads);
   // The most bytes the factors' copies may take (CholmodSolver::
-  // set_copy_max_bytes; 0: automatic); from the next factorisation.
+  // set_copy_max_bytes); from the next factorisation.
   void SetCopyMaxBytes(double bytes);
   // Bytes of the factors' copies in use (0: none, CHOLMOD solves).
   std::size_t copy_bytes() const;

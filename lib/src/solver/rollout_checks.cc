@@ -82,6 +82,10 @@ void CheckCheckpointedRollout(const SimulatorImpl& sim, const CheckpointedRollou
     throw InvalidInputError(caller +
                             ": the checkpointed rollout's checkpoints are not those SimulateCheckpointed keeps for its "
                             "number of steps and checkpoint options");
+  if (rollout.options.svd_warm_start)
+    throw InvalidInputError(caller +
+                            ": the checkpointed rollout's options have svd_warm_start = true; its steps cannot be "
+                            "recomputed bit for bit (SimulateCheckpointed sets it false)");
   for (size_t c = 0; c < rollout.checkpoints.size(); ++c)
     CheckState(rollout.checkpoints[c], n, caller, "checkpoint " + std::to_string(c));
   for (int k = 0; k < steps; ++k) {

@@ -122,8 +122,8 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
   internal::CheckActivation(input.activation, sim.aux.num_muscles());
   const internal::ActivationScope activation(sim, input.activation);
   const auto start = Clock::now();
-  // The step's SVDs start cold: its result depends on (state, input) alone.
-  sim.elastic.ResetWarmStart();
+  // Cold SVDs: the step's result depends on (state, input) alone.
+  if (!sim.options.svd_warm_start) sim.elastic.ResetWarmStart();
   StepReport local;
   StepReport* rep = report ? report : &local;
   *rep = StepReport();

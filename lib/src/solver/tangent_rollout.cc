@@ -223,11 +223,11 @@ struct TangentStep {
 };
 using TangentStepSource = std::function<TangentStep(int i)>;
 
-// The pass over K = inputs.size() steps of a rollout made with forward
-// tolerance `forward_rel_tolerance`, the states from `step_at`. With a
+// The pass over K = inputs.size() steps of a rollout made with `forward`
+// options (their tolerance and SVD warm start), the states from `step_at`. With a
 // consumer, each state's tangents go to it as they are computed and the
 // result's dx and dv stay empty.
-TangentRollout TangentPass(SimulatorImpl& sim, const std::vector<StepInput>& inputs, double forward_rel_tolerance,
+TangentRollout TangentPass(SimulatorImpl& sim, const std::vector<StepInput>& inputs, const SolverOptions& forward,
                            const State& initial, const TangentStepSource& step_at,
                            const std::vector<InputDirection>& directions, const TangentConsumer& consumer) {
   const auto start = std::chrono::steady_clock::now();
@@ -335,9 +335,9 @@ TangentRollout TangentPass(SimulatorImpl& sim, const std::vector<StepInput>& inp
     const MatrixXd& dx0 = out.dx[from];
     const MatrixXd& dv0 = out.dv[from];
     const internal::ActivationScope activation(sim, inputs[i].activation);
-    // The SVDs start cold: the step's tangents depend on its states alone
-    // (a checkpointed rollout's states are recomputed in between).
-    sim.elastic.ResetWarmStart();
+    // Cold SVDs where the forward had them: the step's tangents depend on its
+    // states alone (a checkpointed rollout's states are recomputed in between).
+    if (!forward.svd_warm_start) sim.elastic.ResetWarmStart();
     MatrixXd dx1;
     if (implicit) {
       // Right-hand sides: inertia through xhat, force directions, parameters.
@@ -372,7 +372,7 @@ TangentRollout TangentPass(SimulatorImpl& sim, const std::vector<StepInput>& inp
       if (!pinned.empty()) pins.emplace(sim, pinned, s1.x);
       internal::StepLinearization lin(sim, s1.x);
       lin.set_recycling(&recycling);
-      lin.set_rel_tolerance(internal::AdjointRelTolerance(sim.options, forward_rel_tolerance, at.report));
+      lin.set_rel_tolerance(internal::AdjointRelTolerance(sim.options, forward.rel_tolerance, at.report));
       dx1 = lin.SolveColumns(b, &out.report) + dpin;  // zero at fixed DoFs but the pins
     } else {
       // Acceleration tangent on free DoFs, then symplectic update.
@@ -450,8 +450,7 @@ TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<Inp
     return TangentStep{&rollout.states[i], &rollout.states[i + 1], with_reports ? &rollout.reports[i] : nullptr};
   };
   return WithOverflowMessage(*impl_, [&] {
-    return TangentPass(*impl_, rollout.inputs, rollout.options.rel_tolerance, rollout.states[0], step_at, directions,
-                       nullptr);
+    return TangentPass(*impl_, rollout.inputs, rollout.options, rollout.states[0], step_at, directions, nullptr);
   });
 }
 
@@ -468,8 +467,7 @@ TangentRollout Simulator::Tangents(const CheckpointedRollout& rollout, const std
     return TangentStep{&s0, &s1, &report};
   };
   return WithOverflowMessage(*impl_, [&] {
-    return TangentPass(*impl_, rollout.inputs, rollout.options.rel_tolerance, rollout.initial, step_at, directions,
-                       consumer);
+    return TangentPass(*impl_, rollout.inputs, rollout.options, rollout.initial, step_at, directions, consumer);
   });
 }
 
