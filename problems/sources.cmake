@@ -21,6 +21,7 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/control/reference_curve.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/starfish_control.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/shark_control.cc
+  ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_starts.cc
   # paper: the DiffPD paper's table rows as data
   ${CMAKE_CURRENT_LIST_DIR}/paper/numpy_random.cc
   ${CMAKE_CURRENT_LIST_DIR}/paper/paper_meshes.cc
@@ -82,6 +83,7 @@ set(DIFFPD_PROBLEMS_CALIBRATION_SOURCES
   # calibration over several recordings (a rollout set)
   ${CMAKE_CURRENT_LIST_DIR}/calibration/plant_recordings.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/rollout_set_fit.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_recordings_fit.cc
   # the swimmers' L-BFGS training
   ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_lbfgs.cc)
 # control: trajectory and control optimisation with Ipopt

@@ -6,17 +6,36 @@
 
 namespace diffpd::problems {
 
-EvaluationBudget::EvaluationBudget(const solvers::RolloutFunction* function, int budget, int steps_per_rollout,
-                                   FILE* log)
-    : function_(function), budget_(budget), steps_(steps_per_rollout), log_(log) {
-  DIFFPD_CHECK(function_ != nullptr, "EvaluationBudget needs a rollout function");
+namespace {
+
+void CheckBudget(int budget) {
   if (budget < 1) {
     std::ostringstream msg;
     msg << "evaluations = " << budget << " is invalid: must be >= 1";
     throw InvalidInputError(msg.str());
   }
-  seen_forward_ = function_->statistics().forward_seconds;
-  seen_backward_ = function_->statistics().backward_seconds;
+}
+
+}  // namespace
+
+EvaluationBudget::EvaluationBudget(const solvers::RolloutFunction* function, int budget, int steps_per_rollout,
+                                   FILE* log)
+    : budget_(budget), steps_(steps_per_rollout), log_(log) {
+  DIFFPD_CHECK(function != nullptr, "EvaluationBudget needs a rollout function");
+  CheckBudget(budget);
+  statistics_ = [function] { return function->statistics(); };
+  seen_forward_ = function->statistics().forward_seconds;
+  seen_backward_ = function->statistics().backward_seconds;
+}
+
+EvaluationBudget::EvaluationBudget(const solvers::RolloutSet* set, int budget, int steps_per_rollout, FILE* log)
+    : budget_(budget), steps_(steps_per_rollout), log_(log) {
+  DIFFPD_CHECK(set != nullptr, "EvaluationBudget needs a rollout set");
+  CheckBudget(budget);
+  statistics_ = [set] { return set->statistics(); };
+  const solvers::RolloutStatistics stats = set->statistics();
+  seen_forward_ = stats.forward_seconds;
+  seen_backward_ = stats.backward_seconds;
 }
 
 bool EvaluationBudget::Admit(const Eigen::Ref<const VectorXd>& p) {
@@ -29,7 +48,7 @@ bool EvaluationBudget::Admit(const Eigen::Ref<const VectorXd>& p) {
 }
 
 void EvaluationBudget::Record(const Eigen::Ref<const VectorXd>& p, bool ok, double loss, const VectorXd* gradient) {
-  const solvers::RolloutStatistics& stats = function_->statistics();
+  const solvers::RolloutStatistics stats = statistics_();
   const double forward = stats.forward_seconds - seen_forward_;
   const double backward = stats.backward_seconds - seen_backward_;
   seen_forward_ = stats.forward_seconds;

@@ -7,9 +7,11 @@
 #pragma once
 
 #include <cstdio>
+#include <functional>
 #include <vector>
 
 #include "diffpd/solvers/core/rollout_function.h"
+#include "diffpd/solvers/core/rollout_set.h"
 #include "diffpd/types.h"
 
 namespace diffpd::problems {
@@ -32,6 +34,10 @@ class EvaluationBudget {
   // silent; not owned). Throws InvalidInputError for budget < 1
   // ("evaluations = 0 is invalid: must be >= 1").
   EvaluationBudget(const solvers::RolloutFunction* function, int budget, int steps_per_rollout, FILE* log);
+  // The same over a rollout set's scalar loss (`set` not owned, outliving
+  // the budget): steps_per_rollout counts every term's steps, the timings are
+  // those of the terms evaluated in this process (RolloutSet::statistics).
+  EvaluationBudget(const solvers::RolloutSet* set, int budget, int steps_per_rollout, FILE* log);
 
   // Whether p may be evaluated: always at the latest point, at a new point
   // while fewer than `budget` evaluations were made (otherwise the budget is
@@ -56,7 +62,7 @@ class EvaluationBudget {
  private:
   void Print(const TrainingEvaluation& row) const;
 
-  const solvers::RolloutFunction* function_;
+  std::function<solvers::RolloutStatistics()> statistics_;  // the timings' source
   int budget_, steps_;
   FILE* log_;
   int used_ = 0, failed_ = 0;

@@ -1,20 +1,25 @@
+#include <utility>
+
 #include "control/swimmer_optimizers.h"
 #include "diffpd/solvers/ipopt/ipopt_solve.h"
 #include "diffpd/solvers/ipopt/rollout_nlp.h"
+#include "diffpd/solvers/ipopt/rollout_set_nlp.h"
 
 namespace diffpd::problems {
 namespace {
 
-// RolloutNlp within the budget: a point beyond it is a failed evaluation
-// (Ipopt cuts its step) and the next iteration stops the solve.
-class BudgetedNlp : public solvers::RolloutNlp {
+// An NLP (RolloutNlp or RolloutSetNlp) within the budget: a point beyond it
+// is a failed evaluation (Ipopt cuts its step) and the next iteration stops
+// the solve.
+template <typename Nlp>
+class BudgetedNlp : public Nlp {
  public:
-  BudgetedNlp(std::unique_ptr<solvers::RolloutFunction> function, EvaluationBudget* budget)
-      : RolloutNlp(std::move(function)), budget_(budget) {}
+  template <typename Source>
+  BudgetedNlp(Source&& source, EvaluationBudget* budget) : Nlp(std::forward<Source>(source)), budget_(budget) {}
   bool eval_f(Ipopt::Index n, const Ipopt::Number* x, bool new_x, Ipopt::Number& obj_value) override {
     const Eigen::Map<const VectorXd> p(x, n);
     if (!budget_->Admit(p)) return false;
-    const bool ok = RolloutNlp::eval_f(n, x, new_x, obj_value);
+    const bool ok = Nlp::eval_f(n, x, new_x, obj_value);
     budget_->Record(p, ok, ok ? obj_value : 0.0, nullptr);
     return ok;
   }
@@ -22,7 +27,7 @@ class BudgetedNlp : public solvers::RolloutNlp {
     const Eigen::Map<const VectorXd> p(x, n);
     if (!budget_->Admit(p)) return false;
     double value = 0;
-    const bool ok = RolloutNlp::eval_grad_f(n, x, new_x, grad_f) && RolloutNlp::eval_f(n, x, false, value);
+    const bool ok = Nlp::eval_grad_f(n, x, new_x, grad_f) && Nlp::eval_f(n, x, false, value);
     const VectorXd g = ok ? VectorXd(Eigen::Map<const VectorXd>(grad_f, n)) : VectorXd();
     budget_->Record(p, ok, value, ok ? &g : nullptr);
     return ok;
@@ -32,9 +37,8 @@ class BudgetedNlp : public solvers::RolloutNlp {
                              Ipopt::Number regularization_size, Ipopt::Number alpha_du, Ipopt::Number alpha_pr,
                              Ipopt::Index ls_trials, const Ipopt::IpoptData* ip_data,
                              Ipopt::IpoptCalculatedQuantities* ip_cq) override {
-    const bool go_on =
-        RolloutNlp::intermediate_callback(mode, iter, obj_value, inf_pr, inf_du, mu, d_norm, regularization_size,
-                                          alpha_du, alpha_pr, ls_trials, ip_data, ip_cq);
+    const bool go_on = Nlp::intermediate_callback(mode, iter, obj_value, inf_pr, inf_du, mu, d_norm,
+                                                  regularization_size, alpha_du, alpha_pr, ls_trials, ip_data, ip_cq);
     return go_on && !budget_->exhausted() && budget_->used() < budget_->budget();
   }
 
@@ -42,19 +46,34 @@ class BudgetedNlp : public solvers::RolloutNlp {
   EvaluationBudget* budget_;
 };
 
+// Silent, at most the budget's iterations; only the budget ends the
+// training (the loss has no known minimum).
+solvers::IpoptOptions TrainingOptions(const EvaluationBudget& budget) {
+  solvers::IpoptOptions options;
+  options.int_options.push_back({"print_level", 0});
+  options.int_options.push_back({"max_iter", budget.budget()});
+  options.num_options.push_back({"tol", 1e-12});
+  return options;
+}
+
 }  // namespace
 
 VectorXd MinimizeWithIpopt(std::unique_ptr<solvers::RolloutFunction> function, int loss, EvaluationBudget* budget,
                            std::string* report) {
   const std::vector<int> rows = function->RowsOf(loss);
-  Ipopt::SmartPtr<BudgetedNlp> nlp = new BudgetedNlp(std::move(function), budget);
+  Ipopt::SmartPtr<BudgetedNlp<solvers::RolloutNlp>> nlp =
+      new BudgetedNlp<solvers::RolloutNlp>(std::move(function), budget);
   nlp->AddObjectiveRows(rows);
-  solvers::IpoptOptions options;
-  options.int_options.push_back({"print_level", 0});
-  options.int_options.push_back({"max_iter", budget->budget()});
-  // Only the budget ends the training (the loss has no known minimum).
-  options.num_options.push_back({"tol", 1e-12});
-  const solvers::IpoptSummary summary = solvers::SolveWithIpopt(Ipopt::SmartPtr<solvers::RolloutNlp>(nlp), options);
+  const solvers::IpoptSummary summary =
+      solvers::SolveWithIpopt(Ipopt::SmartPtr<solvers::RolloutNlp>(nlp), TrainingOptions(*budget));
+  *report = summary.status_name;
+  return summary.x;
+}
+
+VectorXd MinimizeWithIpopt(solvers::RolloutSet* set, EvaluationBudget* budget, std::string* report) {
+  Ipopt::SmartPtr<BudgetedNlp<solvers::RolloutSetNlp>> nlp = new BudgetedNlp<solvers::RolloutSetNlp>(set, budget);
+  const solvers::IpoptSummary summary =
+      solvers::SolveRolloutSetWithIpopt(Ipopt::SmartPtr<solvers::RolloutSetNlp>(nlp), TrainingOptions(*budget));
   *report = summary.status_name;
   return summary.x;
 }

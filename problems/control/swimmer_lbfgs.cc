@@ -2,18 +2,24 @@
 #include <ceres/gradient_problem_solver.h>
 #include <ceres/iteration_callback.h>
 
+#include <utility>
+
 #include "control/swimmer_optimizers.h"
 #include "diffpd/solvers/ceres/rollout_loss_function.h"
+#include "diffpd/solvers/ceres/rollout_set_loss_function.h"
 
 namespace diffpd::problems {
 namespace {
 
-// RolloutLossFunction within the budget: a point beyond it is a failed
-// evaluation (Ceres cuts its step and, at the next iteration, stops).
+// A loss (RolloutLossFunction or RolloutSetLossFunction) within the
+// budget: a point beyond it is a failed evaluation (Ceres cuts its step and,
+// at the next iteration, stops).
+template <typename Loss>
 class BudgetedLoss : public ceres::FirstOrderFunction {
  public:
-  BudgetedLoss(solvers::RolloutFunction* function, int loss, EvaluationBudget* budget)
-      : inner_(function, loss), n_(function->num_parameters()), budget_(budget) {}
+  template <typename... Args>
+  BudgetedLoss(EvaluationBudget* budget, Args&&... args)
+      : inner_(std::forward<Args>(args)...), n_(inner_.NumParameters()), budget_(budget) {}
   bool Evaluate(const double* parameters, double* cost, double* gradient) const override {
     const Eigen::Map<const VectorXd> p(parameters, n_);
     if (!budget_->Admit(p)) return false;
@@ -26,7 +32,7 @@ class BudgetedLoss : public ceres::FirstOrderFunction {
   int NumParameters() const override { return n_; }
 
  private:
-  solvers::RolloutLossFunction inner_;
+  Loss inner_;
   int n_;
   EvaluationBudget* budget_;
 };
@@ -43,11 +49,9 @@ class StopWhenSpent : public ceres::IterationCallback {
   const EvaluationBudget* budget_;
 };
 
-}  // namespace
-
-VectorXd MinimizeWithLbfgs(solvers::RolloutFunction* function, int loss, EvaluationBudget* budget,
-                           std::string* report) {
-  ceres::GradientProblem problem(new BudgetedLoss(function, loss, budget));
+// Ceres' L-BFGS on `loss` (owned by the problem) from x0 within the budget.
+VectorXd Lbfgs(ceres::FirstOrderFunction* loss, VectorXd x, EvaluationBudget* budget, std::string* report) {
+  ceres::GradientProblem problem(loss);
   StopWhenSpent stop(budget);
   ceres::GradientProblemSolver::Options options;
   options.line_search_direction_type = ceres::LBFGS;
@@ -58,11 +62,23 @@ VectorXd MinimizeWithLbfgs(solvers::RolloutFunction* function, int loss, Evaluat
   options.parameter_tolerance = 0;
   options.logging_type = ceres::SILENT;
   options.callbacks.push_back(&stop);
-  VectorXd x = function->initial_parameters();
   ceres::GradientProblemSolver::Summary summary;
   ceres::Solve(options, problem, x.data(), &summary);
   *report = summary.BriefReport();
   return x;
+}
+
+}  // namespace
+
+VectorXd MinimizeWithLbfgs(solvers::RolloutFunction* function, int loss, EvaluationBudget* budget,
+                           std::string* report) {
+  return Lbfgs(new BudgetedLoss<solvers::RolloutLossFunction>(budget, function, loss), function->initial_parameters(),
+               budget, report);
+}
+
+VectorXd MinimizeWithLbfgs(solvers::RolloutSet* set, EvaluationBudget* budget, std::string* report) {
+  return Lbfgs(new BudgetedLoss<solvers::RolloutSetLossFunction>(budget, set), set->initial_parameters(), budget,
+               report);
 }
 
 }  // namespace diffpd::problems

@@ -13,6 +13,7 @@
 #include "control/adam.h"
 #include "control/evaluation_budget.h"
 #include "diffpd/solvers/core/rollout_function.h"
+#include "diffpd/solvers/core/rollout_set.h"
 
 namespace diffpd::problems {
 
@@ -20,12 +21,20 @@ namespace diffpd::problems {
 // the returned parameters are those after the last update (not evaluated).
 VectorXd MinimizeWithAdam(solvers::RolloutFunction* function, int loss, const AdamOptions& options,
                           EvaluationBudget* budget);
+// The same over a rollout set's scalar loss L(p) (RolloutSet::Gradient: the
+// terms' losses summed), from the set's initial parameters; the same code
+// whether the set is local or spread over MPI ranks (call it on rank 0).
+// A failed evaluation throws SolverError with the set's last_error().
+VectorXd MinimizeWithAdam(solvers::RolloutSet* set, const AdamOptions& options, EvaluationBudget* budget);
 
 // Ceres' gradient solver (ceres::GradientProblemSolver, L-BFGS line search
 // with strong Wolfe conditions) through solvers/ceres' RolloutLossFunction.
 // Returns Ceres' final point and sets *report to Ceres' one-line report.
 // Defined with the Ceres adapter only.
 VectorXd MinimizeWithLbfgs(solvers::RolloutFunction* function, int loss, EvaluationBudget* budget, std::string* report);
+// The same over a rollout set's scalar loss (solvers/ceres'
+// RolloutSetLossFunction), from the set's initial parameters.
+VectorXd MinimizeWithLbfgs(solvers::RolloutSet* set, EvaluationBudget* budget, std::string* report);
 
 // Ipopt with a limited-memory Hessian through solvers/ipopt's RolloutNlp
 // (which takes the function over). Returns Ipopt's final point (or the best
@@ -33,5 +42,8 @@ VectorXd MinimizeWithLbfgs(solvers::RolloutFunction* function, int loss, Evaluat
 // Defined with the Ipopt adapter only.
 VectorXd MinimizeWithIpopt(std::unique_ptr<solvers::RolloutFunction> function, int loss, EvaluationBudget* budget,
                            std::string* report);
+// The same over a rollout set's scalar loss (solvers/ipopt's RolloutSetNlp),
+// from the set's initial parameters.
+VectorXd MinimizeWithIpopt(solvers::RolloutSet* set, EvaluationBudget* budget, std::string* report);
 
 }  // namespace diffpd::problems

@@ -2,6 +2,8 @@
 
 #include <IpJournalist.hpp>
 
+#include <algorithm>
+
 #include <chrono>
 #include <cmath>
 #include <cstdarg>
@@ -71,6 +73,39 @@ int ParseDerivativeCheck(const std::string& log) {
   return std::atoi(log.c_str() + at + key.size());
 }
 
+// An application with the adapter's defaults and `options`, its output
+// captured by *journal; *status is Initialize's.
+Ipopt::SmartPtr<Ipopt::IpoptApplication> MakeApplication(const IpoptOptions& options,
+                                                         Ipopt::SmartPtr<CaptureJournal>* journal_out,
+                                                         Ipopt::ApplicationReturnStatus* status) {
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = new Ipopt::IpoptApplication(/*create_console_out=*/false);
+  int print_level = 5;
+  for (const auto& [name, value] : options.int_options)
+    if (name == "print_level") print_level = value;
+  if (print_level < Ipopt::J_NONE || print_level > Ipopt::J_LAST_LEVEL - 1) {
+    std::ostringstream msg;
+    msg << "Ipopt option print_level = " << print_level << " is invalid: must be in [0, 12]";
+    throw InvalidInputError(msg.str());
+  }
+  Ipopt::SmartPtr<CaptureJournal> journal =
+      new CaptureJournal(static_cast<Ipopt::EJournalLevel>(print_level), options.echo);
+  journal->SetAllPrintLevels(static_cast<Ipopt::EJournalLevel>(print_level));
+  app->Jnlst()->AddJournal(Ipopt::GetRawPtr(journal));
+
+  Ipopt::OptionsList* list = Ipopt::GetRawPtr(app->Options());
+  SetOption(list, "hessian_approximation", std::string("limited-memory"));
+  SetOption(list, "print_level", 5);
+  SetOption(list, "sb", std::string("yes"));
+  for (const auto& [name, value] : options.string_options) SetOption(list, name, value);
+  for (const auto& [name, value] : options.int_options) SetOption(list, name, value);
+  for (const auto& [name, value] : options.num_options) SetOption(list, name, value);
+
+  std::istringstream no_option_file;  // never read ipopt.opt from the working directory
+  *status = app->Initialize(no_option_file);
+  *journal_out = journal;
+  return app;
+}
+
 }  // namespace
 
 const char* ToString(Ipopt::ApplicationReturnStatus status) {
@@ -136,31 +171,10 @@ std::string IpoptSummary::BriefReport() const {
 IpoptSummary SolveWithIpopt(const Ipopt::SmartPtr<RolloutNlp>& nlp, const IpoptOptions& options) {
   if (!Ipopt::IsValid(nlp)) throw InvalidInputError("SolveWithIpopt: the NLP is null");
   const auto start = std::chrono::steady_clock::now();
-  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = new Ipopt::IpoptApplication(/*create_console_out=*/false);
-  int print_level = 5;
-  for (const auto& [name, value] : options.int_options)
-    if (name == "print_level") print_level = value;
-  if (print_level < Ipopt::J_NONE || print_level > Ipopt::J_LAST_LEVEL - 1) {
-    std::ostringstream msg;
-    msg << "Ipopt option print_level = " << print_level << " is invalid: must be in [0, 12]";
-    throw InvalidInputError(msg.str());
-  }
-  Ipopt::SmartPtr<CaptureJournal> journal =
-      new CaptureJournal(static_cast<Ipopt::EJournalLevel>(print_level), options.echo);
-  journal->SetAllPrintLevels(static_cast<Ipopt::EJournalLevel>(print_level));
-  app->Jnlst()->AddJournal(Ipopt::GetRawPtr(journal));
-
-  Ipopt::OptionsList* list = Ipopt::GetRawPtr(app->Options());
-  SetOption(list, "hessian_approximation", std::string("limited-memory"));
-  SetOption(list, "print_level", 5);
-  SetOption(list, "sb", std::string("yes"));
-  for (const auto& [name, value] : options.string_options) SetOption(list, name, value);
-  for (const auto& [name, value] : options.int_options) SetOption(list, name, value);
-  for (const auto& [name, value] : options.num_options) SetOption(list, name, value);
-
+  Ipopt::SmartPtr<CaptureJournal> journal;
+  Ipopt::ApplicationReturnStatus status;
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = MakeApplication(options, &journal, &status);
   IpoptSummary summary;
-  std::istringstream no_option_file;  // never read ipopt.opt from the working directory
-  Ipopt::ApplicationReturnStatus status = app->Initialize(no_option_file);
 
   const RolloutStatistics before = nlp->statistics();
   const size_t first_iteration = nlp->iterations().size();
@@ -195,6 +209,41 @@ IpoptSummary SolveWithIpopt(const Ipopt::SmartPtr<RolloutNlp>& nlp, const IpoptO
     summary.objective_history.push_back(r.objective);
     summary.iterations = r.iteration;
   }
+  summary.log = journal->text();
+  summary.derivative_checker_errors = ParseDerivativeCheck(summary.log);
+  summary.last_error = nlp->last_error();
+  summary.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+IpoptSummary SolveRolloutSetWithIpopt(const Ipopt::SmartPtr<RolloutSetNlp>& nlp, const IpoptOptions& options) {
+  if (!Ipopt::IsValid(nlp)) throw InvalidInputError("SolveRolloutSetWithIpopt: the NLP is null");
+  const auto start = std::chrono::steady_clock::now();
+  Ipopt::SmartPtr<CaptureJournal> journal;
+  Ipopt::ApplicationReturnStatus status;
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = MakeApplication(options, &journal, &status);
+  IpoptSummary summary;
+  const RolloutStatistics before = nlp->set().statistics();
+  const size_t first_iteration = nlp->objective_history().size();
+  const VectorXd x0 = nlp->starting_point();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (!nlp->Objective(x0, &summary.initial_objective)) summary.initial_objective = nan;
+  if (status == Ipopt::Solve_Succeeded) status = app->OptimizeTNLP(Ipopt::GetRawPtr(nlp));
+
+  summary.status = status;
+  summary.status_name = ToString(status);
+  summary.x = nlp->has_solution() && nlp->solution().size() == x0.size() ? nlp->solution() : x0;
+  if (!nlp->Objective(summary.x, &summary.objective)) summary.objective = nan;
+  summary.constraint_violation = nlp->BoundViolation(summary.x);
+  const RolloutStatistics after = nlp->set().statistics();
+  summary.evaluations = after.rollouts - before.rollouts;
+  summary.backward_passes =
+      (after.adjoint_passes + after.tangent_passes) - (before.adjoint_passes + before.tangent_passes);
+  summary.forward_seconds = after.forward_seconds - before.forward_seconds;
+  summary.backward_seconds = after.backward_seconds - before.backward_seconds;
+  const std::vector<double>& history = nlp->objective_history();
+  summary.objective_history.assign(history.begin() + static_cast<long>(first_iteration), history.end());
+  summary.iterations = std::max(0, static_cast<int>(summary.objective_history.size()) - 1);
   summary.log = journal->text();
   summary.derivative_checker_errors = ParseDerivativeCheck(summary.log);
   summary.last_error = nlp->last_error();

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "diffpd/solvers/ipopt/rollout_nlp.h"
+#include "diffpd/solvers/ipopt/rollout_set_nlp.h"
 
 namespace diffpd::solvers {
 
@@ -74,5 +75,11 @@ const char* ToString(Ipopt::ApplicationReturnStatus status);
 // summary's status); throws InvalidInputError if an option is unknown or
 // has an invalid value (Ipopt rejects it), naming the option.
 IpoptSummary SolveWithIpopt(const Ipopt::SmartPtr<RolloutNlp>& nlp, const IpoptOptions& options = IpoptOptions());
+// SolveWithIpopt over a rollout set's loss (rollout_set_nlp.h): constraint_violation
+// is the bounds' violation, never a best feasible point (Ipopt's iterates
+// keep the bounds); evaluations, passes and seconds are those of the terms
+// evaluated in this process (RolloutSet::statistics).
+IpoptSummary SolveRolloutSetWithIpopt(const Ipopt::SmartPtr<RolloutSetNlp>& nlp,
+                                      const IpoptOptions& options = IpoptOptions());
 
 }  // namespace diffpd::solvers
