@@ -26,8 +26,10 @@ flags="$flags -DEIGEN_MALLOC_ALREADY_ALIGNED=1"
 # The Python package is built for Debian's interpreter, as scripts/setup.sh
 # does. The interpreter is not sanitized: python_tests preloads the runtime so
 # the extension module can load, without leak detection (the interpreter
-# keeps its objects alive at exit by design).
-asan_runtime=$(${CXX:-c++} -print-file-name=libasan.so)
+# keeps its objects alive at exit by design), and the C++ runtime with it, or
+# the runtime's exception interceptor finds no __cxa_throw and aborts at the
+# first C++ exception.
+asan_runtime="$(${CXX:-c++} -print-file-name=libasan.so) $(${CXX:-c++} -print-file-name=libstdc++.so)"
 python=()
 if [ -x /usr/bin/python3 ]; then python=(-DPython_EXECUTABLE=/usr/bin/python3); fi
 launcher=()
