@@ -3,7 +3,9 @@
 # suite with CTest; then every file reader's fuzz harness for a fixed time
 # (scripts/fuzz.sh, in build-fuzz/; DIFFPD_EDGE_CHECKS=0 skips it) and, with
 # DIFFPD_SANITIZE=1, the suite again under AddressSanitizer and
-# UndefinedBehaviorSanitizer (scripts/sanitize.sh, in build-sanitize/). Extra
+# UndefinedBehaviorSanitizer (scripts/sanitize.sh, in build-sanitize/). The
+# sanitizer suite is opt-in: its build compiles about three times as long as
+# the Release build, which would bring CI close to its time bound. Extra
 # arguments go to the Release suite's ctest.
 set -euo pipefail
 cd "$(dirname "$0")"

@@ -77,6 +77,8 @@ void BindOptions(py::module_& m) {
       .def_readwrite("backward_max_iterations", &O::backward_max_iterations)
       .def_readwrite("adjoint_guess_solutions", &O::adjoint_guess_solutions)
       .def_readwrite("max_extent_ratio", &O::max_extent_ratio)
+      .def_readwrite("pd_factor_copy_max_bytes", &O::pd_factor_copy_max_bytes)
+      .def_readwrite("svd_warm_start", &O::svd_warm_start)
       .def_readwrite("num_threads", &O::num_threads)
       .def_readwrite("verbosity", &O::verbosity)
       .def("validate", &O::Validate);

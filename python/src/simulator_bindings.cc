@@ -81,8 +81,8 @@ void BindSimulator(py::module_& m) {
            "loss"_a, release(), "Reverse mode: gradients of a loss given dL/dx_k and dL/dv_k.")
       .def("backward", py::overload_cast<const Rollout&, const LossGradient&, const Controller&>(&Simulator::Backward),
            "rollout"_a, "loss"_a, "controller"_a, release(), "Closed loop: also dL/dtheta of the controller.")
-      .def("tangents", &Simulator::Tangents, "rollout"_a, "directions"_a, release(),
-           "Forward mode: dx_k, dv_k along each direction.")
+      .def("tangents", py::overload_cast<const Rollout&, const std::vector<InputDirection>&>(&Simulator::Tangents),
+           "rollout"_a, "directions"_a, release(), "Forward mode: dx_k, dv_k along each direction.")
       .def(
           "solve_quasi_static",
           [](Simulator& self, const VectorXd& x0, const StepInput& input) {

@@ -79,9 +79,10 @@ def test_list_of_step_inputs_and_array_inputs_give_the_same_rollout(problem):
 
 def test_every_solver_option_field_is_settable_and_round_trips():
     fields = [name for name in dir(diffpd.SolverOptions) if not name.startswith("_") and name != "validate"]
-    assert len(fields) == 26
+    assert len(fields) == 28
     defaults = diffpd.SolverOptions()
     assert defaults.method == diffpd.Method.PD and defaults.time_step == 0.01
+    assert defaults.pd_factor_copy_max_bytes == 4 * 2**30 and defaults.svd_warm_start
     assert defaults.adjoint_solver == diffpd.AdjointSolver.AUTO
 
 

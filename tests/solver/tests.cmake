@@ -23,3 +23,5 @@ diffpd_add_test(closed_loop_gradient_test ${CMAKE_CURRENT_LIST_DIR}/closed_loop_
 diffpd_add_test(rollout_checks_test ${CMAKE_CURRENT_LIST_DIR}/rollout_checks_test.cc)
 diffpd_add_test(simulator_test ${CMAKE_CURRENT_LIST_DIR}/simulator_test.cc)
 diffpd_add_test(tolerance_reference_test ${CMAKE_CURRENT_LIST_DIR}/tolerance_reference_test.cc)
+diffpd_add_test(checkpointed_rollout_test ${CMAKE_CURRENT_LIST_DIR}/checkpointed_rollout_test.cc)
+diffpd_add_test(factor_copy_test ${CMAKE_CURRENT_LIST_DIR}/factor_copy_test.cc)

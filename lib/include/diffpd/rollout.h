@@ -100,6 +100,11 @@ struct BackwardReport {
   int iterative_steps = 0;
   int direct_steps = 0;
   double seconds = 0;
+  // Backward over a checkpointed rollout (checkpointed_rollout.h): forward
+  // steps it recomputed, and the most states (2 x 3n doubles each) held at
+  // once, the rollout's included. Zero otherwise.
+  int recomputed_steps = 0;
+  int peak_states = 0;
 };
 
 // dL/d(input) for every differentiable input of a rollout.

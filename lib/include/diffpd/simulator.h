@@ -10,9 +10,12 @@
 // for every step, iteration and rollout). It is not thread-safe; use one per thread.
 #pragma once
 
+#include <cstddef>
+#include <functional>
 #include <memory>
 #include <vector>
 
+#include "diffpd/checkpointed_rollout.h"
 #include "diffpd/controller.h"
 #include "diffpd/rollout.h"
 #include "diffpd/scene.h"
@@ -98,6 +101,32 @@ class Simulator {
   // from the rollout's ("Backward: the controller's parameters differ from
   // those the rollout was made with").
   RolloutGradient Backward(const Rollout& rollout, const LossGradient& loss, const Controller& controller);
+  // K = inputs.size() steps from `initial` keeping only the checkpoints of
+  // `checkpoints` (checkpointed_rollout.h): memory independent of K but for
+  // the inputs. `observer` (optional) sees every state k = 0..K as it is
+  // computed (e.g. to evaluate a loss). Throws as Step and
+  // CheckpointOptions::Validate.
+  CheckpointedRollout SimulateCheckpointed(const State& initial, const std::vector<StepInput>& inputs,
+                                           const CheckpointOptions& checkpoints = CheckpointOptions(),
+                                           const std::function<void(int k, const State& state)>& observer = nullptr);
+  // Backward over a checkpointed rollout: the steps between checkpoints are
+  // recomputed with the rollout's forward options, and the gradient is the
+  // stored rollout's (bit for bit with a fixed SolverOptions::adjoint_solver
+  // and svd_warm_start = false, to rounding with warm SVDs).
+  // BackwardReport::recomputed_steps and peak_states say what it cost. The
+  // same preconditions as Backward on a stored rollout (open loop), and
+  // InvalidInputError for checkpoints other than SimulateCheckpointed's
+  // ("Backward: the checkpointed rollout's checkpoints are not those
+  // SimulateCheckpointed keeps for its number of steps and checkpoint
+  // options"), options with svd_warm_start = true, or a state with the
+  // wrong size or a non-finite entry.
+  RolloutGradient Backward(const CheckpointedRollout& rollout, const LossGradient& loss);
+  // The same with the loss's state derivatives asked for as the states are
+  // recomputed, and the per-step gradients passed on (StateLossGradient):
+  // memory independent of K. InvalidInputError for a loss derivative of the
+  // wrong size or non-finite ("Backward: the loss's dL/dx_3 has 5 entries,
+  // expected 0 or 48 finite ones (3 x number of nodes)").
+  RolloutGradient Backward(const CheckpointedRollout& rollout, const StateLossGradient& loss);
   // Forward mode: tangents of every state of the rollout along each of the
   // P directions (tangent_rollout.h), all P solved together per step with the
   // step's exact Hessian H (PD: the forward factor of A, A z = b + dA z or
@@ -108,6 +137,18 @@ class Simulator {
   // no direction or a direction with wrongly sized or non-finite entries.
   // A closed-loop rollout's actions are held fixed (open-loop tangents).
   TangentRollout Tangents(const Rollout& rollout, const std::vector<InputDirection>& directions);
+  // Forward mode over a checkpointed rollout: its states are recomputed from
+  // the initial one alongside the tangents (one forward step per step, with
+  // the rollout's forward options), so the tangents are the stored
+  // rollout's, bit for bit with a fixed SolverOptions::adjoint_solver and
+  // svd_warm_start = false. With
+  // a consumer (tangent_rollout.h) every state and its tangents go to it as
+  // they are computed and TangentRollout::dx and dv stay empty (memory
+  // independent of K); without, they hold every state's tangents. The
+  // preconditions and exceptions of Backward over a checkpointed rollout and
+  // of Tangents.
+  TangentRollout Tangents(const CheckpointedRollout& rollout, const std::vector<InputDirection>& directions,
+                          const TangentConsumer& consumer = nullptr);
 
   // Equilibrium under the declared forces (gravity, `input.external_force`)
   // and Dirichlet conditions, by Newton (newton-pcg if that is the method,
@@ -121,6 +162,10 @@ class Simulator {
   // pays per (mesh, h, material weights, Dirichlet set), shared by every
   // iteration, step and rollout after it.
   double pd_factorization_seconds() const;
+  // Bytes of the PD factor's copy for parallel solves in use: 0 before a PD
+  // method has stepped, or where the copy would exceed
+  // SolverOptions::pd_factor_copy_max_bytes and CHOLMOD solves instead.
+  std::size_t pd_factor_copy_bytes() const;
 
  private:
   // Backward after the rollout's checks, with an optional controller

@@ -195,6 +195,27 @@ struct SolverOptions {
   // - x_i) / h. > 1; infinity: only a non-finite state is an error.
   double max_extent_ratio = 1e3;
 
+  // PD methods solve with their factor of A through a copy of it laid out
+  // for parallel triangular solves (twice L's entries: about 20 bytes per
+  // entry, 1.2 GiB for a 421 k-DoF cantilever). When that copy's estimated
+  // size exceeds this many bytes the copy is not made and CHOLMOD's own
+  // solves serve instead (the same solutions to rounding; slower on two or
+  // more threads, serial). Default 4 GiB, a fixed size so that which path
+  // runs never depends on the machine's state; >= 0 (0: never a copy,
+  // infinity: always). Simulator::pd_factor_copy_bytes() says which path is
+  // in use.
+  double pd_factor_copy_max_bytes = 4294967296.0;
+
+  // Each SVD of the elastic forces (one per quadrature sample) starts its
+  // iterations from the previous evaluation's result at that sample (true,
+  // default: fewer sweeps) or, false, from the identity at the start of
+  // every forward step, backward step and tangent step, so that a step
+  // depends on its states and input alone and is recomputed bit for bit.
+  // The results differ in the last bits only. Checkpointed rollouts
+  // (Simulator::SimulateCheckpointed) always run with false; a stored
+  // rollout made with false has their derivatives bit for bit.
+  bool svd_warm_start = true;
+
   // Threads for the element loops and PD's triangular solves (0: OpenMP's
   // default), at most MaxSolverThreads(). Never changes the process-wide
   // OpenMP setting. Results do not depend on it beyond rounding (the solves'

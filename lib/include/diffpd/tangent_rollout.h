@@ -9,6 +9,7 @@
 // parameters); with one scalar loss and many inputs use Backward instead.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "diffpd/rollout.h"
@@ -64,5 +65,10 @@ struct TangentRollout {
   int num_steps() const { return static_cast<int>(dx.size()) - 1; }
   int num_directions() const { return dx.empty() ? 0 : static_cast<int>(dx[0].cols()); }
 };
+
+// Receives state k of a rollout and its tangents dx_k, dv_k (3n x P, as in
+// TangentRollout) as a tangent pass computes them, k = 0, 1, ..., K in order
+// (Simulator::Tangents over a checkpointed rollout).
+using TangentConsumer = std::function<void(int k, const State& state, const MatrixXd& dx, const MatrixXd& dv)>;
 
 }  // namespace diffpd

@@ -150,6 +150,8 @@ ElasticForces::ElasticForces(const FemModel& fem, std::vector<ElasticEnergy> ene
   }
 }
 
+void ElasticForces::ResetWarmStart() { std::fill(v_cache_.begin(), v_cache_.end(), Mat3::Identity()); }
+
 double ElasticForces::PdWeight(double mu, double lambda) const {
   double w = 0;
   for (const ElasticEnergy e : energies_) {

@@ -35,6 +35,13 @@ class ElasticForces {
   // not of PD form, used only as the quasi-Newton initial Hessian).
   double PdWeight(double mu, double lambda) const;
 
+  // Resets the SVDs' warm start (every sample's V) to the identity, so that
+  // what follows depends on its inputs alone, not on earlier evaluations.
+  // Every step calls it first when SolverOptions::svd_warm_start is false: a
+  // step is then a function of its state and input, recomputed bit for bit
+  // (checkpointed_rollout.h).
+  void ResetWarmStart();
+
   // Returns E(x) (J) and, if grad != nullptr, sets *grad = dE/dx (3n, N).
   // Throws SolverError(kInvertedElement) for neo-Hookean with det F <= 0 and
   // SolverError(kNonFinite) when x produces a non-finite value.

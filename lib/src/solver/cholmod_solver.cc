@@ -106,6 +106,8 @@ void CholmodSolver::MakeCopy() {
   const cholmod_factor* f = impl_->With(layout_, [](auto& llt) { return llt.factor(); });
   if (f == nullptr || !f->is_ll || f->xtype != CHOLMOD_REAL || f->itype != CHOLMOD_INT) return;
   const int n = static_cast<int>(f->n);
+  // The lean path: CHOLMOD solves.
+  if (ParallelTriangularSolve::EstimatedBytes(n, factor_nonzeros()) > copy_max_bytes_) return;
   std::vector<int> node_of_column;
   if (f->is_super) {
     node_of_column.resize(n);

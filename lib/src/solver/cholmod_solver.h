@@ -9,6 +9,7 @@
 // factorised once and solved with at every iteration; see PdSystem).
 #pragma once
 
+#include <limits>
 #include <memory>
 
 #include "diffpd/types.h"
@@ -58,6 +59,11 @@ class CholmodSolver {
   // kParallelCopy: threads of the solves (>= 1, default 1); takes effect at
   // once (the copy is re-partitioned) or at the next factorisation.
   void set_solve_threads(int threads);
+  // kParallelCopy: the most bytes the copy may take (its size estimated from
+  // the factor's entries before it is made: ParallelTriangularSolve::
+  // EstimatedBytes); above it no copy is made and CHOLMOD solves. >= 0;
+  // default: no bound. Takes effect at the next factorisation.
+  void set_copy_max_bytes(double bytes) { copy_max_bytes_ = bytes; }
   // kParallelCopy: the copy in use (null before a factorisation, or where the
   // factor was not in the form the copy needs and CHOLMOD solves instead).
   const ParallelTriangularSolve* parallel_copy() const { return copy_.get(); }
@@ -80,6 +86,7 @@ class CholmodSolver {
   CholmodLayout layout_;
   CholmodSolveKernel kernel_;
   int solve_threads_ = 1;
+  double copy_max_bytes_ = std::numeric_limits<double>::infinity();
   std::unique_ptr<ParallelTriangularSolve> copy_;
   Eigen::Index rows_ = -1;
   Eigen::Index nonzeros_ = -1;

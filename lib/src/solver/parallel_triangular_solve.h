@@ -52,6 +52,14 @@ class ParallelTriangularSolve {
   int num_threads() const { return num_threads_; }
   // Bytes held by the copy (values, row indices, triangles, partition).
   std::size_t bytes() const;
+  // An upper estimate of the bytes a copy of an n x n factor with
+  // `factor_nonzeros` entries takes, for the memory check before the copy is
+  // made: two layouts of the values and the row indices (a tenth more for
+  // the padding of the blocks' rows), and per column at most a block
+  // triangle's row (kBlockWidth doubles), 7 padding rows and the partition.
+  static double EstimatedBytes(int n, double factor_nonzeros) {
+    return 1.1 * factor_nonzeros * (2 * sizeof(double) + sizeof(int)) + 160.0 * n;
+  }
   // Share of L's entries in the serial top (0 when solved serially: all of
   // it runs on one thread, none of it waits).
   double serial_fraction() const { return serial_fraction_; }

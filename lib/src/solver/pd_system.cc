@@ -162,6 +162,17 @@ void PdSystem::SetSolveThreads(int threads) {
   for (Group& g : groups_) g.solver->set_solve_threads(threads);
 }
 
+void PdSystem::SetCopyMaxBytes(double bytes) {
+  for (Group& g : groups_) g.solver->set_copy_max_bytes(bytes);
+}
+
+std::size_t PdSystem::copy_bytes() const {
+  std::size_t bytes = 0;
+  for (const Group& g : groups_)
+    if (g.solver->parallel_copy()) bytes += g.solver->parallel_copy()->bytes();
+  return bytes;
+}
+
 void PdSystem::SetAuxiliaryMatrix(const SparseMatrix& auxiliary) {
   auxiliary_ = auxiliary;
   h_ = -1;

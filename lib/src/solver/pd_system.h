@@ -52,6 +52,11 @@ class PdSystem {
   // copy is solved in parallel over subtrees of its elimination tree
   // (solver/parallel_triangular_solve.h).
   void SetSolveThreads(int threads);
+  // The most bytes the factors' copies may take (CholmodSolver::
+  // set_copy_max_bytes); from the next factorisation.
+  void SetCopyMaxBytes(double bytes);
+  // Bytes of the factors' copies in use (0: none, CHOLMOD solves).
+  std::size_t copy_bytes() const;
   // y = A x over the free DoFs (fixed rows and columns erased).
   VectorXd Apply(const VectorXd& x) const;
 

@@ -4,6 +4,7 @@
 
 #include "diffpd/error.h"
 #include "forces/activation_scope.h"
+#include "solver/checkpoint_schedule.h"
 
 namespace diffpd::internal {
 namespace {
@@ -23,6 +24,18 @@ void CheckEntries(const VectorXd& v, int n, bool allow_empty, const std::string&
     msg << "a non-finite entry in " << name;
     throw InvalidInputError(msg.str());
   }
+}
+
+// "<caller>: the checkpointed rollout's <what> has x with ..." unless s has
+// 3n finite entries in x and in v.
+void CheckState(const State& s, int n, const std::string& caller, const std::string& what) {
+  for (const VectorXd* v : {&s.x, &s.v})
+    if (v->size() != n || !v->allFinite()) {
+      std::ostringstream msg;
+      msg << caller << ": the checkpointed rollout's " << what << " has " << (v == &s.x ? "x" : "v") << " with "
+          << v->size() << " entries, expected " << n << " finite ones (3 x number of nodes)";
+      throw InvalidInputError(msg.str());
+    }
 }
 
 }  // namespace
@@ -55,6 +68,38 @@ void CheckRolloutForDerivatives(const SimulatorImpl& sim, const Rollout& rollout
   const bool contact = !sim.scene.frictional_contacts.empty() && sim.options.method != Method::kSemiImplicit;
   if (contact && rollout.reports.size() != steps)
     throw InvalidInputError(caller + ": a rollout with frictional contact needs its step reports (active sets)");
+}
+
+void CheckCheckpointedRollout(const SimulatorImpl& sim, const CheckpointedRollout& rollout, const std::string& caller) {
+  const int n = sim.num_dofs();
+  const int steps = rollout.num_steps();
+  rollout.checkpoint_options.Validate();
+  CheckState(rollout.initial, n, caller, "initial state");
+  CheckState(rollout.final, n, caller, "final state");
+  if (rollout.checkpoint_steps != FirstDescentSteps(steps, rollout.checkpoint_options.num_checkpoints) ||
+      rollout.checkpoints.size() != rollout.checkpoint_steps.size() ||
+      rollout.checkpoint_reports.size() != rollout.checkpoint_steps.size())
+    throw InvalidInputError(caller +
+                            ": the checkpointed rollout's checkpoints are not those SimulateCheckpointed keeps for its "
+                            "number of steps and checkpoint options");
+  if (rollout.options.svd_warm_start)
+    throw InvalidInputError(caller +
+                            ": the checkpointed rollout's options have svd_warm_start = true; its steps cannot be "
+                            "recomputed bit for bit (SimulateCheckpointed sets it false)");
+  for (size_t c = 0; c < rollout.checkpoints.size(); ++c)
+    CheckState(rollout.checkpoints[c], n, caller, "checkpoint " + std::to_string(c));
+  for (int k = 0; k < steps; ++k) {
+    CheckEntries(rollout.inputs[k].external_force, n, true, caller, "input", k, "external_force");
+    try {
+      CheckActivation(rollout.inputs[k].activation, sim.aux.num_muscles());
+    } catch (const InvalidInputError& e) {
+      throw InvalidInputError(caller + ": the rollout's input " + std::to_string(k) + ": " + e.what());
+    }
+  }
+  if (!MadeWithCurrentSettings(sim, rollout.material, rollout.region_materials, rollout.options))
+    throw InvalidInputError(caller +
+                            ": the rollout was made with another material, time step or method than the simulator's "
+                            "current ones");
 }
 
 }  // namespace diffpd::internal

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "diffpd/checkpointed_rollout.h"
 #include "diffpd/rollout.h"
 #include "solver/simulator_impl.h"
 
@@ -25,5 +26,14 @@ namespace diffpd::internal {
 //  - with frictional contact (implicit methods), one report per step: "Backward: a rollout with frictional contact
 //    needs its step reports (active sets)".
 void CheckRolloutForDerivatives(const SimulatorImpl& sim, const Rollout& rollout, const std::string& caller);
+
+// The same for a checkpointed rollout (checkpointed_rollout.h): valid
+// checkpoint options, the initial, final and checkpoint states of 3n finite
+// entries ("Backward: the checkpointed rollout's checkpoint 0 has v with 5
+// entries, expected 48 finite ones (3 x number of nodes)"), the checkpoints
+// SimulateCheckpointed keeps ("Backward: the checkpointed rollout's
+// checkpoints are not those SimulateCheckpointed keeps for its number of
+// steps and checkpoint options"), the inputs and settings as above.
+void CheckCheckpointedRollout(const SimulatorImpl& sim, const CheckpointedRollout& rollout, const std::string& caller);
 
 }  // namespace diffpd::internal

@@ -9,7 +9,7 @@
 #include "contact/active_set_step.h"
 #include "diffpd/error.h"
 #include "forces/activation_scope.h"
-#include "solver/adjoint_tolerance.h"
+#include "solver/adjoint_sweep.h"
 #include "solver/energy_bounded_step.h"
 #include "solver/rollout_checks.h"
 #include "solver/simulator_impl.h"
@@ -111,6 +111,8 @@ int Simulator::num_pd_factorizations() const {
 
 double Simulator::pd_factorization_seconds() const { return impl_->pd_factorization_seconds(); }
 
+std::size_t Simulator::pd_factor_copy_bytes() const { return impl_->pd_factor_copy_bytes(); }
+
 State Simulator::Step(const State& state, const StepInput& input, StepReport* report) {
   SimulatorImpl& sim = *impl_;
   const int n = sim.num_dofs();
@@ -120,6 +122,8 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
   internal::CheckActivation(input.activation, sim.aux.num_muscles());
   const internal::ActivationScope activation(sim, input.activation);
   const auto start = Clock::now();
+  // Cold SVDs: the step's result depends on (state, input) alone.
+  if (!sim.options.svd_warm_start) sim.elastic.ResetWarmStart();
   StepReport local;
   StepReport* rep = report ? report : &local;
   *rep = StepReport();
@@ -276,124 +280,13 @@ RolloutGradient BackwardPass(SimulatorImpl& sim, const Rollout& rollout, const L
     CheckVector(loss.dx[k], n, "loss.dx", true);
     CheckVector(loss.dv[k], n, "loss.dv", true);
   }
-  const double h = sim.h();
-  const VectorXd& mass = sim.Mass();
-  const bool contact = !sim.scene.frictional_contacts.empty() && IsImplicit(sim.options.method);
-  RolloutGradient out;
-  out.external_force.assign(steps, VectorXd());
-  out.activation.assign(steps, VectorXd());
-  VectorXd gx = loss.dx[steps].size() ? loss.dx[steps] : VectorXd::Zero(n);
-  VectorXd gv = loss.dv[steps].size() ? loss.dv[steps] : VectorXd::Zero(n);
-  VectorXd g_memory;  // dL/dm_{i+1} of the controller (empty: zero)
-  if (controller) out.controller_parameters = VectorXd::Zero(controller->num_parameters());
-  // Material adjoints per part (0: base, r + 1: region r): Lame parameters,
-  // and dL/dM (3n), turned into densities at the end (M = sum_p rho_p m_p).
-  const int parts = sim.num_parts();
-  VectorXd dmu = VectorXd::Zero(parts), dlambda = VectorXd::Zero(parts);
-  VectorXd part_mu, part_lambda;
-  VectorXd dmass = VectorXd::Zero(n);
-  const VectorXd gravity = internal::GravityPerDof(sim);
-
-  // The adjoints solved so far: the next step's initial guess.
-  internal::AdjointRecycling recycling(sim.options.adjoint_guess_solutions);
-  for (int i = steps - 1; i >= 0; --i) {
-    const State& s0 = rollout.states[i];
-    const State& s1 = rollout.states[i + 1];
-    const internal::ActivationScope activation(sim, rollout.inputs[i].activation);
-    VectorXd gx_prev, gv_prev;
-    if (IsImplicit(sim.options.method)) {
-      VectorXd b = gx + gv / h;
-      // With contact the step's active set is held fixed: its nodes are pinned.
-      std::optional<internal::ContactPinScope> pins;
-      if (contact) pins.emplace(sim, rollout.reports[i].contact_nodes, s1.x);
-      internal::StepLinearization lin(sim, s1.x);
-      lin.set_recycling(&recycling);
-      lin.set_rel_tolerance(internal::AdjointRelTolerance(
-          sim.options, rollout.options.rel_tolerance,
-          static_cast<int>(rollout.reports.size()) == steps ? &rollout.reports[i] : nullptr));
-      const VectorXd z = lin.Solve(b, &out.report);  // zero at fixed DoFs
-      sim.elastic.PartLameDots(s1.x, z, sim.part_of_element, parts, &part_mu, &part_lambda, sim.threads());
-      dmu -= part_mu;
-      dlambda -= part_lambda;
-      // grad g depends on M through M (x_{i+1} - x_i - h v_i) / h^2 - M g.
-      dmass -= z.cwiseProduct((s1.x - s0.x - h * s0.v) / (h * h) - gravity);
-      out.external_force[i] = z;
-      if (sim.aux.num_muscles() > 0) out.activation[i] = sim.aux.muscles().ActivationGradient(s1.x, sim.activation, z);
-      gx_prev = mass.cwiseProduct(z) / (h * h) - gv / h;
-      gv_prev = mass.cwiseProduct(z) / h;
-      if (contact) internal::AddPinGradient(sim, lin, s0, rollout.reports[i].contact_nodes, b, z, &gx_prev, &gv_prev);
-    } else {
-      // Semi-implicit: v1 = v0 + h M^-1 (f - grad E(x0)) on free DoFs, x1 = x0 + h v1.
-      VectorXd gvt = gv + h * gx;  // total dL/dv1 through v1 and x1
-      sim.ZeroFixed(&gvt);
-      const VectorXd w = h * gvt.cwiseQuotient(mass);  // dL/d(force) = h M^-1 gvt
-      std::vector<Mat9> dstress;
-      sim.elastic.StressDifferentials(s0.x, sim.lame(), &dstress, sim.threads());
-      VectorXd hw;
-      sim.elastic.ApplyHessian(dstress, w, &hw, sim.threads());
-      sim.aux.AddHessianProduct(s0.x, sim.activation, w, &hw);
-      if (sim.aux.num_muscles() > 0) out.activation[i] = sim.aux.muscles().ActivationGradient(s0.x, sim.activation, w);
-      VectorXd gx_free = gx;
-      sim.ZeroFixed(&gx_free);
-      gx_prev = gx_free - hw;
-      for (int d = 0; d < n; ++d)
-        if (sim.fixed[d]) gx_prev(d) -= gv(d) / h;
-      gv_prev = gvt;
-      sim.elastic.PartLameDots(s0.x, w, sim.part_of_element, parts, &part_mu, &part_lambda, sim.threads());
-      dmu -= part_mu;
-      dlambda -= part_lambda;
-      // M^-1 (f_user + f_state - grad E) varies with M as -M^-2 (...) dM
-      // (f_state's explicit dependence on M is added below); gravity's
-      // acceleration M^-1 M g does not vary.
-      VectorXd grad_e;
-      sim.elastic.EnergyAndGradient(s0.x, sim.lame(), &grad_e, sim.threads());
-      sim.aux.AddEnergyAndGradient(s0.x, sim.activation, &grad_e);
-      VectorXd net = rollout.inputs[i].external_force.size() ? rollout.inputs[i].external_force : VectorXd::Zero(n);
-      sim.state_forces.Add(s0.x, s0.v, mass, &net);
-      net -= grad_e;
-      dmass -= w.cwiseProduct(net).cwiseQuotient(mass);
-      out.external_force[i] = w;
-    }
-    // Explicit state forces f(x_i, v_i; M): dL/df = out.external_force[i].
-    sim.state_forces.AddVjp(s0.x, s0.v, mass, out.external_force[i], &gx_prev, &gv_prev, &out.state_forces, &dmass);
-    if (controller) {
-      // The action u_i = pi(x_i, v_i, m_i): dL/du_i flows into the state and memory.
-      const ControlAction g_action{out.activation[i], out.external_force[i]};
-      VectorXd g_memory_prev;
-      controller->ActVjp(i, s0, rollout.controller_memory[i], g_action, g_memory, &gx_prev, &gv_prev, &g_memory_prev,
-                         &out.controller_parameters);
-      g_memory = std::move(g_memory_prev);
-    }
-    if (loss.dx[i].size()) gx_prev += loss.dx[i];
-    if (loss.dv[i].size()) gv_prev += loss.dv[i];
-    gx = std::move(gx_prev);
-    gv = std::move(gv_prev);
-  }
-  out.x0 = gx;
-  out.v0 = gv;
-  if (controller) out.controller_memory = g_memory.size() ? g_memory : VectorXd::Zero(controller->memory_size());
-  const VectorXd drho = sim.mass_model.DensityGradient(dmass);
-  for (int p = 0; p < parts; ++p) {
-    double dmu_dE, dmu_dnu, dl_dE, dl_dnu;
-    sim.part_material(p).LameDerivatives(&dmu_dE, &dmu_dnu, &dl_dE, &dl_dnu);
-    MaterialComponents g;
-    g.youngs_modulus = dmu(p) * dmu_dE + dlambda(p) * dl_dE;
-    g.poissons_ratio = dmu(p) * dmu_dnu + dlambda(p) * dl_dnu;
-    g.density = drho(p);
-    if (p == 0) {
-      out.youngs_modulus = g.youngs_modulus;
-      out.poissons_ratio = g.poissons_ratio;
-      out.density = g.density;
-    } else {
-      out.region_materials.push_back(g);
-    }
-  }
-  bool finite = out.x0.allFinite() && out.v0.allFinite() && std::isfinite(out.youngs_modulus) &&
-                std::isfinite(out.poissons_ratio) && std::isfinite(out.density);
-  for (int i = 0; i < steps; ++i) finite = finite && out.external_force[i].allFinite() && out.activation[i].allFinite();
-  for (const MaterialComponents& g : out.region_materials)
-    finite = finite && std::isfinite(g.youngs_modulus) && std::isfinite(g.poissons_ratio) && std::isfinite(g.density);
-  if (!finite) throw SolverError(SolverStatus::kNonFinite, "the gradient is not finite");
+  const bool with_reports = static_cast<int>(rollout.reports.size()) == steps;
+  internal::AdjointSweep sweep(sim, steps, rollout.options, loss.dx[steps], loss.dv[steps], controller);
+  for (int i = steps - 1; i >= 0; --i)
+    sweep.Step(i, rollout.states[i], rollout.states[i + 1], rollout.inputs[i],
+               with_reports ? &rollout.reports[i] : nullptr, controller ? &rollout.controller_memory[i] : nullptr,
+               loss.dx[i], loss.dv[i]);
+  RolloutGradient out = sweep.Finish();
   out.report.seconds = Seconds(start);
   return out;
 }

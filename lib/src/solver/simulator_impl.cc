@@ -112,6 +112,7 @@ PdSystem& SimulatorImpl::pd_system() {
     weights.push_back(scale * elastic.PdWeight(m.mu(), m.lambda()));
   }
   pd_->SetSolveThreads(threads() > 0 ? threads() : omp_get_max_threads());
+  pd_->SetCopyMaxBytes(options.pd_factor_copy_max_bytes);
   pd_->Update(h(), densities, weights);
   return *pd_;
 }
@@ -146,12 +147,17 @@ bool SameMaterial(const MaterialParameters& a, const MaterialParameters& b) {
 
 }  // namespace
 
+bool MadeWithCurrentSettings(const SimulatorImpl& sim, const MaterialParameters& material,
+                             const std::vector<MaterialParameters>& region_materials, const SolverOptions& options) {
+  if (!SameMaterial(material, sim.scene.material)) return false;
+  if (region_materials.size() != sim.scene.material_regions.size()) return false;
+  for (size_t r = 0; r < region_materials.size(); ++r)
+    if (!SameMaterial(region_materials[r], sim.scene.material_regions[r].material)) return false;
+  return options.time_step == sim.h() && options.method == sim.options.method;
+}
+
 bool MadeWithCurrentSettings(const SimulatorImpl& sim, const Rollout& rollout) {
-  if (!SameMaterial(rollout.material, sim.scene.material)) return false;
-  if (rollout.region_materials.size() != sim.scene.material_regions.size()) return false;
-  for (size_t r = 0; r < rollout.region_materials.size(); ++r)
-    if (!SameMaterial(rollout.region_materials[r], sim.scene.material_regions[r].material)) return false;
-  return rollout.options.time_step == sim.h() && rollout.options.method == sim.options.method;
+  return MadeWithCurrentSettings(sim, rollout.material, rollout.region_materials, rollout.options);
 }
 
 VectorXd GravityPerDof(const SimulatorImpl& sim) {

@@ -106,6 +106,7 @@ class SimulatorImpl {
   void ResetAdjointCostModels();
   int pd_factorizations() const { return pd_ ? pd_->num_factorizations() : 0; }
   double pd_factorization_seconds() const { return pd_ ? pd_->factorization_seconds() : 0.0; }
+  std::size_t pd_factor_copy_bytes() const { return pd_ ? pd_->copy_bytes() : 0; }
 
  private:
   void MaterialsChanged();
@@ -123,6 +124,9 @@ class SimulatorImpl {
 // True when `rollout` was made with the simulator's current materials (base
 // and regions), time step and method: the condition of Backward and Tangents.
 bool MadeWithCurrentSettings(const SimulatorImpl& sim, const Rollout& rollout);
+// The same for a rollout's recorded materials and options.
+bool MadeWithCurrentSettings(const SimulatorImpl& sim, const MaterialParameters& material,
+                             const std::vector<MaterialParameters>& region_materials, const SolverOptions& options);
 // Gravity's acceleration at every DoF (3n, m/s^2; zero without gravity).
 VectorXd GravityPerDof(const SimulatorImpl& sim);
 

@@ -106,6 +106,8 @@ void SolverOptions::Validate() const {
     Reject("adjoint_solver", static_cast<int>(adjoint_solver), "kAuto (0), kIterative (1) or kDirect (2)");
   if (backward_max_iterations < 1) Reject("backward_max_iterations", backward_max_iterations, ">= 1");
   if (adjoint_guess_solutions < 0) Reject("adjoint_guess_solutions", adjoint_guess_solutions, ">= 0");
+  if (!(pd_factor_copy_max_bytes >= 0))
+    Reject("pd_factor_copy_max_bytes", pd_factor_copy_max_bytes, ">= 0 (0: never a copy, infinity: always)");
   if (!(max_extent_ratio > 1)) Reject("max_extent_ratio", max_extent_ratio, "> 1 (infinity: no bound)");
   if (num_threads < 0 || num_threads > MaxSolverThreads()) {
     std::ostringstream range;

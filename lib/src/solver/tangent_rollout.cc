@@ -25,6 +25,7 @@
 // force directions as df = df/dx dx_i + df/dv dv_i + df/dM dM + df/dtheta
 // dtheta (their Jacobian-vector products).
 #include <chrono>
+#include <functional>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -35,6 +36,7 @@
 #include "contact/active_set_step.h"
 #include "forces/activation_scope.h"
 #include "solver/adjoint_tolerance.h"
+#include "solver/forward_options_scope.h"
 #include "solver/rollout_checks.h"
 #include "solver/simulator_impl.h"
 
@@ -211,12 +213,26 @@ MaterialComponents PartComponents(const InputDirection& d, int part) {
 
 namespace {
 
-// Tangents' pass over the steps; checks its input first.
-TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std::vector<InputDirection>& directions) {
+// The states and report of step i as the tangent pass meets them (i = 0,
+// 1, ..., K - 1 in order; report nullptr: none). The pointers stay valid
+// until the next call.
+struct TangentStep {
+  const State* s0 = nullptr;
+  const State* s1 = nullptr;
+  const StepReport* report = nullptr;
+};
+using TangentStepSource = std::function<TangentStep(int i)>;
+
+// The pass over K = inputs.size() steps of a rollout made with `forward`
+// options (their tolerance and SVD warm start), the states from `step_at`. With a
+// consumer, each state's tangents go to it as they are computed and the
+// result's dx and dv stay empty.
+TangentRollout TangentPass(SimulatorImpl& sim, const std::vector<StepInput>& inputs, const SolverOptions& forward,
+                           const State& initial, const TangentStepSource& step_at,
+                           const std::vector<InputDirection>& directions, const TangentConsumer& consumer) {
   const auto start = std::chrono::steady_clock::now();
   const int n = sim.num_dofs();
-  const int steps = rollout.num_steps();
-  internal::CheckRolloutForDerivatives(sim, rollout, "Tangents");
+  const int steps = static_cast<int>(inputs.size());
   CheckDirections(directions, n, steps, sim.aux.num_muscles(), static_cast<int>(sim.scene.material_regions.size()));
   CheckStateForceDirections(directions, sim.scene);
   const bool contact = !sim.scene.frictional_contacts.empty() && sim.options.method != Method::kSemiImplicit;
@@ -276,8 +292,8 @@ TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std
   for (int p = 0; p < num_dirs; ++p) state_force_dirs[p] = directions[p].state_forces;
 
   TangentRollout out;
-  out.dx.resize(steps + 1);
-  out.dv.resize(steps + 1);
+  out.dx.resize(consumer ? 1 : steps + 1);
+  out.dv.resize(consumer ? 1 : steps + 1);
   out.dx[0] = MatrixXd::Zero(n, num_dirs);
   out.dv[0] = MatrixXd::Zero(n, num_dirs);
   for (int p = 0; p < num_dirs; ++p) {
@@ -309,12 +325,19 @@ TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std
 
   // The tangents solved so far: the next step's initial guess.
   internal::AdjointRecycling recycling(sim.options.adjoint_guess_solutions);
+  // With a consumer only the latest tangents are kept (in out.dx[0], dv[0]).
+  if (consumer) consumer(0, initial, out.dx[0], out.dv[0]);
   for (int i = 0; i < steps; ++i) {
-    const State& s0 = rollout.states[i];
-    const State& s1 = rollout.states[i + 1];
-    const MatrixXd& dx0 = out.dx[i];
-    const MatrixXd& dv0 = out.dv[i];
-    const internal::ActivationScope activation(sim, rollout.inputs[i].activation);
+    const TangentStep at = step_at(i);
+    const State& s0 = *at.s0;
+    const State& s1 = *at.s1;
+    const int from = consumer ? 0 : i;
+    const MatrixXd& dx0 = out.dx[from];
+    const MatrixXd& dv0 = out.dv[from];
+    const internal::ActivationScope activation(sim, inputs[i].activation);
+    // Cold SVDs where the forward had them: the step's tangents depend on its
+    // states alone (a checkpointed rollout's states are recomputed in between).
+    if (!forward.svd_warm_start) sim.elastic.ResetWarmStart();
     MatrixXd dx1;
     if (implicit) {
       // Right-hand sides: inertia through xhat, force directions, parameters.
@@ -331,7 +354,7 @@ TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std
       sim.state_forces.AddJvp(s0.x, s0.v, mass, dx0, dv0, dmass, state_force_dirs, &b);
       subtract_activation_terms(i, s1.x, &b);
       const std::vector<int> no_pins;
-      const std::vector<int>& pinned = contact ? rollout.reports[i].contact_nodes : no_pins;
+      const std::vector<int>& pinned = contact ? at.report->contact_nodes : no_pins;
       MatrixXd dpin = MatrixXd::Zero(n, num_dirs);
       if (!pinned.empty()) {
         // Pinned nodes follow their pins; move their coupling to the right.
@@ -349,9 +372,7 @@ TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std
       if (!pinned.empty()) pins.emplace(sim, pinned, s1.x);
       internal::StepLinearization lin(sim, s1.x);
       lin.set_recycling(&recycling);
-      lin.set_rel_tolerance(internal::AdjointRelTolerance(
-          sim.options, rollout.options.rel_tolerance,
-          static_cast<int>(rollout.reports.size()) == steps ? &rollout.reports[i] : nullptr));
+      lin.set_rel_tolerance(internal::AdjointRelTolerance(sim.options, forward.rel_tolerance, at.report));
       dx1 = lin.SolveColumns(b, &out.report) + dpin;  // zero at fixed DoFs but the pins
     } else {
       // Acceleration tangent on free DoFs, then symplectic update.
@@ -374,7 +395,7 @@ TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std
         VectorXd grad_e;
         sim.elastic.EnergyAndGradient(s0.x, sim.lame(), &grad_e, sim.threads());
         sim.aux.AddEnergyAndGradient(s0.x, sim.activation, &grad_e);
-        const VectorXd& user = rollout.inputs[i].external_force;
+        const VectorXd& user = inputs[i].external_force;
         VectorXd force_sum = user.size() ? user : VectorXd::Zero(n);
         sim.state_forces.Add(s0.x, s0.v, mass, &force_sum);
         const VectorXd net = (force_sum - grad_e).cwiseQuotient(mass.cwiseAbs2());
@@ -385,29 +406,69 @@ TangentRollout TangentPass(SimulatorImpl& sim, const Rollout& rollout, const std
       for (int d = 0; d < n; ++d)
         if (sim.fixed[d]) dx1.row(d).setZero();
     }
-    out.dv[i + 1] = (dx1 - dx0) / h;
-    out.dx[i + 1] = std::move(dx1);
+    MatrixXd dv1 = (dx1 - dx0) / h;
+    if (!dx1.allFinite() || !dv1.allFinite())
+      throw SolverError(SolverStatus::kNonFinite, "the tangent of state " + std::to_string(i + 1) + " is not finite");
+    if (consumer) {
+      consumer(i + 1, s1, dx1, dv1);
+      out.dx[0] = std::move(dx1);
+      out.dv[0] = std::move(dv1);
+    } else {
+      out.dv[i + 1] = std::move(dv1);
+      out.dx[i + 1] = std::move(dx1);
+    }
   }
-  for (int k = 0; k <= steps; ++k)
-    if (!out.dx[k].allFinite() || !out.dv[k].allFinite())
-      throw SolverError(SolverStatus::kNonFinite, "the tangent of state " + std::to_string(k) + " is not finite");
+  if (!out.dx[0].allFinite() || !out.dv[0].allFinite())
+    throw SolverError(SolverStatus::kNonFinite, "the tangent of state 0 is not finite");
+  if (consumer) {
+    out.dx.clear();
+    out.dv.clear();
+  }
   out.report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
+}
+
+// Runs `pass`, reporting a non-finite value on the way as an overflow (the
+// rollout and directions were checked finite).
+TangentRollout WithOverflowMessage(const SimulatorImpl& sim, const std::function<TangentRollout()>& pass) {
+  try {
+    return pass();
+  } catch (const SolverError& e) {
+    if (e.status() != SolverStatus::kNonFinite) throw;
+    throw SolverError(SolverStatus::kNonFinite, std::string(ToString(sim.options.method)) +
+                                                    " tangent: the tangents overflowed double precision (" + e.what() +
+                                                    ")");
+  }
 }
 
 }  // namespace
 
 TangentRollout Simulator::Tangents(const Rollout& rollout, const std::vector<InputDirection>& directions) {
-  // The rollout and directions are checked finite: a non-finite value on the
-  // way is an overflow.
-  try {
-    return TangentPass(*impl_, rollout, directions);
-  } catch (const SolverError& e) {
-    if (e.status() != SolverStatus::kNonFinite) throw;
-    throw SolverError(SolverStatus::kNonFinite, std::string(ToString(impl_->options.method)) +
-                                                    " tangent: the tangents overflowed double precision (" + e.what() +
-                                                    ")");
-  }
+  internal::CheckRolloutForDerivatives(*impl_, rollout, "Tangents");
+  const bool with_reports = rollout.reports.size() == rollout.inputs.size();
+  const TangentStepSource step_at = [&rollout, with_reports](int i) {
+    return TangentStep{&rollout.states[i], &rollout.states[i + 1], with_reports ? &rollout.reports[i] : nullptr};
+  };
+  return WithOverflowMessage(*impl_, [&] {
+    return TangentPass(*impl_, rollout.inputs, rollout.options, rollout.states[0], step_at, directions, nullptr);
+  });
+}
+
+TangentRollout Simulator::Tangents(const CheckpointedRollout& rollout, const std::vector<InputDirection>& directions,
+                                   const TangentConsumer& consumer) {
+  internal::CheckCheckpointedRollout(*impl_, rollout, "Tangents");
+  // The states are recomputed step by step with the forward's options.
+  State s0, s1 = rollout.initial;
+  StepReport report;
+  const TangentStepSource step_at = [&](int i) {
+    s0 = std::move(s1);
+    const internal::ForwardOptionsScope forward(*impl_, rollout.options);
+    s1 = Step(s0, rollout.inputs[i], &report);
+    return TangentStep{&s0, &s1, &report};
+  };
+  return WithOverflowMessage(*impl_, [&] {
+    return TangentPass(*impl_, rollout.inputs, rollout.options, rollout.initial, step_at, directions, consumer);
+  });
 }
 
 }  // namespace diffpd

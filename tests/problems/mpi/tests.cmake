@@ -3,7 +3,9 @@
 # (--oversubscribe: CI machines may have fewer cores; the variables let
 # OpenMPI run as root and start local ranks without ssh).
 set(_dir ${CMAKE_CURRENT_LIST_DIR})
-set(_mpi_env "OMP_NUM_THREADS=1;OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_plm=isolated")
+# DIFFPD_MPI_TEST_ENVIRONMENT: as in tests/solvers/mpi/tests.cmake.
+set(_mpi_env
+    "OMP_NUM_THREADS=1;OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_plm=isolated;${DIFFPD_MPI_TEST_ENVIRONMENT}")
 add_executable(distributed_swimmer_training_test ${_dir}/distributed_swimmer_training_test.cc)
 target_link_libraries(distributed_swimmer_training_test PRIVATE diffpd_problems diffpd_mpi diffpd_test_util GTest::gtest
                       diffpd_compile_options)

@@ -9,5 +9,9 @@ target_include_directories(distributed_rollout_set_test PRIVATE ${PROJECT_SOURCE
 add_test(NAME distributed_rollout_set_test
          COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 --oversubscribe ${MPIEXEC_PREFLAGS}
                  $<TARGET_FILE:distributed_rollout_set_test> ${MPIEXEC_POSTFLAGS})
+# Extra NAME=VALUE entries (;-separated) for the environment of every test run
+# by mpiexec (here and in tests/problems/mpi/); scripts/sanitize.sh sets the
+# leak checker's options with it.
+set(DIFFPD_MPI_TEST_ENVIRONMENT "" CACHE STRING "Extra NAME=VALUE entries (;-separated) for distributed_rollout_set_test")
 set_tests_properties(distributed_rollout_set_test PROPERTIES
-  ENVIRONMENT "OMP_NUM_THREADS=1;OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_plm=isolated")
+  ENVIRONMENT "OMP_NUM_THREADS=1;OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_plm=isolated;${DIFFPD_MPI_TEST_ENVIRONMENT}")
