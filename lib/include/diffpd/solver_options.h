@@ -161,8 +161,8 @@ struct SolverOptions {
   // step must meet.
   bool rigid_mode_correction = true;
 
-  // PD methods' backward and tangent solves: iterative, direct or chosen
-  // per step by measured cost (AdjointSolver).
+  // PD methods' backward and tangent solves: iterative, direct or chosen per step by measured cost (AdjointSolver;
+  // kAuto follows timings, so two runs may differ in the last bits: set it to compare runs bit for bit).
   AdjointSolver adjoint_solver = AdjointSolver::kAuto;
   PdBackwardMethod pd_backward = PdBackwardMethod::kConjugateGradient;
   // Iterative backward (adjoint) and tangent solves stop at the relative
