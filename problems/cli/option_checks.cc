@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <functional>
+#include <sstream>
 
 #include "diffpd/error.h"
 #include "diffpd/solver_options.h"
@@ -80,6 +81,15 @@ CLI::Validator Fraction(const std::string& option, bool include_one) {
   return Rule(option, include_one ? "in (0, 1]" : "in (0, 1)", [include_one](const std::string& s) {
     double v = 0;
     return ParseDouble(s, &v) && v > 0 && (include_one ? v <= 1 : v < 1);
+  });
+}
+
+CLI::Validator OpenInterval(const std::string& option, double low, double high) {
+  std::ostringstream range;
+  range << "finite and in (" << low << ", " << high << ")";
+  return Rule(option, range.str(), [low, high](const std::string& s) {
+    double v = 0;
+    return ParseDouble(s, &v) && std::isfinite(v) && v > low && v < high;
   });
 }
 

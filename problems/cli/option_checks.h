@@ -32,5 +32,8 @@ CLI::Validator NonNegative(const std::string& option);
 // A number in (0, 1), or (0, 1] with include_one: "--rtol = 0 is invalid:
 // must be in (0, 1)".
 CLI::Validator Fraction(const std::string& option, bool include_one = false);
+// A finite number in the open interval (low, high): "--nu = 0.7 is invalid:
+// must be finite and in (-1, 0.5)".
+CLI::Validator OpenInterval(const std::string& option, double low, double high);
 
 }  // namespace diffpd::problems

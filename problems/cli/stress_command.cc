@@ -122,9 +122,18 @@ Subcommand AddStressCommand(CLI::App* parent) {
   cmd->add_option("--refine", args->refine, "cell doublings of every problem's mesh")
       ->check(IntegerIn("--refine", kMinRefinement, kMaxRefinement))
       ->capture_default_str();
-  cmd->add_option("--E", o.youngs_moduli, "comma-separated Young's moduli (Pa)")->delimiter(',')->capture_default_str();
-  cmd->add_option("--nu", o.poissons_ratios, "comma-separated Poisson's ratios")->delimiter(',')->capture_default_str();
-  cmd->add_option("--dt", o.time_steps, "comma-separated time steps (s)")->delimiter(',')->capture_default_str();
+  cmd->add_option("--E", o.youngs_moduli, "comma-separated Young's moduli (Pa)")
+      ->delimiter(',')
+      ->check(Positive("--E", "Pa"))
+      ->capture_default_str();
+  cmd->add_option("--nu", o.poissons_ratios, "comma-separated Poisson's ratios")
+      ->delimiter(',')
+      ->check(OpenInterval("--nu", -1, 0.5))
+      ->capture_default_str();
+  cmd->add_option("--dt", o.time_steps, "comma-separated time steps (s)")
+      ->delimiter(',')
+      ->check(Positive("--dt", "s"))
+      ->capture_default_str();
   cmd->add_option("--steps", o.steps, "steps per case")->check(IntegerAtLeast("--steps", 1))->capture_default_str();
   cmd->add_option("--rtol", o.rel_tolerance, "relative tolerance of each step's solve")
       ->check(Fraction("--rtol"))
