@@ -526,25 +526,26 @@ std::vector<Row> RolloutRows() {
          other.time_step = 0.02;
          backward(r, OnesLoss(r), other);
        },
-       "Backward: the rollout was made with another material, time step or method than the simulator's current ones"});
-  rows.push_back(
-      {"rollout of another method",
-       [=] {
-         const Rollout r = BeamRollout(pd);
-         backward(r, OnesLoss(r), testing::TightOptions(Method::kNewtonCholesky));
-       },
-       "Backward: the rollout was made with another material, time step or method than the simulator's current ones"});
-  rows.push_back(
-      {"rollout of another material",
-       [=] {
-         const Rollout r = BeamRollout(pd);
-         Simulator sim(testing::SmallBeamScene(), pd);
-         MaterialParameters m = sim.scene().material;
-         m.youngs_modulus *= 2;
-         sim.SetMaterial(m);
-         sim.Backward(r, OnesLoss(r));
-       },
-       "Backward: the rollout was made with another material, time step or method than the simulator's current ones"});
+       "Backward: the rollout was made with another time step (0.01 s) than the simulator's current one (0.02 "
+       "s)"});
+  rows.push_back({"rollout of another method",
+                  [=] {
+                    const Rollout r = BeamRollout(pd);
+                    backward(r, OnesLoss(r), testing::TightOptions(Method::kNewtonCholesky));
+                  },
+                  "Backward: the rollout was made with another method (pd) than the simulator's current one "
+                  "(newton-cholesky)"});
+  rows.push_back({"rollout of another material",
+                  [=] {
+                    const Rollout r = BeamRollout(pd);
+                    Simulator sim(testing::SmallBeamScene(), pd);
+                    MaterialParameters m = sim.scene().material;
+                    m.youngs_modulus *= 2;
+                    sim.SetMaterial(m);
+                    sim.Backward(r, OnesLoss(r));
+                  },
+                  "Backward: the rollout was made with another material (E = 200000 Pa, nu = 0.4, rho = 1000 kg/m^3) "
+                  "than the simulator's current one (E = 400000 Pa, nu = 0.4, rho = 1000 kg/m^3)"});
   rows.push_back({"rollout without inputs",
                   [=] {
                     Rollout r = BeamRollout(pd);
@@ -614,9 +615,9 @@ std::vector<Row> CommandLineRows() {
   add({"bench", "cantilever", "--scaling", "--scales", "3"},
       "scale = 3 is invalid: must be a power of 2 (1, 2, 4, 8, ...)");
   add({"bench", "cantilever", "--max-iterations", "0"}, "--max-iterations = 0 is invalid: must be an integer >= 1");
-  add({"stress", "--E", "-1"}, "youngs_modulus = -1 is invalid: must be finite and > 0 (Pa)");
-  add({"stress", "--nu", "0.5"}, "poissons_ratio = 0.5 is invalid: must be finite and in (-1, 0.5)");
-  add({"stress", "--dt", "0"}, "time_step = 0 is invalid: must be finite and > 0 (s)");
+  add({"stress", "--E", "-1"}, "--E = -1 is invalid: must be finite and > 0 (Pa)");
+  add({"stress", "--nu", "0.5"}, "--nu = 0.5 is invalid: must be finite and in (-1, 0.5)");
+  add({"stress", "--dt", "0"}, "--dt = 0 is invalid: must be finite and > 0 (s)");
   add({"stress", "--abs-tol", "-1"}, "--abs-tol = -1 is invalid: must be finite and > 0 (N)");
   add({"gradcheck", "cantilever", "--tol", "-1"}, "--tol = -1 is invalid: must be finite and > 0");
   add({"gradcheck", "cantilever", "--directions", "0"}, "--directions = 0 is invalid: must be an integer >= 1");

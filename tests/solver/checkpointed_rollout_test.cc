@@ -341,8 +341,8 @@ TEST(CheckpointedRolloutTest, BadCheckpointsAndLossesAreRejectedWithTheirMessage
   other.time_step = 0.02;
   sim.SetOptions(other);
   ASSERT_THROW_MESSAGE(sim.Backward(r, LossGradient(9)), InvalidInputError,
-                       "Backward: the rollout was made with another material, time step or method than the "
-                       "simulator's current ones");
+                       "Backward: the rollout was made with another time step (0.01 s) than the simulator's current "
+                       "one (0.02 s)");
 }
 
 }  // namespace

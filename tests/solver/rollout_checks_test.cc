@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <functional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -89,9 +90,10 @@ TEST(RolloutChecksTest, BackwardAndTangentsRefuseMalformedRolloutsAlike) {
       {"activations without muscles", [](Rollout* r, Method) { r->inputs[0].activation = VectorXd::Ones(2); },
        "the rollout's input 0: activation has 2 entries, expected 0 (one per muscle)"},
       {"another time step", [](Rollout* r, Method) { r->options.time_step *= 2; },
-       "the rollout was made with another material, time step or method than the simulator's current ones"},
+       "the rollout was made with another time step (<2h> s) than the simulator's current one (<h> s)"},
       {"another material", [](Rollout* r, Method) { r->material.density = 2e3; },
-       "the rollout was made with another material, time step or method than the simulator's current ones"},
+       "the rollout was made with another material (E = 200000 Pa, nu = 0.4, rho = 2000 kg/m^3) than the "
+       "simulator's current one (E = 200000 Pa, nu = 0.4, rho = 1000 kg/m^3)"},
   };
   for (Method method : {Method::kPd, Method::kSemiImplicit}) {
     Simulator sim(beam, Options(method));
@@ -101,8 +103,15 @@ TEST(RolloutChecksTest, BackwardAndTangentsRefuseMalformedRolloutsAlike) {
       Rollout bad = good;
       c.corrupt(&bad, method);
       const auto [backward, tangents] = Messages(sim, bad);
-      EXPECT_EQ(backward, "Backward: " + c.message) << c.name << ", " << ToString(method);
-      EXPECT_EQ(tangents, "Tangents: " + c.message) << c.name << ", " << ToString(method);
+      // <h> and <2h> in a message: the method's time step and twice it.
+      std::string message = c.message;
+      for (const auto& [key, factor] : {std::pair<std::string, double>{"<h>", 1.0}, {"<2h>", 2.0}}) {
+        std::ostringstream value;
+        value << factor * sim.options().time_step;
+        if (const size_t at = message.find(key); at != std::string::npos) message.replace(at, key.size(), value.str());
+      }
+      EXPECT_EQ(backward, "Backward: " + message) << c.name << ", " << ToString(method);
+      EXPECT_EQ(tangents, "Tangents: " + message) << c.name << ", " << ToString(method);
     }
   }
 }

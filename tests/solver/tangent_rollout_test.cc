@@ -247,8 +247,8 @@ TEST(TangentRolloutTest, RejectsBadDirectionsWithMessages) {
   EXPECT_EQ(message({nan}), "Tangents: direction 0 has a non-finite entry in v0");
   sim.SetMaterial(MaterialParameters{3e5, 0.4, 1e3});
   EXPECT_EQ(message({InputDirection::Density()}),
-            "Tangents: the rollout was made with another material, time step or method than the simulator's "
-            "current ones");
+            "Tangents: the rollout was made with another material (E = 200000 Pa, nu = 0.4, rho = 1000 kg/m^3) than "
+            "the simulator's current one (E = 300000 Pa, nu = 0.4, rho = 1000 kg/m^3)");
 }
 
 // A small box (2 x 2 x 2 hexes, 4 cm) dropped onto the plane z = 0 with a

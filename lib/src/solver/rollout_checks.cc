@@ -61,10 +61,8 @@ void CheckRolloutForDerivatives(const SimulatorImpl& sim, const Rollout& rollout
       throw InvalidInputError(caller + ": the rollout's input " + std::to_string(k) + ": " + e.what());
     }
   }
-  if (!MadeWithCurrentSettings(sim, rollout))
-    throw InvalidInputError(caller +
-                            ": the rollout was made with another material, time step or method than the simulator's "
-                            "current ones");
+  const std::string mismatch = SettingsMismatch(sim, rollout.material, rollout.region_materials, rollout.options);
+  if (!mismatch.empty()) throw InvalidInputError(caller + ": the rollout was made with " + mismatch);
   const bool contact = !sim.scene.frictional_contacts.empty() && sim.options.method != Method::kSemiImplicit;
   if (contact && rollout.reports.size() != steps)
     throw InvalidInputError(caller + ": a rollout with frictional contact needs its step reports (active sets)");
@@ -96,10 +94,8 @@ void CheckCheckpointedRollout(const SimulatorImpl& sim, const CheckpointedRollou
       throw InvalidInputError(caller + ": the rollout's input " + std::to_string(k) + ": " + e.what());
     }
   }
-  if (!MadeWithCurrentSettings(sim, rollout.material, rollout.region_materials, rollout.options))
-    throw InvalidInputError(caller +
-                            ": the rollout was made with another material, time step or method than the simulator's "
-                            "current ones");
+  const std::string mismatch = SettingsMismatch(sim, rollout.material, rollout.region_materials, rollout.options);
+  if (!mismatch.empty()) throw InvalidInputError(caller + ": the rollout was made with " + mismatch);
 }
 
 }  // namespace diffpd::internal

@@ -21,8 +21,8 @@ namespace diffpd::internal {
 //    0 has external_force with 3 entries, expected 48 (3 x number of nodes)",
 //    "Backward: the rollout's input 0: activation has 3 entries, expected 2 (one per muscle)";
 //  - made with the simulator's current materials, time step and method
-//    (MadeWithCurrentSettings): "Backward: the rollout was made with another
-//    material, time step or method than the simulator's current ones";
+//    (SettingsMismatch): "Backward: the rollout was made with another time
+//    step (0.01 s) than the simulator's current one (0.02 s)";
 //  - with frictional contact (implicit methods), one report per step: "Backward: a rollout with frictional contact
 //    needs its step reports (active sets)".
 void CheckRolloutForDerivatives(const SimulatorImpl& sim, const Rollout& rollout, const std::string& caller);

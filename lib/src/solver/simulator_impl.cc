@@ -147,17 +147,39 @@ bool SameMaterial(const MaterialParameters& a, const MaterialParameters& b) {
 
 }  // namespace
 
-bool MadeWithCurrentSettings(const SimulatorImpl& sim, const MaterialParameters& material,
-                             const std::vector<MaterialParameters>& region_materials, const SolverOptions& options) {
-  if (!SameMaterial(material, sim.scene.material)) return false;
-  if (region_materials.size() != sim.scene.material_regions.size()) return false;
-  for (size_t r = 0; r < region_materials.size(); ++r)
-    if (!SameMaterial(region_materials[r], sim.scene.material_regions[r].material)) return false;
-  return options.time_step == sim.h() && options.method == sim.options.method;
+namespace {
+
+std::string Describe(const MaterialParameters& m) {
+  std::ostringstream s;
+  s << "E = " << m.youngs_modulus << " Pa, nu = " << m.poissons_ratio << ", rho = " << m.density << " kg/m^3";
+  return s.str();
 }
 
-bool MadeWithCurrentSettings(const SimulatorImpl& sim, const Rollout& rollout) {
-  return MadeWithCurrentSettings(sim, rollout.material, rollout.region_materials, rollout.options);
+}  // namespace
+
+std::string SettingsMismatch(const SimulatorImpl& sim, const MaterialParameters& material,
+                             const std::vector<MaterialParameters>& region_materials, const SolverOptions& options) {
+  std::ostringstream msg;
+  if (!SameMaterial(material, sim.scene.material)) {
+    msg << "another material (" << Describe(material) << ") than the simulator's current one ("
+        << Describe(sim.scene.material) << ")";
+  } else if (region_materials.size() != sim.scene.material_regions.size()) {
+    msg << region_materials.size() << " region materials, while the simulator's scene has "
+        << sim.scene.material_regions.size() << " regions";
+  } else if (options.time_step != sim.h()) {
+    msg << "another time step (" << options.time_step << " s) than the simulator's current one (" << sim.h() << " s)";
+  } else if (options.method != sim.options.method) {
+    msg << "another method (" << ToString(options.method) << ") than the simulator's current one ("
+        << ToString(sim.options.method) << ")";
+  } else {
+    for (size_t r = 0; r < region_materials.size(); ++r)
+      if (!SameMaterial(region_materials[r], sim.scene.material_regions[r].material)) {
+        msg << "another material of region " << r << " (" << Describe(region_materials[r])
+            << ") than the simulator's current one (" << Describe(sim.scene.material_regions[r].material) << ")";
+        break;
+      }
+  }
+  return msg.str();
 }
 
 VectorXd GravityPerDof(const SimulatorImpl& sim) {

@@ -4,6 +4,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/SparseLU>
@@ -121,11 +122,11 @@ class SimulatorImpl {
   std::map<int, AdjointCostModel> tangent_cost_;
 };
 
-// True when `rollout` was made with the simulator's current materials (base
-// and regions), time step and method: the condition of Backward and Tangents.
-bool MadeWithCurrentSettings(const SimulatorImpl& sim, const Rollout& rollout);
-// The same for a rollout's recorded materials and options.
-bool MadeWithCurrentSettings(const SimulatorImpl& sim, const MaterialParameters& material,
+// "" when a rollout's recorded materials (base and regions), time step and
+// method are the simulator's current ones (the condition of Backward and
+// Tangents); else what differs, completing "the rollout was made with ...":
+// "another time step (0.01 s) than the simulator's current one (0.02 s)".
+std::string SettingsMismatch(const SimulatorImpl& sim, const MaterialParameters& material,
                              const std::vector<MaterialParameters>& region_materials, const SolverOptions& options);
 // Gravity's acceleration at every DoF (3n, m/s^2; zero without gravity).
 VectorXd GravityPerDof(const SimulatorImpl& sim);
