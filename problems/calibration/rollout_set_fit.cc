@@ -5,27 +5,11 @@
 
 #include <ceres/ceres.h>
 
+#include "calibration/counting_cost_function.h"
 #include "calibration/iteration_table.h"
 #include "calibration/material_fit_settings.h"
-#include "diffpd/solvers/ceres/rollout_set_cost_function.h"
 
 namespace diffpd::problems {
-namespace {
-
-// Counts the set's evaluations.
-class CountingCostFunction : public solvers::RolloutSetCostFunction {
- public:
-  CountingCostFunction(solvers::RolloutSet* set, int* count) : RolloutSetCostFunction(set), count_(count) {}
-  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    ++*count_;
-    return RolloutSetCostFunction::Evaluate(parameters, residuals, jacobians);
-  }
-
- private:
-  int* count_;
-};
-
-}  // namespace
 
 RolloutSetFit FitMaterialOverSet(solvers::RolloutSet* set, const std::vector<solvers::MaterialField>& fields,
                                  int max_iterations, FILE* log) {

@@ -6,27 +6,14 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include "calibration/counting_cost_function.h"
 #include "diffpd/error.h"
 #include "diffpd/solvers/ceres/coordinate_manifold.h"
-#include "diffpd/solvers/ceres/rollout_set_cost_function.h"
 
 namespace diffpd::problems {
 namespace {
 
 constexpr double kMm = 1e-3;
-
-// Counts the set's evaluations.
-class CountingCostFunction : public solvers::RolloutSetCostFunction {
- public:
-  CountingCostFunction(solvers::RolloutSet* set, int* count) : RolloutSetCostFunction(set), count_(count) {}
-  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    ++*count_;
-    return RolloutSetCostFunction::Evaluate(parameters, residuals, jacobians);
-  }
-
- private:
-  int* count_;
-};
 
 // One line per iteration: cost, change, gradient, time and the 5 values.
 class Table : public ceres::IterationCallback {

@@ -337,6 +337,9 @@ TEST(CheckpointedRolloutTest, BadCheckpointsAndLossesAreRejectedWithTheirMessage
   ASSERT_THROW_MESSAGE(sim.Tangents(warm, {InputDirection::YoungsModulus()}), InvalidInputError,
                        "Tangents: the checkpointed rollout's options have svd_warm_start = true; its steps cannot be "
                        "recomputed bit for bit (SimulateCheckpointed sets it false)");
+  LossGradient nan_loss(9);
+  nan_loss.dv[3] = VectorXd::Constant(sim.num_dofs(), std::nan(""));
+  ASSERT_THROW_MESSAGE(sim.Backward(r, nan_loss), InvalidInputError, "loss.dv has a non-finite entry");
   SolverOptions other = sim.options();
   other.time_step = 0.02;
   sim.SetOptions(other);

@@ -74,22 +74,7 @@ CheckpointedRollout Simulator::SimulateCheckpointed(const State& initial, const 
 }
 
 RolloutGradient Simulator::Backward(const CheckpointedRollout& rollout, const LossGradient& loss) {
-  const int steps = rollout.num_steps();
-  if (static_cast<int>(loss.dx.size()) != steps + 1 || static_cast<int>(loss.dv.size()) != steps + 1) {
-    std::ostringstream msg;
-    msg << "Backward: the loss gradient must have " << steps + 1 << " entries in dx and dv (got " << loss.dx.size()
-        << " and " << loss.dv.size() << ")";
-    throw InvalidInputError(msg.str());
-  }
-  const int n = impl_->num_dofs();
-  for (int k = 0; k <= steps; ++k)
-    for (const VectorXd* g : {&loss.dx[k], &loss.dv[k]})
-      if (g->size() != 0 && (g->size() != n || !g->allFinite())) {
-        std::ostringstream msg;
-        msg << "Backward: " << (g == &loss.dx[k] ? "loss.dx[" : "loss.dv[") << k << "] has " << g->size()
-            << " entries, expected 0 or " << n << " finite ones (3 x number of nodes)";
-        throw InvalidInputError(msg.str());
-      }
+  internal::CheckLossGradient(loss, rollout.num_steps(), impl_->num_dofs());
   StateLossGradient state_loss;
   state_loss.state_gradient = [&loss](int k, const State&, VectorXd* dx, VectorXd* dv) {
     *dx = loss.dx[k];

@@ -38,6 +38,24 @@ void CheckState(const State& s, int n, const std::string& caller, const std::str
     }
 }
 
+// Every input's external force and activation, then the settings the
+// rollout was made with (the rules of CheckRolloutForDerivatives).
+void CheckInputsAndSettings(const SimulatorImpl& sim, const std::vector<StepInput>& inputs,
+                            const MaterialParameters& material, const std::vector<MaterialParameters>& region_materials,
+                            const SolverOptions& options, const std::string& caller) {
+  const int n = sim.num_dofs();
+  for (size_t k = 0; k < inputs.size(); ++k) {
+    CheckEntries(inputs[k].external_force, n, true, caller, "input", k, "external_force");
+    try {
+      CheckActivation(inputs[k].activation, sim.aux.num_muscles());
+    } catch (const InvalidInputError& e) {
+      throw InvalidInputError(caller + ": the rollout's input " + std::to_string(k) + ": " + e.what());
+    }
+  }
+  const std::string mismatch = SettingsMismatch(sim, material, region_materials, options);
+  if (!mismatch.empty()) throw InvalidInputError(caller + ": the rollout was made with " + mismatch);
+}
+
 }  // namespace
 
 void CheckRolloutForDerivatives(const SimulatorImpl& sim, const Rollout& rollout, const std::string& caller) {
@@ -53,16 +71,7 @@ void CheckRolloutForDerivatives(const SimulatorImpl& sim, const Rollout& rollout
     CheckEntries(rollout.states[k].x, n, false, caller, "state", k, "x");
     CheckEntries(rollout.states[k].v, n, false, caller, "state", k, "v");
   }
-  for (size_t k = 0; k < steps; ++k) {
-    CheckEntries(rollout.inputs[k].external_force, n, true, caller, "input", k, "external_force");
-    try {
-      CheckActivation(rollout.inputs[k].activation, sim.aux.num_muscles());
-    } catch (const InvalidInputError& e) {
-      throw InvalidInputError(caller + ": the rollout's input " + std::to_string(k) + ": " + e.what());
-    }
-  }
-  const std::string mismatch = SettingsMismatch(sim, rollout.material, rollout.region_materials, rollout.options);
-  if (!mismatch.empty()) throw InvalidInputError(caller + ": the rollout was made with " + mismatch);
+  CheckInputsAndSettings(sim, rollout.inputs, rollout.material, rollout.region_materials, rollout.options, caller);
   const bool contact = !sim.scene.frictional_contacts.empty() && sim.options.method != Method::kSemiImplicit;
   if (contact && rollout.reports.size() != steps)
     throw InvalidInputError(caller + ": a rollout with frictional contact needs its step reports (active sets)");
@@ -86,16 +95,27 @@ void CheckCheckpointedRollout(const SimulatorImpl& sim, const CheckpointedRollou
                             "recomputed bit for bit (SimulateCheckpointed sets it false)");
   for (size_t c = 0; c < rollout.checkpoints.size(); ++c)
     CheckState(rollout.checkpoints[c], n, caller, "checkpoint " + std::to_string(c));
-  for (int k = 0; k < steps; ++k) {
-    CheckEntries(rollout.inputs[k].external_force, n, true, caller, "input", k, "external_force");
-    try {
-      CheckActivation(rollout.inputs[k].activation, sim.aux.num_muscles());
-    } catch (const InvalidInputError& e) {
-      throw InvalidInputError(caller + ": the rollout's input " + std::to_string(k) + ": " + e.what());
-    }
+  CheckInputsAndSettings(sim, rollout.inputs, rollout.material, rollout.region_materials, rollout.options, caller);
+}
+
+void CheckLossGradient(const LossGradient& loss, int steps, int n) {
+  if (static_cast<int>(loss.dx.size()) != steps + 1 || static_cast<int>(loss.dv.size()) != steps + 1) {
+    std::ostringstream msg;
+    msg << "Backward: the loss gradient must have " << steps + 1 << " entries in dx and dv (got " << loss.dx.size()
+        << " and " << loss.dv.size() << ")";
+    throw InvalidInputError(msg.str());
   }
-  const std::string mismatch = SettingsMismatch(sim, rollout.material, rollout.region_materials, rollout.options);
-  if (!mismatch.empty()) throw InvalidInputError(caller + ": the rollout was made with " + mismatch);
+  for (int k = 0; k <= steps; ++k)
+    for (const VectorXd* g : {&loss.dx[k], &loss.dv[k]}) {
+      const char* name = g == &loss.dx[k] ? "loss.dx" : "loss.dv";
+      if (g->size() == 0) continue;
+      if (g->size() != n) {
+        std::ostringstream msg;
+        msg << name << " has " << g->size() << " entries, expected " << n << " (3 x number of nodes)";
+        throw InvalidInputError(msg.str());
+      }
+      if (!g->allFinite()) throw InvalidInputError(std::string(name) + " has a non-finite entry");
+    }
 }
 
 }  // namespace diffpd::internal

@@ -36,4 +36,10 @@ void CheckRolloutForDerivatives(const SimulatorImpl& sim, const Rollout& rollout
 // steps and checkpoint options"), the inputs and settings as above.
 void CheckCheckpointedRollout(const SimulatorImpl& sim, const CheckpointedRollout& rollout, const std::string& caller);
 
+// Throws InvalidInputError unless `loss` has steps + 1 entries in dx and in
+// dv ("Backward: the loss gradient must have 3 entries in dx and dv (got 2
+// and 3)"), each empty or of n finite entries ("loss.dv has 4 entries,
+// expected 135 (3 x number of nodes)", "loss.dx has a non-finite entry").
+void CheckLossGradient(const LossGradient& loss, int steps, int n);
+
 }  // namespace diffpd::internal

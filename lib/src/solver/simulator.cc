@@ -270,16 +270,7 @@ RolloutGradient BackwardPass(SimulatorImpl& sim, const Rollout& rollout, const L
   const auto start = Clock::now();
   const int n = sim.num_dofs();
   const int steps = rollout.num_steps();
-  if (static_cast<int>(loss.dx.size()) != steps + 1 || static_cast<int>(loss.dv.size()) != steps + 1) {
-    std::ostringstream msg;
-    msg << "Backward: the loss gradient must have " << steps + 1 << " entries in dx and dv (got " << loss.dx.size()
-        << " and " << loss.dv.size() << ")";
-    throw InvalidInputError(msg.str());
-  }
-  for (int k = 0; k <= steps; ++k) {
-    CheckVector(loss.dx[k], n, "loss.dx", true);
-    CheckVector(loss.dv[k], n, "loss.dv", true);
-  }
+  internal::CheckLossGradient(loss, steps, n);
   const bool with_reports = static_cast<int>(rollout.reports.size()) == steps;
   internal::AdjointSweep sweep(sim, steps, rollout.options, loss.dx[steps], loss.dv[steps], controller);
   for (int i = steps - 1; i >= 0; --i)
