@@ -3,8 +3,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <sstream>
+#include <stdexcept>
 
+#include "calibration/starfish_plot.h"
 #include "calibration/starfish_trace.h"
 #include "cli/commands.h"
 #include "diffpd/error.h"
@@ -12,6 +15,7 @@
 #include "diffpd/solvers/core/least_squares_loss.h"
 #include "diffpd/solvers/core/marker_residuals.h"
 #include "diffpd/solvers/core/material_block.h"
+#include "diffpd/solvers/core/state_force_block.h"
 #include "shared_data.h"
 
 namespace diffpd::problems {
@@ -23,6 +27,7 @@ constexpr double kFitStart = 1.0;     // s: the tendon first moves at 1.18 s in 
 constexpr double kFitSeconds = 2.0;   // s
 constexpr double kDefaultSeconds = 10;
 constexpr int kDefaultIterations = 10;
+constexpr int kVtkStride = 6;  // camera frames per VTK frame: 10 per second
 
 std::string Num(double v) {
   std::ostringstream s;
@@ -130,14 +135,15 @@ StarfishErrors StarfishCalibration::WindowErrors(const Mesh& mesh, const std::ve
                               CapturedDisplacements(rec, w));
 }
 
-std::unique_ptr<solvers::RolloutFunction> StarfishCalibration::MakeModel(const StarfishRecording& rec,
-                                                                         const StarfishWindow& w,
-                                                                         const SolverOptions& options,
-                                                                         const MaterialParameters& material,
-                                                                         const StarfishActuation& actuation) const {
+std::unique_ptr<solvers::RolloutFunction> StarfishCalibration::MakeModel(
+    const StarfishRecording& rec, const StarfishWindow& w, const SolverOptions& options,
+    const MaterialParameters& material, const StarfishActuation& actuation, const StarfishWater& water) const {
   using solvers::MaterialField;
   Scene scene = MakeScene();
   scene.material = material;
+  scene.hydrodynamics->drag_tangential = water.drag_tangential;
+  scene.hydrodynamics->drag_normal = water.drag_normal;
+  scene.hydrodynamics->thrust = water.thrust;
   for (MaterialRegion& region : scene.material_regions) region.material = material;
   SolverOptions solver = options;
   solver.time_step = StarfishTimeStep(rec, w, substeps_);
@@ -159,6 +165,13 @@ std::unique_ptr<solvers::RolloutFunction> StarfishCalibration::MakeModel(const S
   model->AddBlock(std::make_unique<solvers::MaterialBlock>(fitted, scene));
   model->AddBlock(std::make_unique<TendonActuationBlock>(WindowContractions(rec, w), solver.time_step,
                                                          static_cast<int>(scene.muscles.size()), actuation));
+  if (water_in_model()) {
+    using solvers::StateForceField;
+    model->AddBlock(std::make_unique<solvers::StateForceBlock>(
+        std::vector<solvers::StateForceBlock::Entry>{StateForceField::kDragTangential, StateForceField::kDragNormal,
+                                                     StateForceField::kThrust},
+        scene));
+  }
   auto residuals = std::make_unique<solvers::MarkerResiduals>(WindowMotion(scene.mesh, initial, rec, w), scene.mesh,
                                                               solver.time_step, steps);
   if (fit_method_ == StarfishFitMethod::kLbfgs)
@@ -174,9 +187,11 @@ StarfishFit StarfishCalibration::Fit(const StarfishRecording& rec, const Starfis
   const bool arms = regions_ == StarfishRegions::kBodyArms;
   if (arms && fit_method_ == StarfishFitMethod::kLevenbergMarquardt)
     throw InvalidInputError("the lm fit has no tied arms' nu: fit body-arms regions with --fit lbfgs");
-  std::unique_ptr<solvers::RolloutFunction> model = MakeModel(rec, w, options, guess, actuation_guess);
+  const StarfishWater water = water_in_model() ? WaterGuess() : StarfishWater();
+  std::unique_ptr<solvers::RolloutFunction> model = MakeModel(rec, w, options, guess, actuation_guess, water);
   if (fit_method_ == StarfishFitMethod::kLevenbergMarquardt)
-    return FitStarfishLeastSquares(model.get(), 0, guess, actuation_guess, max_iterations, log);
+    return FitStarfishLeastSquares(model.get(), 0, guess, actuation_guess, water_in_model() ? &water : nullptr,
+                                   max_iterations, log);
   return FitStarfishLoss(model.get(), regions_ == StarfishRegions::kBodyArms, guess, actuation_guess, max_iterations,
                          log);
 }
@@ -187,6 +202,9 @@ StarfishCalibration::Prediction StarfishCalibration::Predict(const StarfishRecor
   Scene s = MakeScene();
   s.material = fit.material;
   for (size_t r = 0; r < fit.region_materials.size(); ++r) s.material_regions[r].material = fit.region_materials[r];
+  s.hydrodynamics->drag_tangential = fit.water.drag_tangential;
+  s.hydrodynamics->drag_normal = fit.water.drag_normal;
+  s.hydrodynamics->thrust = fit.water.thrust;
   SolverOptions o = options;
   o.time_step = StarfishTimeStep(rec, w, substeps_);
   Simulator sim(s, o);
@@ -204,13 +222,20 @@ StarfishCalibration::Prediction StarfishCalibration::Predict(const StarfishRecor
 
 int StarfishCalibration::Run(const CommandArgs& args) const {
   RefuseSimulatorTuning(args, name());
-  if (!args.regions.empty() || !args.fit.empty()) {  // a copy with the settings, run without the options
+  if (!args.regions.empty() || !args.fit.empty() || !args.water.empty()) {  // a copy with the settings
     StarfishCalibration with = *this;
     if (!args.regions.empty()) with.set_regions(ParseStarfishRegions(args.regions));
     if (!args.fit.empty()) with.set_fit_method(ParseStarfishFitMethod(args.fit));
+    if (!args.water.empty()) {
+      if (args.water != "fitted" && args.water != "fixed")
+        throw InvalidInputError("--water = '" + args.water +
+                                "' is invalid: calibrate-starfish knows 'fitted' or 'fixed'");
+      with.set_fit_water(args.water == "fitted");
+    }
     CommandArgs rest = args;
     rest.regions.clear();
     rest.fit.clear();
+    rest.water.clear();
     return with.Run(rest);
   }
   if (args.steps > 0 || args.dt > 0)
@@ -299,19 +324,25 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                "failed\n",
                stats.rollouts, stats.forward_seconds, stats.gradients, stats.tangent_passes, stats.backward_seconds,
                stats.failures);
-  const char* const kFitNames[5] = {"youngs_modulus", "poissons_ratio", "tendon_slack", "tendon_lag", "tendon_length"};
-  const double fit_values[5] = {fitted.youngs_modulus, fitted.poissons_ratio, actuation.slack, actuation.lag,
-                                actuation.length};
-  if (!fit.standard_deviation.empty()) {
+  if (fit.water_fitted)
+    std::fprintf(log, "# fit: water drag_tangential = %.4g, drag_normal = %.4g, thrust = %.4g\n",
+                 fit.water.drag_tangential, fit.water.drag_normal, fit.water.thrust);
+  const std::vector<std::string> fit_names = {"youngs_modulus", "poissons_ratio",  "tendon_slack", "tendon_lag",
+                                              "tendon_length",  "drag_tangential", "drag_normal",  "thrust"};
+  const std::vector<double> fit_values = {fitted.youngs_modulus, fitted.poissons_ratio, actuation.slack,
+                                          actuation.lag,         actuation.length,      fit.water.drag_tangential,
+                                          fit.water.drag_normal, fit.water.thrust};
+  const int n = static_cast<int>(fit.standard_deviation.size());
+  if (n > 0) {
     std::fprintf(log, "# uncertainty (ceres::Covariance, %d residuals, noise fitted): value, standard deviation\n",
                  fit.residuals);
-    for (int i = 0; i < 5; ++i)
-      std::fprintf(log, "#   %-15s %12.6g +- %-12.4g%s\n", kFitNames[i], fit_values[i], fit.standard_deviation[i],
-                   fit.at_bound[i] ? " (at a bound: the interval is not meaningful)" : "");
+    for (int i = 0; i < n; ++i)
+      std::fprintf(log, "#   %-15s %12.6g +- %-12.4g%s\n", fit_names[i].c_str(), fit_values[i],
+                   fit.standard_deviation[i], fit.at_bound[i] ? " (at a bound: the interval is not meaningful)" : "");
     std::fprintf(log, "# correlation:\n");
-    for (int i = 0; i < 5; ++i) {
-      std::fprintf(log, "#   %-15s", kFitNames[i]);
-      for (int j = 0; j < 5; ++j) std::fprintf(log, " %6.3f", fit.correlation[5 * i + j]);
+    for (int i = 0; i < n; ++i) {
+      std::fprintf(log, "#   %-15s", fit_names[i].c_str());
+      for (int j = 0; j < n; ++j) std::fprintf(log, " %6.3f", fit.correlation[n * i + j]);
       std::fprintf(log, "\n");
     }
   }
@@ -333,7 +364,21 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
     const StarfishWindow& w = windows[f];
     if (!w.note.empty()) std::fprintf(log, "# note: %s\n", w.note.c_str());
     const Prediction p = Predict(rec, w, options, fit);
-    if (!args.out_dir.empty()) WriteStarfishTrace(args.out_dir, rec, w, p.rollout, substeps_, p.simulated, p.captured);
+    if (!args.out_dir.empty()) {
+      const std::string trace = WriteStarfishTrace(args.out_dir, rec, w, p.rollout, substeps_, p.simulated, p.captured);
+      const std::string stem = std::filesystem::path(rec.path).stem().string();
+      const std::string png = (std::filesystem::path(args.out_dir) / (stem + "_trace.png")).string();
+      try {
+        WriteStarfishTracePlot(trace, png,
+                               stem + (rec.path == calibrate_path ? " (fitted on it)" : " (predicted)") +
+                                   ": simulated and captured marker displacement, tendon");
+      } catch (const std::runtime_error& e) {  // no gnuplot: the trace CSV stays
+        std::fprintf(log, "# no plot: %s\n", e.what());
+      }
+      std::vector<double> times(rec.time.begin() + w.first, rec.time.begin() + w.last + 1);
+      WriteStarfishVtk(args.out_dir, stem, scene.mesh, MarkerVertices(scene.mesh), p.rollout.states, substeps_, times,
+                       p.captured, kVtkStride);
+    }
     const StarfishErrors& e = p.errors;
     const StarfishBaselines& b = p.baselines;
     const double window_seconds = rec.time[w.last] - rec.time[w.first];
@@ -400,12 +445,16 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                           {"files", files},
                           {"total_seconds", total}};
     out["regions"] = ToString(regions_);
+    out["water"] = {{"fitted", fit.water_fitted},
+                    {"drag_tangential", fit.water.drag_tangential},
+                    {"drag_normal", fit.water.drag_normal},
+                    {"thrust", fit.water.thrust}};
     out["fit"] = ToString(fit_method_);
     if (!fit.standard_deviation.empty()) {
       nlohmann::json sd, bound;
-      for (int i = 0; i < 5; ++i) {
-        sd[kFitNames[i]] = fit.standard_deviation[i];
-        bound[kFitNames[i]] = static_cast<bool>(fit.at_bound[i]);
+      for (int i = 0; i < n; ++i) {
+        sd[fit_names[i]] = fit.standard_deviation[i];
+        bound[fit_names[i]] = static_cast<bool>(fit.at_bound[i]);
       }
       out["standard_deviation"] = sd;
       out["at_bound"] = bound;

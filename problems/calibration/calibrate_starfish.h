@@ -55,6 +55,13 @@ class StarfishCalibration : public Problem {
   StarfishRegions regions() const { return regions_; }
   void set_regions(StarfishRegions regions) { regions_ = regions; }
 
+  // Whether the lm fit fits the water's drag and thrust coefficients too
+  // (default true; the lbfgs fit keeps the scene's).
+  bool fit_water() const { return fit_water_; }
+  void set_fit_water(bool fit) { fit_water_ = fit; }
+  // Whether the water joins a model (fit_water() and the lm fit).
+  bool water_in_model() const { return fit_water_ && fit_method_ == StarfishFitMethod::kLevenbergMarquardt; }
+
   // How Fit minimises (default kLevenbergMarquardt).
   StarfishFitMethod fit_method() const { return fit_method_; }
   void set_fit_method(StarfishFitMethod method) { fit_method_ = method; }
@@ -96,10 +103,12 @@ class StarfishCalibration : public Problem {
   // at a multiple of the cost), backward relative tolerance 1e-8.
   SolverOptions Options(Method method, int threads) const;
 
-  // The rollout function of a window at `material` and `actuation`: blocks
-  // {E, nu} (Pa, 1; with kBodyArms {E, nu, E_arms, nu_arms}, the arms region
-  // starting at `material` too) and {slack, lag, length} (m, s, m; the tendon
-  // actuation model, which writes every step's activations), and functional
+  // The rollout function of a window at `material`, `actuation` and `water`:
+  // blocks {E, nu} (Pa, 1; with kBodyArms {E, nu, E_arms, nu_arms}, the arms
+  // region starting at `material` too), {slack, lag, length} (m, s, m; the
+  // tendon actuation model, which writes every step's activations) and,
+  // when water_in_model(), {drag_tangential, drag_normal, thrust} (a
+  // StateForceBlock; otherwise the scene has `water`'s values), and functional
   // 0: with fit_method() kLbfgs one row, the scalar loss 1/2 |r|^2 of the
   // marker residuals (LeastSquaresLoss; its gradient is one adjoint), with
   // kLevenbergMarquardt the marker residuals r themselves (MarkerResiduals,
@@ -108,9 +117,11 @@ class StarfishCalibration : public Problem {
   // starts with the tendon slack (a = 1, as in the default fit window from rest).
   std::unique_ptr<solvers::RolloutFunction> MakeModel(const StarfishRecording& recording, const StarfishWindow& window,
                                                       const SolverOptions& options, const MaterialParameters& material,
-                                                      const StarfishActuation& actuation) const;
+                                                      const StarfishActuation& actuation,
+                                                      const StarfishWater& water = StarfishWater()) const;
 
-  // Fits E, nu, slack, lag and length (with kBodyArms also the arms' E) on
+  // Fits E, nu, slack, lag and length (with kBodyArms also the arms' E;
+  // when water_in_model() also the water's coefficients from the scene's) on
   // a window: FitStarfishLeastSquares or FitStarfishLoss (fit_method()) on
   // MakeModel's functional, starting from `guess` (both regions) and
   // `actuation_guess`, at most `max_iterations` iterations; the iteration
@@ -132,17 +143,22 @@ class StarfishCalibration : public Problem {
     double simulate_seconds = 0;  // wall-clock time of the rollout
   };
   // Simulates `window` of `recording` with `fit`'s material (and region
-  // materials) and actuation. Throws what the simulator throws.
+  // materials), actuation and water. Throws what the simulator throws.
   Prediction Predict(const StarfishRecording& recording, const StarfishWindow& window, const SolverOptions& options,
                      const StarfishFit& fit) const;
 
+  // The fit's starting water when fitted: the scene's drag, thrust 0.1 (the
+  // fit keeps the thrust positive, StarfishWaterCoordinates).
+  static StarfishWater WaterGuess() { return StarfishWater{0.05, 2.05, 0.1}; }
   // The fit's starting actuation: slack 3 mm, lag 50 ms, length 65 mm.
   static StarfishActuation ActuationGuess() { return StarfishActuation{0.003, 0.05, kTendonRest}; }
 
   // `diffpd run calibrate-starfish [--calibrate FILE] [--predict FILE ...]
   // [--seconds S] [--json] [--threads T] [--max-iterations N] [--out DIR]
   // [--regions body-arms] [--fit lm|lbfgs] [--fit-start S] [--fit-seconds S]`:
-  // fits E, nu, tendon slack, lag and length on the calibration file's window
+  // [--water fitted|fixed]
+  // fits E, nu, tendon slack, lag and length (and, unless --water fixed or
+  // --fit lbfgs, the water's drag and thrust coefficients) on the calibration file's window
   // (default [1 s, 3 s]: the tendon first moves at 1.18 s in cyclic1) by
   // Levenberg-Marquardt on the marker residuals (--fit lbfgs: L-BFGS on the
   // scalar loss; at most 10 iterations unless --max-iterations; 0: no fit,
@@ -152,8 +168,11 @@ class StarfishCalibration : public Problem {
   // format; default: the calibration file and, when no --calibrate is given,
   // cyclic2 too) with the fitted parameters and reports per file the errors
   // and the zero-motion and mean-displacement baselines.
-  // --out DIR writes DIR/<file stem>_trace.csv per predicted file
-  // (WriteStarfishTrace).
+  // --out DIR writes per predicted file DIR/<file stem>_trace.csv
+  // (WriteStarfishTrace), its plot <stem>_trace.png (WriteStarfishTracePlot;
+  // skipped with a note without gnuplot) and the simulated body with the
+  // captured markers at 10 frames per second, <stem>_body.pvd and
+  // <stem>_markers.pvd (WriteStarfishVtk).
   // Method: pd-lbfgs, or the first of --methods, or a --method other than
   // the command line's default pd. --threads as for every problem.
   // --regions body-arms fits the arms' E apart from the body's (kBodyArms,
@@ -164,6 +183,7 @@ class StarfishCalibration : public Problem {
   int substeps_ = 2;
   StarfishRegions regions_ = StarfishRegions::kNone;
   StarfishFitMethod fit_method_ = StarfishFitMethod::kLevenbergMarquardt;
+  bool fit_water_ = true;
 };
 
 }  // namespace diffpd::problems

@@ -21,6 +21,12 @@ constexpr double kMinE = 1e4, kMaxE = 5e6, kMinNu = 0.2, kMaxNu = 0.45;
 constexpr double kMaxSlack = 0.015;                     // m
 constexpr double kMinLag = 1e-3, kMaxLag = 0.5;         // s
 constexpr double kMinLength = 0.03, kMaxLength = 0.13;  // m
+// The water's coefficients stay positive: every term opposes the motion it
+// comes from (a negative thrust below -drag_normal would push a face along
+// its own normal motion, feeding energy into the body).
+constexpr double kMinDragTangential = 0.005, kMaxDragTangential = 5;
+constexpr double kMinDragNormal = 0.2, kMaxDragNormal = 20;
+constexpr double kMinThrust = 1e-3, kMaxThrust = 10;
 
 std::string Num(double v) {
   std::ostringstream s;
@@ -93,18 +99,23 @@ class FitTable : public ceres::IterationCallback {
   bool arms_;
 };
 
-// The iteration table of the least-squares fit (values in the two blocks).
+// The iteration table of the least-squares fit (values in the blocks;
+// `water` nullptr when the water is not fitted).
 class LeastSquaresTable : public ceres::IterationCallback {
  public:
-  LeastSquaresTable(FILE* log, const double* material, const double* actuation)
-      : log_(log), material_(material), actuation_(actuation) {}
+  LeastSquaresTable(FILE* log, const double* material, const double* actuation, const double* water)
+      : log_(log), material_(material), actuation_(actuation), water_(water) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    if (s.iteration == 0)
-      std::fprintf(log_, "%4s %13s %11s %11s %9s %14s %14s %9s %9s %9s\n", "iter", "cost", "cost_change", "|gradient|",
+    if (s.iteration == 0) {
+      std::fprintf(log_, "%4s %13s %11s %11s %9s %14s %14s %9s %9s %9s", "iter", "cost", "cost_change", "|gradient|",
                    "total_t", "youngs_modulus", "poissons_ratio", "slack_mm", "lag_s", "length_mm");
-    std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %9.2f %14.6g %14.6g %9.4f %9.4f %9.3f\n", s.iteration, s.cost,
+      std::fprintf(log_, water_ ? " %9s %9s %9s\n" : "\n", "drag_t", "drag_n", "thrust");
+    }
+    std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %9.2f %14.6g %14.6g %9.4f %9.4f %9.3f", s.iteration, s.cost,
                  s.cost_change, s.gradient_max_norm, s.cumulative_time_in_seconds, material_[0], material_[1],
                  actuation_[0] / kMm, actuation_[1], actuation_[2] / kMm);
+    if (water_) std::fprintf(log_, " %9.4f %9.4f %9.4f", water_[0], water_[1], water_[2]);
+    std::fprintf(log_, "\n");
     std::fflush(log_);
     return ceres::SOLVER_CONTINUE;
   }
@@ -113,6 +124,7 @@ class LeastSquaresTable : public ceres::IterationCallback {
   FILE* log_;
   const double* material_;
   const double* actuation_;
+  const double* water_;
 };
 
 // The tangent coordinate of x under `map` (0 for linear and log maps).
@@ -152,6 +164,24 @@ std::vector<solvers::CoordinateMap> StarfishFitCoordinates(bool arms) {
                                      CoordinateMap::LogLogit(kMinLength, kMaxLength)};
   if (arms) maps.push_back(CoordinateMap::LogLogit(kMinE, kMaxE));
   return maps;
+}
+
+std::vector<solvers::CoordinateMap> StarfishWaterCoordinates() {
+  using solvers::CoordinateMap;
+  return {CoordinateMap::LogLogit(kMinDragTangential, kMaxDragTangential),
+          CoordinateMap::LogLogit(kMinDragNormal, kMaxDragNormal), CoordinateMap::LogLogit(kMinThrust, kMaxThrust)};
+}
+
+void CheckStarfishWaterStart(const StarfishWater& w) {
+  if (!(w.drag_tangential > kMinDragTangential && w.drag_tangential < kMaxDragTangential))
+    throw InvalidInputError("drag_tangential = " + Num(w.drag_tangential) + " is outside the fit's interval (" +
+                            Num(kMinDragTangential) + ", " + Num(kMaxDragTangential) + ")");
+  if (!(w.drag_normal > kMinDragNormal && w.drag_normal < kMaxDragNormal))
+    throw InvalidInputError("drag_normal = " + Num(w.drag_normal) + " is outside the fit's interval (" +
+                            Num(kMinDragNormal) + ", " + Num(kMaxDragNormal) + ")");
+  if (!(w.thrust > kMinThrust && w.thrust < kMaxThrust))
+    throw InvalidInputError("thrust = " + Num(w.thrust) + " is outside the fit's interval (" + Num(kMinThrust) + ", " +
+                            Num(kMaxThrust) + ")");
 }
 
 std::vector<double> StarfishFitStart(const MaterialParameters& m, const StarfishActuation& a, bool arms) {
@@ -206,18 +236,32 @@ StarfishFit FitStarfishLoss(solvers::RolloutFunction* model, bool arms, const Ma
 
 StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residual_functional,
                                     const MaterialParameters& guess, const StarfishActuation& actuation_guess,
-                                    int max_iterations, FILE* log) {
+                                    const StarfishWater* water_guess, int max_iterations, FILE* log) {
   const std::vector<double> start = StarfishFitStart(guess, actuation_guess, false);
-  const std::vector<solvers::CoordinateMap> maps = StarfishFitCoordinates(false);
+  if (water_guess) CheckStarfishWaterStart(*water_guess);
+  std::vector<solvers::CoordinateMap> maps = StarfishFitCoordinates(false);
   double material[2] = {start[0], start[1]};
   double actuation[3] = {start[2], start[3], start[4]};
-  solvers::RolloutEvaluationCallback callback(model, {material, actuation});
+  double water[3] = {0, 0, 0};
+  std::vector<double*> blocks = {material, actuation};
+  std::vector<int> sizes = {2, 3};
+  if (water_guess) {
+    water[0] = water_guess->drag_tangential;
+    water[1] = water_guess->drag_normal;
+    water[2] = water_guess->thrust;
+    blocks.push_back(water);
+    sizes.push_back(3);
+    for (const solvers::CoordinateMap& m : StarfishWaterCoordinates()) maps.push_back(m);
+  }
+  const int n = static_cast<int>(maps.size());
+  solvers::RolloutEvaluationCallback callback(model, blocks);
   ceres::Problem::Options problem_options;
   problem_options.evaluation_callback = &callback;
   ceres::Problem problem(problem_options);
-  solvers::AddMarkerResidualBlocks(&problem, model, residual_functional, {material, actuation});
-  problem.SetManifold(material, new solvers::CoordinateManifold({maps[0], maps[1]}));
-  problem.SetManifold(actuation, new solvers::CoordinateManifold({maps[2], maps[3], maps[4]}));
+  solvers::AddMarkerResidualBlocks(&problem, model, residual_functional, blocks);
+  for (size_t b = 0, first = 0; b < blocks.size(); first += sizes[b], ++b)
+    problem.SetManifold(blocks[b], new solvers::CoordinateManifold(std::vector<solvers::CoordinateMap>(
+                                       maps.begin() + first, maps.begin() + first + sizes[b])));
 
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
@@ -230,7 +274,7 @@ StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residua
   options.gradient_tolerance = 1e-12;
   options.update_state_every_iteration = true;
   options.logging_type = ceres::SILENT;
-  LeastSquaresTable table(log, material, actuation);
+  LeastSquaresTable table(log, material, actuation, water_guess ? water : nullptr);
   if (log) options.callbacks.push_back(&table);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
@@ -238,6 +282,10 @@ StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residua
   StarfishFit fit;
   fit.material = MaterialParameters{material[0], material[1], guess.density};
   fit.actuation = StarfishActuation{actuation[0], actuation[1], actuation[2]};
+  if (water_guess) {
+    fit.water = StarfishWater{water[0], water[1], water[2]};
+    fit.water_fitted = true;
+  }
   fit.initial_cost = summary.initial_cost;
   fit.final_cost = summary.final_cost;
   fit.iterations = static_cast<int>(summary.iterations.size()) - 1;
@@ -250,8 +298,9 @@ StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residua
 
   // Rows with a weight (the markers' unobserved y has none).
   VectorXd r;
-  VectorXd point(5);
+  VectorXd point(n);
   point << material[0], material[1], actuation[0], actuation[1], actuation[2];
+  if (water_guess) point.tail(3) << water[0], water[1], water[2];
   const std::vector<int> rows = model->RowsOf(residual_functional);
   if (fit.usable && model->Evaluate(point, rows, &r, nullptr)) {
     MatrixXd j;
@@ -259,34 +308,32 @@ StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residua
     int used = 0;
     for (int i = 0; i < j.rows(); ++i) used += j.row(i).squaredNorm() > 0 || r(i) != 0;
     fit.residuals = used;
-    const double noise = r.squaredNorm() / std::max(1, used - 5);
+    const double noise = r.squaredNorm() / std::max(1, used - n);
     ceres::Covariance::Options covariance_options;
     covariance_options.algorithm_type = ceres::DENSE_SVD;
     covariance_options.null_space_rank = -1;
     ceres::Covariance covariance(covariance_options);
-    const std::vector<std::pair<const double*, const double*>> pairs = {
-        {material, material}, {material, actuation}, {actuation, actuation}};
+    std::vector<std::pair<const double*, const double*>> pairs;
+    for (size_t a = 0; a < blocks.size(); ++a)
+      for (size_t b = a; b < blocks.size(); ++b) pairs.emplace_back(blocks[a], blocks[b]);
     if (covariance.Compute(pairs, &problem)) {
-      double c_mm[4], c_ma[6], c_aa[9];
-      covariance.GetCovarianceBlock(material, material, c_mm);
-      covariance.GetCovarianceBlock(material, actuation, c_ma);
-      covariance.GetCovarianceBlock(actuation, actuation, c_aa);
-      Eigen::Matrix<double, 5, 5> c;
-      for (int a = 0; a < 2; ++a)
-        for (int b = 0; b < 2; ++b) c(a, b) = c_mm[2 * a + b];
-      for (int a = 0; a < 2; ++a)
-        for (int b = 0; b < 3; ++b) c(a, 2 + b) = c(2 + b, a) = c_ma[3 * a + b];
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) c(2 + a, 2 + b) = c_aa[3 * a + b];
+      MatrixXd c(n, n);
+      for (size_t a = 0, fa = 0; a < blocks.size(); fa += sizes[a], ++a)
+        for (size_t b = a, fb = fa; b < blocks.size(); fb += sizes[b], ++b) {
+          std::vector<double> block(sizes[a] * sizes[b]);
+          covariance.GetCovarianceBlock(blocks[a], blocks[b], block.data());
+          for (int u = 0; u < sizes[a]; ++u)
+            for (int v = 0; v < sizes[b]; ++v) c(fa + u, fb + v) = c(fb + v, fa + u) = block[sizes[b] * u + v];
+        }
       c *= noise;
-      for (int a = 0; a < 5; ++a) fit.standard_deviation.push_back(std::sqrt(std::max(0.0, c(a, a))));
-      for (int a = 0; a < 5; ++a)
-        for (int b = 0; b < 5; ++b) {
+      for (int a = 0; a < n; ++a) fit.standard_deviation.push_back(std::sqrt(std::max(0.0, c(a, a))));
+      for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b) {
           const double d = fit.standard_deviation[a] * fit.standard_deviation[b];
           fit.correlation.push_back(d > 0 ? c(a, b) / d : 0.0);
         }
     }
-    for (int a = 0; a < 5; ++a) fit.at_bound.push_back(std::abs(BoundCoordinate(maps[a], point(a))) > 5);
+    for (int a = 0; a < n; ++a) fit.at_bound.push_back(std::abs(BoundCoordinate(maps[a], point(a))) > 5);
   }
   fit.statistics = model->statistics();
   return fit;

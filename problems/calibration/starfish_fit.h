@@ -11,6 +11,9 @@
 //   x4 length in (30, 130) mm
 //   x5 E_arms in (1e4, 5e6) Pa (StarfishRegions::kBodyArms only; the arms'
 //      nu is tied to the body's)
+// and, in the least-squares fit when the water is fitted (StarfishWater),
+// three more, log-logit (positive: each term opposes the motion):
+//   drag_tangential in (0.005, 5), drag_normal in (0.2, 20), thrust in (0.001, 10)
 #pragma once
 
 #include <cstdio>
@@ -23,6 +26,19 @@
 #include "diffpd/solvers/core/rollout_function.h"
 
 namespace diffpd::problems {
+
+// The water's coefficients of the starfish (Hydrodynamics, state_forces.h):
+// the scene's drag and thrust (the defaults), or the fitted values.
+struct StarfishWater {
+  double drag_tangential = 0.05;  // Cd along the face
+  double drag_normal = 2.05;      // Cd normal to the face
+  double thrust = 0;              // Ct normal to the face
+};
+// The maps of drag_tangential, drag_normal and thrust (file comment).
+std::vector<solvers::CoordinateMap> StarfishWaterCoordinates();
+// Throws InvalidInputError for a value outside its interval, e.g.
+//   "drag_normal = 30 is outside the fit's interval (0.2, 20)".
+void CheckStarfishWaterStart(const StarfishWater& water);
 
 // How a fit minimises the marker error.
 enum class StarfishFitMethod {
@@ -42,18 +58,21 @@ struct StarfishFit {
   // density = material's); empty otherwise.
   std::vector<MaterialParameters> region_materials;
   StarfishActuation actuation;  // fitted
-  double initial_cost = 0;      // the model's loss at the start
+  StarfishWater water;          // fitted when water_fitted, else the scene's
+  bool water_fitted = false;
+  double initial_cost = 0;  // the model's loss at the start
   double final_cost = 0;
   int iterations = 0;                     // Ceres iterations
   bool usable = false;                    // Ceres' solution is usable
   std::string termination;                // Ceres' message
   solvers::RolloutStatistics statistics;  // rollouts, gradients, timings
-  // FitStarfishLeastSquares only (empty otherwise): per fitted value x0..x4
-  // its standard deviation from ceres::Covariance (physical units; the
-  // residuals scaled by their fitted noise, s^2 = |r|^2 / (rows - 5)), the
-  // 5 x 5 correlation matrix (row-major), and whether the value lies at a
-  // bound of its interval (tangent coordinate |u| > 5: within 1% of an end),
-  // where the interval is not meaningful.
+  // FitStarfishLeastSquares only (empty otherwise): per fitted value (x0..x4,
+  // then drag_tangential, drag_normal, thrust when the water is fitted: n
+  // values) its standard deviation from ceres::Covariance (physical units;
+  // the residuals scaled by their fitted noise, s^2 = |r|^2 / (rows - n)),
+  // the n x n correlation matrix (row-major), and whether the value lies at
+  // a bound of its interval (tangent coordinate |u| > 5: within 1% of an
+  // end), where the interval is not meaningful.
   std::vector<double> standard_deviation;
   std::vector<double> correlation;
   std::vector<bool> at_bound;
@@ -78,15 +97,19 @@ std::vector<double> StarfishFitStart(const MaterialParameters& material, const S
 StarfishFit FitStarfishLoss(solvers::RolloutFunction* model, bool arms, const MaterialParameters& guess,
                             const StarfishActuation& actuation_guess, int max_iterations, FILE* log);
 
-// Fits `model` (blocks: material {E, nu}, then TendonActuationBlock;
-// functional `residual_functional`: a MarkerResiduals) by Levenberg-Marquardt
-// (ceres::Problem, one residual block per capture frame, Jacobians by the
-// rollout function: forward-mode tangents for 5 parameters) on the manifolds
-// of StarfishFitCoordinates(false), from `guess` and `actuation_guess`, at
-// most `max_iterations` iterations, then the parameters' covariance (see
-// StarfishFit). The iteration table goes to `log` (nullptr: silent).
+// Fits `model` (blocks: material {E, nu}, then TendonActuationBlock, and
+// with `water_guess` a StateForceBlock {drag_tangential, drag_normal,
+// thrust}; functional `residual_functional`: a MarkerResiduals) by
+// Levenberg-Marquardt (ceres::Problem, one residual block per capture frame,
+// Jacobians by the rollout function: forward-mode tangents for 5 or 8
+// parameters) on the manifolds of StarfishFitCoordinates(false) and
+// StarfishWaterCoordinates(), from `guess`, `actuation_guess` and
+// `water_guess` (nullptr: the water is not fitted), at most `max_iterations`
+// iterations, then the parameters' covariance (see StarfishFit). The
+// iteration table goes to `log` (nullptr: silent). Throws what
+// StarfishFitStart and CheckStarfishWaterStart throw.
 StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residual_functional,
                                     const MaterialParameters& guess, const StarfishActuation& actuation_guess,
-                                    int max_iterations, FILE* log);
+                                    const StarfishWater* water_guess, int max_iterations, FILE* log);
 
 }  // namespace diffpd::problems

@@ -58,7 +58,9 @@ solvers::RolloutTerm StarfishRecordingTerm(const StarfishCalibration& problem, c
   const StarfishRecording recording = ReadStarfishRecording(path);
   const StarfishWindow window = MakeStarfishWindow(recording, recordings.start, recordings.seconds);
   solvers::RolloutTerm term;
-  term.function = problem.MakeModel(recording, window, options, recordings.guess, recordings.actuation_guess);
+  StarfishCalibration fixed_water = problem;  // the set's fit has the 5 parameters
+  fixed_water.set_fit_water(false);
+  term.function = fixed_water.MakeModel(recording, window, options, recordings.guess, recordings.actuation_guess);
   term.rows = term.function->RowsOf(0);
   return term;
 }

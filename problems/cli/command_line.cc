@@ -87,6 +87,8 @@ int RunCommandLine(const std::vector<std::string>& argv) {
                   "calibrate-starfish: 'lm' (Levenberg-Marquardt on marker residuals, default) or 'lbfgs'");
   run->add_option("--fit-start", run_args.fit_start, "calibrate-starfish: start of the fit window (s, default 1)")
       ->check(NonNegative("--fit-start"));
+  run->add_option("--water", run_args.water,
+                  "calibrate-starfish: 'fitted' (the lm fit fits drag and thrust, default) or 'fixed'");
   run->add_option("--fit-seconds", run_args.fit_seconds, "calibrate-starfish: length of the fit window (s, default 2)")
       ->check(Positive("--fit-seconds", "s"));
 

@@ -63,6 +63,7 @@ struct CommandArgs {
   std::string fit;
   double fit_start = -1;
   double fit_seconds = -1;
+  std::string water;  // calibrate-starfish: "": the problem's; "fitted", "fixed"
 };
 
 int ListCommand(bool json);

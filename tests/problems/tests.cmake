@@ -15,6 +15,8 @@ if(TARGET diffpd_ceres)
   diffpd_add_test(plant_recordings_test ${_dir}/calibration/plant_recordings_test.cc LIBS diffpd_problems)
   diffpd_add_test(calibrate_bouncing_ball_test ${_dir}/calibration/calibrate_bouncing_ball_test.cc LIBS diffpd_problems)
   diffpd_add_test(calibrate_starfish_test ${_dir}/calibration/calibrate_starfish_test.cc LIBS diffpd_problems)
+  diffpd_add_test(starfish_covariance_check_test ${_dir}/calibration/starfish_covariance_check_test.cc
+                  LIBS diffpd_problems)
   diffpd_add_test(starfish_recordings_fit_test ${_dir}/calibration/starfish_recordings_fit_test.cc
                   LIBS diffpd_problems)
 endif()

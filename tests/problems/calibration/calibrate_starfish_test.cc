@@ -15,7 +15,9 @@
 #include <sstream>
 
 #include "calibration/calibrate_starfish.h"
+#include "calibration/starfish_plot.h"
 #include "calibration/starfish_trace.h"
+#include "tools/tradeoff.h"
 #include "diffpd/error.h"
 #include "util/expect_message.h"
 #include "util/temporary_directory.h"
@@ -301,6 +303,65 @@ TEST(StarfishTraceTest, OneRowPerFrameInMillimetres) {
   EXPECT_NEAR(row[8], cap[3][1](0) * 1e3, 1e-5 * std::abs(cap[3][1](0) * 1e3) + 1e-9);
 }
 
+// The VTK output: every stride-th frame of the body (its displacement from
+// the first state) and the four captured markers as points at the marker
+// vertex's first position plus the captured x, z displacement; the trace's
+// plot is a PNG (where gnuplot is installed).
+TEST(StarfishTraceTest, VtkHasTheBodyAndTheCapturedMarkersAndThePlotIsAPng) {
+  const StarfishRecording r = ReadStarfishRecording(kCyclic1);
+  const StarfishWindow w = MakeStarfishWindow(r, 2, 0.1);
+  ASSERT_EQ(w.num_frames(), 7);
+  Mesh mesh;
+  mesh.type = ElementType::kTet4;
+  mesh.vertices = Eigen::Matrix3Xd::Identity(3, 4);
+  mesh.vertices.col(3) = Vec3(0.1, 0.2, 0.3);
+  mesh.elements.resize(4, 1);
+  mesh.elements << 0, 1, 2, 3;
+  const std::array<int, 4> vertices = {0, 1, 2, 3};
+  std::vector<State> states(13);  // 2 steps per frame
+  for (size_t k = 0; k < states.size(); ++k) {
+    states[k].x = Eigen::Map<const VectorXd>(mesh.vertices.data(), 12);
+    states[k].x(0) += 1e-3 * k;
+  }
+  const StarfishDisplacements cap = CapturedDisplacements(r, w);
+  std::vector<double> times(r.time.begin() + w.first, r.time.begin() + w.last + 1);
+  const std::string dir = Scratch().path().string();
+  const std::array<std::string, 2> pvd = WriteStarfishVtk(dir, "c1", mesh, vertices, states, 2, times, cap, 3);
+  EXPECT_EQ(pvd[0], dir + "/c1_body.pvd");
+  EXPECT_EQ(pvd[1], dir + "/c1_markers.pvd");
+  auto read = [](const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  const std::string markers = read(pvd[1]);
+  EXPECT_NE(markers.find("c1_markers_0002.vtp"), std::string::npos);  // frames 0, 3, 6
+  EXPECT_EQ(markers.find("c1_markers_0003.vtp"), std::string::npos);
+  EXPECT_NE(read(pvd[0]).find("c1_body_0002.vtu"), std::string::npos);
+  // Frame 6 (file 2): M4 at its vertex (0.1, 0.2, 0.3) plus the captured displacement.
+  const std::string points = read(dir + "/c1_markers_0002.vtp");
+  std::istringstream in(points.substr(points.find("format=\"ascii\">") + 15));
+  Eigen::Matrix<double, 3, 4> p;
+  for (int m = 0; m < 4; ++m) in >> p(0, m) >> p(1, m) >> p(2, m);
+  EXPECT_NEAR(p(0, 3), 0.1 + cap[6][3](0), 1e-15);
+  EXPECT_NEAR(p(1, 3), 0.2, 1e-15);
+  EXPECT_NEAR(p(2, 3), 0.3 + cap[6][3](1), 1e-15);
+  EXPECT_NEAR(p(0, 0), 1 + cap[6][0](0), 1e-15);
+  EXPECT_THROW_MESSAGE(WriteStarfishVtk(dir, "c1", mesh, vertices, states, 2, times, cap, 0), InvalidInputError,
+                       "stride = 0 is invalid: must be >= 1");
+  EXPECT_THROW_MESSAGE(WriteStarfishVtk(dir, "c1", mesh, vertices, std::vector<State>(12, states[0]), 2, times, cap, 1),
+                       InvalidInputError, "starfish vtk: 12 states are too few for 7 frames of 2 steps");
+  if (!GnuplotAvailable()) GTEST_SKIP() << "gnuplot is not installed: the plot is not checked";
+  Rollout rollout;
+  rollout.inputs.resize(12);
+  for (StepInput& in : rollout.inputs) in.activation = VectorXd::Ones(4);
+  const std::string trace = WriteStarfishTrace(dir, r, w, rollout, 2, cap, cap);
+  WriteStarfishTracePlot(trace, dir + "/c1.png", "c1");
+  std::ifstream png(dir + "/c1.png", std::ios::binary);
+  char magic[4] = {};
+  png.read(magic, 4);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+}
+
 // The window of the gradient and fit tests: 0.15 s from 1.15 s of cyclic1
 // (the tendon first moves at 1.18 s), one step per frame.
 class StarfishFitTest : public ::testing::Test {
@@ -459,31 +520,44 @@ TEST_F(StarfishFitTest, ShortFitLowersTheLoss) {
 }
 
 // The least-squares model's residual Jacobian (forward-mode tangents through
-// the water's drag) against central differences of the residuals.
+// the water's drag, and for the water's coefficients through the state
+// forces) against central differences of the residuals.
 TEST_F(StarfishFitTest, ResidualJacobianMatchesCentralDifferences) {
   ASSERT_EQ(starfish_.fit_method(), StarfishFitMethod::kLevenbergMarquardt);
+  ASSERT_TRUE(starfish_.water_in_model());
   SolverOptions options = starfish_.Options(Method::kPdLbfgs, 1);
   options.rel_tolerance = 1e-10;
   options.abs_tolerance = 1e-10;
+  const StarfishWater water{0.1, 1.5, 0.3};
   auto model = starfish_.MakeModel(recording_, window_, options, MaterialParameters{2e5, 0.35, 400},
-                                   StarfishActuation{0.004, 0.03, 0.05});
+                                   StarfishActuation{0.004, 0.03, 0.05}, water);
+  ASSERT_EQ(model->num_blocks(), 3);
   ASSERT_EQ(model->ResolvedMode(model->num_rows()), solvers::DerivativeMode::kForward);
-  VectorXd p0(5);
-  p0 << 2e5, 0.35, 0.004, 0.03, 0.05;
+  VectorXd p0(8);
+  p0 << 2e5, 0.35, 0.004, 0.03, 0.05, 0.1, 1.5, 0.3;
   MatrixXd j;
   ASSERT_TRUE(model->Evaluate(p0, model->AllRows(), nullptr, &j)) << model->statistics().last_error;
   EXPECT_EQ(model->statistics().tangent_passes, 1);
-  const double step[5] = {2e5 * 1e-4, 1e-4, 1e-6, 1e-5, 1e-6};
-  for (int i = 0; i < 5; ++i) {
+  const double step[8] = {2e5 * 1e-4, 1e-4, 1e-6, 1e-5, 1e-6, 1e-5, 1e-4, 1e-4};
+  for (int i = 0; i < 8; ++i) {
     VectorXd plus = p0, minus = p0, rp, rm;
     plus(i) += step[i];
     minus(i) -= step[i];
     ASSERT_TRUE(model->Evaluate(plus, model->AllRows(), &rp, nullptr));
     ASSERT_TRUE(model->Evaluate(minus, model->AllRows(), &rm, nullptr));
     const VectorXd fd = (rp - rm) / (2 * step[i]);
-    EXPECT_GT(fd.norm() * std::abs(p0(i)), 1e-3) << "column " << i << ": the residuals depend on it";
+    EXPECT_GT(fd.norm() * std::abs(p0(i)), i < 5 ? 1e-3 : 1e-6) << "column " << i << ": the residuals depend on it";
     EXPECT_LT((j.col(i) - fd).norm(), 1e-4 * fd.norm()) << "column " << i;
   }
+  // Without the water in the model: 5 columns, the scene has `water`.
+  starfish_.set_fit_water(false);
+  auto fixed = starfish_.MakeModel(recording_, window_, options, MaterialParameters{2e5, 0.35, 400},
+                                   StarfishActuation{0.004, 0.03, 0.05}, water);
+  ASSERT_EQ(fixed->num_blocks(), 2);
+  VectorXd r8, r5;
+  ASSERT_TRUE(model->Evaluate(p0, model->AllRows(), &r8, nullptr));
+  ASSERT_TRUE(fixed->Evaluate(p0.head(5), fixed->AllRows(), &r5, nullptr));
+  EXPECT_LT((r8 - r5).norm(), 1e-9 * r8.norm());
 }
 
 // Levenberg-Marquardt lowers the cost and gives every parameter a finite
@@ -497,13 +571,16 @@ TEST_F(StarfishFitTest, LeastSquaresFitLowersTheCostAndHasIntervals) {
   EXPECT_GT(fit.statistics.tangent_passes, 0);
   EXPECT_EQ(fit.statistics.adjoint_passes, 0);
   EXPECT_EQ(fit.residuals, 8 * (window_.num_frames() - 1));
-  ASSERT_EQ(fit.standard_deviation.size(), 5u);
-  ASSERT_EQ(fit.correlation.size(), 25u);
-  for (int i = 0; i < 5; ++i) {
+  EXPECT_TRUE(fit.water_fitted);
+  ASSERT_EQ(fit.standard_deviation.size(), 8u);
+  ASSERT_EQ(fit.correlation.size(), 64u);
+  for (int i = 0; i < 8; ++i) {
     EXPECT_TRUE(std::isfinite(fit.standard_deviation[i]) && fit.standard_deviation[i] > 0) << i;
-    EXPECT_NEAR(fit.correlation[6 * i], 1, 1e-9);
-    for (int k = 0; k < 5; ++k) EXPECT_NEAR(fit.correlation[5 * i + k], fit.correlation[5 * k + i], 1e-12);
+    EXPECT_NEAR(fit.correlation[9 * i], 1, 1e-9);
+    for (int k = 0; k < 8; ++k) EXPECT_NEAR(fit.correlation[8 * i + k], fit.correlation[8 * k + i], 1e-12);
   }
+  EXPECT_THROW_MESSAGE(CheckStarfishWaterStart(StarfishWater{0.05, 30, 0}), InvalidInputError,
+                       "drag_normal = 30 is outside the fit's interval (0.2, 20)");
   starfish_.set_regions(StarfishRegions::kBodyArms);
   EXPECT_THROW_MESSAGE(
       starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
