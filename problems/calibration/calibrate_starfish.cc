@@ -137,7 +137,8 @@ StarfishErrors StarfishCalibration::WindowErrors(const Mesh& mesh, const std::ve
 
 std::unique_ptr<solvers::RolloutFunction> StarfishCalibration::MakeModel(
     const StarfishRecording& rec, const StarfishWindow& w, const SolverOptions& options,
-    const MaterialParameters& material, const StarfishActuation& actuation, const StarfishWater& water) const {
+    const MaterialParameters& material, const StarfishActuation& actuation, const StarfishWater& water,
+    const CapturedMotion* motion) const {
   using solvers::MaterialField;
   Scene scene = MakeScene();
   scene.material = material;
@@ -172,8 +173,8 @@ std::unique_ptr<solvers::RolloutFunction> StarfishCalibration::MakeModel(
                                                      StateForceField::kThrust},
         scene));
   }
-  auto residuals = std::make_unique<solvers::MarkerResiduals>(WindowMotion(scene.mesh, initial, rec, w), scene.mesh,
-                                                              solver.time_step, steps);
+  auto residuals = std::make_unique<solvers::MarkerResiduals>(
+      motion ? *motion : WindowMotion(scene.mesh, initial, rec, w), scene.mesh, solver.time_step, steps);
   if (fit_method_ == StarfishFitMethod::kLbfgs)
     model->AddFunctional(std::make_unique<solvers::LeastSquaresLoss>(std::move(residuals)));
   else
@@ -187,11 +188,15 @@ StarfishFit StarfishCalibration::Fit(const StarfishRecording& rec, const Starfis
   const bool arms = regions_ == StarfishRegions::kBodyArms;
   if (arms && fit_method_ == StarfishFitMethod::kLevenbergMarquardt)
     throw InvalidInputError("the lm fit has no tied arms' nu: fit body-arms regions with --fit lbfgs");
+  if (fit_release_lag_ && fit_method_ != StarfishFitMethod::kLevenbergMarquardt)
+    throw InvalidInputError("the release lag is fitted by the lm fit only: use --fit lm with --servo asymmetric");
+  StarfishActuation start = actuation_guess;
+  if (fit_release_lag_ && !start.release_lag) start.release_lag = start.lag;
   const StarfishWater water = water_in_model() ? WaterGuess() : StarfishWater();
-  std::unique_ptr<solvers::RolloutFunction> model = MakeModel(rec, w, options, guess, actuation_guess, water);
+  std::unique_ptr<solvers::RolloutFunction> model = MakeModel(rec, w, options, guess, start, water);
   if (fit_method_ == StarfishFitMethod::kLevenbergMarquardt)
-    return FitStarfishLeastSquares(model.get(), 0, guess, actuation_guess, water_in_model() ? &water : nullptr,
-                                   max_iterations, log);
+    return FitStarfishLeastSquares(model.get(), 0, guess, start, water_in_model() ? &water : nullptr, max_iterations,
+                                   log);
   return FitStarfishLoss(model.get(), regions_ == StarfishRegions::kBodyArms, guess, actuation_guess, max_iterations,
                          log);
 }
@@ -222,7 +227,7 @@ StarfishCalibration::Prediction StarfishCalibration::Predict(const StarfishRecor
 
 int StarfishCalibration::Run(const CommandArgs& args) const {
   RefuseSimulatorTuning(args, name());
-  if (!args.regions.empty() || !args.fit.empty() || !args.water.empty()) {  // a copy with the settings
+  if (!args.regions.empty() || !args.fit.empty() || !args.water.empty() || !args.servo.empty()) {
     StarfishCalibration with = *this;
     if (!args.regions.empty()) with.set_regions(ParseStarfishRegions(args.regions));
     if (!args.fit.empty()) with.set_fit_method(ParseStarfishFitMethod(args.fit));
@@ -232,10 +237,17 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                                 "' is invalid: calibrate-starfish knows 'fitted' or 'fixed'");
       with.set_fit_water(args.water == "fitted");
     }
+    if (!args.servo.empty()) {
+      if (args.servo != "symmetric" && args.servo != "asymmetric")
+        throw InvalidInputError("--servo = '" + args.servo +
+                                "' is invalid: calibrate-starfish knows 'symmetric' or 'asymmetric'");
+      with.set_fit_release_lag(args.servo == "asymmetric");
+    }
     CommandArgs rest = args;
     rest.regions.clear();
     rest.fit.clear();
     rest.water.clear();
+    rest.servo.clear();
     return with.Run(rest);
   }
   if (args.steps > 0 || args.dt > 0)
@@ -327,11 +339,10 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
   if (fit.water_fitted)
     std::fprintf(log, "# fit: water drag_tangential = %.4g, drag_normal = %.4g, thrust = %.4g\n",
                  fit.water.drag_tangential, fit.water.drag_normal, fit.water.thrust);
-  const std::vector<std::string> fit_names = {"youngs_modulus", "poissons_ratio",  "tendon_slack", "tendon_lag",
-                                              "tendon_length",  "drag_tangential", "drag_normal",  "thrust"};
-  const std::vector<double> fit_values = {fitted.youngs_modulus, fitted.poissons_ratio, actuation.slack,
-                                          actuation.lag,         actuation.length,      fit.water.drag_tangential,
-                                          fit.water.drag_normal, fit.water.thrust};
+  if (actuation.release_lag)
+    std::fprintf(log, "# fit: asymmetric servo: release lag = %.4f s\n", *actuation.release_lag);
+  const std::vector<std::string> fit_names = StarfishFitNames(actuation.release_lag.has_value(), fit.water_fitted);
+  const std::vector<double> fit_values = StarfishFitValues(fit);
   const int n = static_cast<int>(fit.standard_deviation.size());
   if (n > 0) {
     std::fprintf(log, "# uncertainty (ceres::Covariance, %d residuals, noise fitted): value, standard deviation\n",
@@ -413,6 +424,8 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                           {"tendon_slack_mm", actuation.slack / kMm},
                           {"tendon_lag_s", actuation.lag},
                           {"tendon_length_mm", actuation.length / kMm},
+                          {"tendon_release_lag_s",
+                           actuation.release_lag ? nlohmann::json(*actuation.release_lag) : nlohmann::json(nullptr)},
                           {"truth", nlohmann::json::object()},
                           {"initial_guess",
                            {{"youngs_modulus", guess.youngs_modulus},

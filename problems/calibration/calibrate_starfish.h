@@ -59,6 +59,10 @@ class StarfishCalibration : public Problem {
   // (default true; the lbfgs fit keeps the scene's).
   bool fit_water() const { return fit_water_; }
   void set_fit_water(bool fit) { fit_water_ = fit; }
+  // Whether the lm fit models an asymmetric servo and fits its release lag
+  // (StarfishActuation::release_lag; default false).
+  bool fit_release_lag() const { return fit_release_lag_; }
+  void set_fit_release_lag(bool fit) { fit_release_lag_ = fit; }
   // Whether the water joins a model (fit_water() and the lm fit).
   bool water_in_model() const { return fit_water_ && fit_method_ == StarfishFitMethod::kLevenbergMarquardt; }
 
@@ -106,7 +110,8 @@ class StarfishCalibration : public Problem {
   // The rollout function of a window at `material`, `actuation` and `water`:
   // blocks {E, nu} (Pa, 1; with kBodyArms {E, nu, E_arms, nu_arms}, the arms
   // region starting at `material` too), {slack, lag, length} (m, s, m; the
-  // tendon actuation model, which writes every step's activations) and,
+  // tendon actuation model, which writes every step's activations; with
+  // `actuation`'s release_lag set {slack, lag, length, release_lag}) and,
   // when water_in_model(), {drag_tangential, drag_normal, thrust} (a
   // StateForceBlock; otherwise the scene has `water`'s values), and functional
   // 0: with fit_method() kLbfgs one row, the scalar loss 1/2 |r|^2 of the
@@ -115,20 +120,27 @@ class StarfishCalibration : public Problem {
   // 3 rows per marker and frame, y unweighted). The initial state is WindowInitialState at
   // `actuation` and is held fixed, so the gradient is exact when the window
   // starts with the tendon slack (a = 1, as in the default fit window from rest).
+  // `motion` (not nullptr): the residuals of this motion instead of the
+  // recording's (e.g. a synthetic recording with WindowMotion's markers,
+  // sample times and weights).
   std::unique_ptr<solvers::RolloutFunction> MakeModel(const StarfishRecording& recording, const StarfishWindow& window,
                                                       const SolverOptions& options, const MaterialParameters& material,
                                                       const StarfishActuation& actuation,
-                                                      const StarfishWater& water = StarfishWater()) const;
+                                                      const StarfishWater& water = StarfishWater(),
+                                                      const CapturedMotion* motion = nullptr) const;
 
   // Fits E, nu, slack, lag and length (with kBodyArms also the arms' E;
   // when water_in_model() also the water's coefficients from the scene's) on
-  // a window: FitStarfishLeastSquares or FitStarfishLoss (fit_method()) on
+  // a window (with fit_release_lag() also the release lag, starting at the
+  // guess's lag): FitStarfishLeastSquares or FitStarfishLoss (fit_method()) on
   // MakeModel's functional, starting from `guess` (both regions) and
   // `actuation_guess`, at most `max_iterations` iterations; the iteration
   // table goes to `log` (nullptr: silent). Throws what MakeModel and
   // StarfishFitStart throw, and InvalidInputError for kBodyArms with
   // kLevenbergMarquardt ("the lm fit has no tied arms' nu: fit body-arms
-  // regions with --fit lbfgs").
+  // regions with --fit lbfgs") and for fit_release_lag() with kLbfgs ("the
+  // release lag is fitted by the lm fit only: use --fit lm with --servo
+  // asymmetric").
   StarfishFit Fit(const StarfishRecording& recording, const StarfishWindow& window, const SolverOptions& options,
                   const MaterialParameters& guess, const StarfishActuation& actuation_guess, int max_iterations,
                   FILE* log) const;
@@ -156,7 +168,7 @@ class StarfishCalibration : public Problem {
   // `diffpd run calibrate-starfish [--calibrate FILE] [--predict FILE ...]
   // [--seconds S] [--json] [--threads T] [--max-iterations N] [--out DIR]
   // [--regions body-arms] [--fit lm|lbfgs] [--fit-start S] [--fit-seconds S]`:
-  // [--water fitted|fixed]
+  // [--water fitted|fixed] [--servo symmetric|asymmetric]
   // fits E, nu, tendon slack, lag and length (and, unless --water fixed or
   // --fit lbfgs, the water's drag and thrust coefficients) on the calibration file's window
   // (default [1 s, 3 s]: the tendon first moves at 1.18 s in cyclic1) by
@@ -184,6 +196,7 @@ class StarfishCalibration : public Problem {
   StarfishRegions regions_ = StarfishRegions::kNone;
   StarfishFitMethod fit_method_ = StarfishFitMethod::kLevenbergMarquardt;
   bool fit_water_ = true;
+  bool fit_release_lag_ = false;
 };
 
 }  // namespace diffpd::problems

@@ -17,30 +17,40 @@ std::string Num(double v) {
 }
 
 StarfishActuation At(const Eigen::Ref<const VectorXd>& values) {
-  return StarfishActuation{values(0), values(1), values(2)};
+  StarfishActuation a{values(0), values(1), values(2)};
+  if (values.size() > 3) a.release_lag = values(3);
+  return a;
 }
 
 }  // namespace
 
 std::vector<double> StarfishActivationsUntilNegative(const std::vector<double>& c, double h,
                                                      const StarfishActuation& act,
-                                                     std::vector<std::array<double, 3>>* derivatives,
+                                                     std::vector<std::array<double, 4>>* derivatives,
                                                      int* first_negative) {
   if (!(std::isfinite(h) && h > 0)) throw InvalidInputError("time step = " + Num(h) + " is invalid: must be > 0 (s)");
   if (!(std::isfinite(act.slack) && act.slack >= 0))
     throw InvalidInputError("tendon slack = " + Num(act.slack) + " is invalid: must be finite and >= 0 (m)");
   if (!(std::isfinite(act.lag) && act.lag >= 0))
     throw InvalidInputError("tendon lag = " + Num(act.lag) + " is invalid: must be finite and >= 0 (s)");
+  if (act.release_lag && !(std::isfinite(*act.release_lag) && *act.release_lag >= 0))
+    throw InvalidInputError("tendon release_lag = " + Num(*act.release_lag) +
+                            " is invalid: must be finite and >= 0 (s)");
   if (!(std::isfinite(act.length) && act.length > 0))
     throw InvalidInputError("tendon length = " + Num(act.length) + " is invalid: must be finite and > 0 (m)");
   const size_t n = c.size();
   std::vector<double> a(n);
-  if (derivatives) derivatives->assign(n, {0, 0, 0});
-  double f = n ? c[0] : 0, df = 0;  // filtered contraction and its derivative in lag
+  if (derivatives) derivatives->assign(n, {0, 0, 0, 0});
+  // The filtered contraction and its derivatives in lag and release_lag.
+  double f = n ? c[0] : 0, df = 0, dr = 0;
   const double w = kSlackSmoothing, L = act.length;
   for (size_t k = 0; k < n; ++k) {
-    const double f_new = (act.lag * f + h * c[k]) / (act.lag + h);
-    df = (f - f_new + act.lag * df) / (act.lag + h);
+    const bool release = act.release_lag && c[k] < f;
+    const double lag = release ? *act.release_lag : act.lag;
+    const double f_new = (lag * f + h * c[k]) / (lag + h);
+    // d f_new = (lag d f + (f - f_new) d lag) / (lag + h).
+    df = ((release ? 0 : f - f_new) + lag * df) / (lag + h);
+    dr = ((release ? f - f_new : 0) + lag * dr) / (lag + h);
     f = f_new;
     const double x = f - act.slack;
     const double hinge = x <= 0 ? 0 : x < w ? x * x / (2 * w) : x - w / 2;
@@ -50,7 +60,7 @@ std::vector<double> StarfishActivationsUntilNegative(const std::vector<double>& 
       *first_negative = static_cast<int>(k);
       return a;
     }
-    if (derivatives) (*derivatives)[k] = {slope / L, -slope * df / L, hinge / (L * L)};
+    if (derivatives) (*derivatives)[k] = {slope / L, -slope * df / L, hinge / (L * L), -slope * dr / L};
   }
   *first_negative = -1;
   return a;
@@ -62,7 +72,7 @@ std::string NegativeActivation(const std::vector<double>& a, int k, const Starfi
 }
 
 std::vector<double> StarfishActivations(const std::vector<double>& c, double h, const StarfishActuation& act,
-                                        std::vector<std::array<double, 3>>* derivatives) {
+                                        std::vector<std::array<double, 4>>* derivatives) {
   int negative = -1;
   std::vector<double> a = StarfishActivationsUntilNegative(c, h, act, derivatives, &negative);
   if (negative >= 0)
@@ -72,8 +82,11 @@ std::vector<double> StarfishActivations(const std::vector<double>& c, double h, 
 
 TendonActuationBlock::TendonActuationBlock(std::vector<double> contraction, double h, int muscles,
                                            const StarfishActuation& start)
-    : ParameterBlock(3), contraction_(std::move(contraction)), h_(h), muscles_(muscles) {
-  SetInitial(Eigen::Vector3d(start.slack, start.lag, start.length));
+    : ParameterBlock(start.release_lag ? 4 : 3), contraction_(std::move(contraction)), h_(h), muscles_(muscles) {
+  VectorXd initial(size());
+  initial.head(3) << start.slack, start.lag, start.length;
+  if (start.release_lag) initial(3) = *start.release_lag;
+  SetInitial(initial);
 }
 
 void TendonActuationBlock::CheckFits(const Scene& scene, int num_steps) const {
@@ -88,17 +101,17 @@ void TendonActuationBlock::Apply(const Eigen::Ref<const VectorXd>& values, solve
 
 void TendonActuationBlock::PullBack(const Eigen::Ref<const VectorXd>& values, const RolloutGradient& grad,
                                     Eigen::Ref<VectorXd> out) const {
-  std::vector<std::array<double, 3>> d;
+  std::vector<std::array<double, 4>> d;
   StarfishActivations(contraction_, h_, At(values), &d);
   out.setZero();
-  for (int j = 0; j < 3; ++j)
+  for (int j = 0; j < size(); ++j)
     for (size_t k = 0; k < d.size() && k < grad.activation.size(); ++k)
       if (grad.activation[k].size()) out(j) += grad.activation[k].dot(VectorXd::Constant(muscles_, d[k][j]));
 }
 
 void TendonActuationBlock::PushForward(const Eigen::Ref<const VectorXd>& values, int j,
                                        const solvers::RolloutSetup& setup, InputDirection* direction) const {
-  std::vector<std::array<double, 3>> d;
+  std::vector<std::array<double, 4>> d;
   StarfishActivations(contraction_, h_, At(values), &d);
   for (size_t k = 0; k < d.size(); ++k) direction->activation[k] = VectorXd::Constant(muscles_, d[k][j]);
 }

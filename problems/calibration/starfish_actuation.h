@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,38 +22,45 @@ namespace diffpd::problems {
 //               pulls nothing; the quadratic onset keeps a smooth),
 //   length:     the tendon length over which the contraction is spread (the
 //               fact sheet's 65 mm).
+//   release:    with release_lag set, the servo follows a release (c(k) <
+//               c_f(k-1)) with release_lag instead of lag (an asymmetric
+//               servo: it pulls against the body, releases with it).
 // slack = 0, lag = 0, length = 65 mm is the fact sheet's a = 1 - c / 65 mm
 // except below 1 mm.
 struct StarfishActuation {
-  double slack = 0;       // m, >= 0
-  double lag = 0;         // s, >= 0
-  double length = 0.065;  // m, > 0
+  double slack = 0;                   // m, >= 0
+  double lag = 0;                     // s, >= 0
+  double length = 0.065;              // m, > 0
+  std::optional<double> release_lag;  // s, >= 0; unset: lag for both directions
 };
 
 // Activations a(k) of the steps of a contraction sequence (one value per
 // step, m) at time step h (s), and if not nullptr, per step the derivatives
-// {da/dslack (1/m), da/dlag (1/s), da/dlength (1/m)}. Throws
+// {da/dslack (1/m), da/dlag (1/s), da/dlength (1/m), da/drelease_lag (1/s;
+// 0 without release_lag)}. Throws
 // InvalidInputError for h <= 0, a negative or non-finite slack or lag, or a
-// length <= 0 ("tendon lag = -1 is invalid: must be finite and >= 0 (s)"),
+// length <= 0 ("tendon lag = -1 is invalid: must be finite and >= 0 (s)",
+// also "tendon release_lag = -1 ..."),
 // and for a negative activation ("tendon: activation -0.2 < 0 (the filtered
 // contraction exceeds slack + length: slack 0 m, length 0.01 m) at step 7").
 std::vector<double> StarfishActivations(const std::vector<double>& contraction, double h,
                                         const StarfishActuation& actuation,
-                                        std::vector<std::array<double, 3>>* derivatives);
+                                        std::vector<std::array<double, 4>>* derivatives);
 // StarfishActivations with its checks of h and the actuation, but without
 // the negative-activation one: *first_negative is the first step with a < 0
 // (-1: none), where the sequence stops (the steps after it are not computed).
 std::vector<double> StarfishActivationsUntilNegative(const std::vector<double>& contraction, double h,
                                                      const StarfishActuation& actuation,
-                                                     std::vector<std::array<double, 3>>* derivatives,
+                                                     std::vector<std::array<double, 4>>* derivatives,
                                                      int* first_negative);
 // "activation -0.2 < 0 (the filtered contraction exceeds slack + length:
 // slack 0 m, length 0.065 m)" of step k of `activations`.
 std::string NegativeActivation(const std::vector<double>& activations, int k, const StarfishActuation& actuation);
 
-// StarfishActivations as a parameter block {slack, lag, length} (m, s, m):
-// it writes the same activation into every muscle at every step of a rollout
-// of contraction.size() steps.
+// StarfishActivations as a parameter block {slack, lag, length} (m, s, m),
+// or {slack, lag, length, release_lag} when `start` has a release_lag: it
+// writes the same activation into every muscle at every step of a rollout of
+// contraction.size() steps.
 class TendonActuationBlock : public solvers::ParameterBlock {
  public:
   TendonActuationBlock(std::vector<double> contraction, double h, int muscles, const StarfishActuation& start);

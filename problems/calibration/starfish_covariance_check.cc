@@ -23,14 +23,13 @@ StarfishCovarianceCheck CheckStarfishCovariance(const StarfishModelFactory& make
   }
   const auto begin = std::chrono::steady_clock::now();
   StarfishCovarianceCheck check;
-  check.names = {"youngs_modulus", "poissons_ratio", "tendon_slack", "tendon_lag", "tendon_length"};
-  check.truth = {truth.material.youngs_modulus, truth.material.poissons_ratio, truth.actuation.slack,
-                 truth.actuation.lag, truth.actuation.length};
-  if (truth.water) {
-    for (const char* name : {"drag_tangential", "drag_normal", "thrust"}) check.names.push_back(name);
-    for (double v : {truth.water->drag_tangential, truth.water->drag_normal, truth.water->thrust})
-      check.truth.push_back(v);
-  }
+  StarfishFit truth_fit;
+  truth_fit.material = truth.material;
+  truth_fit.actuation = truth.actuation;
+  truth_fit.water_fitted = truth.water.has_value();
+  if (truth.water) truth_fit.water = *truth.water;
+  check.names = StarfishFitNames(truth.actuation.release_lag.has_value(), truth_fit.water_fitted);
+  check.truth = StarfishFitValues(truth_fit);
   const int n = static_cast<int>(check.truth.size());
 
   // The simulated positions at the truth: layout + residual / weight.
@@ -63,9 +62,7 @@ StarfishCovarianceCheck CheckStarfishCovariance(const StarfishModelFactory& make
     ++check.refits;
     if (!fit.usable || static_cast<int>(fit.standard_deviation.size()) != n) continue;
     ++check.usable;
-    const std::vector<double> x = {fit.material.youngs_modulus, fit.material.poissons_ratio, fit.actuation.slack,
-                                   fit.actuation.lag,           fit.actuation.length,         fit.water.drag_tangential,
-                                   fit.water.drag_normal,       fit.water.thrust};
+    const std::vector<double> x = StarfishFitValues(fit);
     for (int i = 0; i < n; ++i) {
       values[i].push_back(x[i]);
       reported[i].push_back(fit.standard_deviation[i]);

@@ -103,17 +103,19 @@ class FitTable : public ceres::IterationCallback {
 // `water` nullptr when the water is not fitted).
 class LeastSquaresTable : public ceres::IterationCallback {
  public:
-  LeastSquaresTable(FILE* log, const double* material, const double* actuation, const double* water)
-      : log_(log), material_(material), actuation_(actuation), water_(water) {}
+  LeastSquaresTable(FILE* log, const double* material, const double* actuation, bool release, const double* water)
+      : log_(log), material_(material), actuation_(actuation), release_(release), water_(water) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     if (s.iteration == 0) {
       std::fprintf(log_, "%4s %13s %11s %11s %9s %14s %14s %9s %9s %9s", "iter", "cost", "cost_change", "|gradient|",
                    "total_t", "youngs_modulus", "poissons_ratio", "slack_mm", "lag_s", "length_mm");
+      if (release_) std::fprintf(log_, " %9s", "release_s");
       std::fprintf(log_, water_ ? " %9s %9s %9s\n" : "\n", "drag_t", "drag_n", "thrust");
     }
     std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %9.2f %14.6g %14.6g %9.4f %9.4f %9.3f", s.iteration, s.cost,
                  s.cost_change, s.gradient_max_norm, s.cumulative_time_in_seconds, material_[0], material_[1],
                  actuation_[0] / kMm, actuation_[1], actuation_[2] / kMm);
+    if (release_) std::fprintf(log_, " %9.4f", actuation_[3]);
     if (water_) std::fprintf(log_, " %9.4f %9.4f %9.4f", water_[0], water_[1], water_[2]);
     std::fprintf(log_, "\n");
     std::fflush(log_);
@@ -124,6 +126,7 @@ class LeastSquaresTable : public ceres::IterationCallback {
   FILE* log_;
   const double* material_;
   const double* actuation_;
+  bool release_;
   const double* water_;
 };
 
@@ -234,17 +237,39 @@ StarfishFit FitStarfishLoss(solvers::RolloutFunction* model, bool arms, const Ma
   return fit;
 }
 
+std::vector<std::string> StarfishFitNames(bool release, bool water) {
+  std::vector<std::string> names = {"youngs_modulus", "poissons_ratio", "tendon_slack", "tendon_lag", "tendon_length"};
+  if (release) names.push_back("tendon_release_lag");
+  if (water)
+    for (const char* n : {"drag_tangential", "drag_normal", "thrust"}) names.push_back(n);
+  return names;
+}
+
+std::vector<double> StarfishFitValues(const StarfishFit& fit) {
+  std::vector<double> v = {fit.material.youngs_modulus, fit.material.poissons_ratio, fit.actuation.slack,
+                           fit.actuation.lag, fit.actuation.length};
+  if (fit.actuation.release_lag) v.push_back(*fit.actuation.release_lag);
+  if (fit.water_fitted)
+    for (double w : {fit.water.drag_tangential, fit.water.drag_normal, fit.water.thrust}) v.push_back(w);
+  return v;
+}
+
 StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residual_functional,
                                     const MaterialParameters& guess, const StarfishActuation& actuation_guess,
                                     const StarfishWater* water_guess, int max_iterations, FILE* log) {
   const std::vector<double> start = StarfishFitStart(guess, actuation_guess, false);
   if (water_guess) CheckStarfishWaterStart(*water_guess);
+  const bool release = actuation_guess.release_lag.has_value();
+  if (release && !(*actuation_guess.release_lag > kMinLag && *actuation_guess.release_lag < kMaxLag))
+    throw InvalidInputError("tendon release_lag = " + Num(*actuation_guess.release_lag) +
+                            " is outside the fit's interval (0.001, 0.5) s");
   std::vector<solvers::CoordinateMap> maps = StarfishFitCoordinates(false);
+  if (release) maps.push_back(solvers::CoordinateMap::LogLogit(kMinLag, kMaxLag));
   double material[2] = {start[0], start[1]};
-  double actuation[3] = {start[2], start[3], start[4]};
+  double actuation[4] = {start[2], start[3], start[4], release ? *actuation_guess.release_lag : 0};
   double water[3] = {0, 0, 0};
   std::vector<double*> blocks = {material, actuation};
-  std::vector<int> sizes = {2, 3};
+  std::vector<int> sizes = {2, release ? 4 : 3};
   if (water_guess) {
     water[0] = water_guess->drag_tangential;
     water[1] = water_guess->drag_normal;
@@ -274,7 +299,7 @@ StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residua
   options.gradient_tolerance = 1e-12;
   options.update_state_every_iteration = true;
   options.logging_type = ceres::SILENT;
-  LeastSquaresTable table(log, material, actuation, water_guess ? water : nullptr);
+  LeastSquaresTable table(log, material, actuation, release, water_guess ? water : nullptr);
   if (log) options.callbacks.push_back(&table);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
@@ -282,6 +307,7 @@ StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residua
   StarfishFit fit;
   fit.material = MaterialParameters{material[0], material[1], guess.density};
   fit.actuation = StarfishActuation{actuation[0], actuation[1], actuation[2]};
+  if (release) fit.actuation.release_lag = actuation[3];
   if (water_guess) {
     fit.water = StarfishWater{water[0], water[1], water[2]};
     fit.water_fitted = true;
@@ -298,9 +324,8 @@ StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residua
 
   // Rows with a weight (the markers' unobserved y has none).
   VectorXd r;
-  VectorXd point(n);
-  point << material[0], material[1], actuation[0], actuation[1], actuation[2];
-  if (water_guess) point.tail(3) << water[0], water[1], water[2];
+  const std::vector<double> values = StarfishFitValues(fit);
+  const VectorXd point = Eigen::Map<const VectorXd>(values.data(), n);
   const std::vector<int> rows = model->RowsOf(residual_functional);
   if (fit.usable && model->Evaluate(point, rows, &r, nullptr)) {
     MatrixXd j;

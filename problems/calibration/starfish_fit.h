@@ -11,6 +11,9 @@
 //   x4 length in (30, 130) mm
 //   x5 E_arms in (1e4, 5e6) Pa (StarfishRegions::kBodyArms only; the arms'
 //      nu is tied to the body's)
+// in the least-squares fit with an asymmetric servo (StarfishActuation::
+// release_lag set) also the release lag, log-logit like the lag:
+//   release_lag in (1, 500) ms
 // and, in the least-squares fit when the water is fitted (StarfishWater),
 // three more, log-logit (positive: each term opposes the motion):
 //   drag_tangential in (0.005, 5), drag_normal in (0.2, 20), thrust in (0.001, 10)
@@ -79,6 +82,15 @@ struct StarfishFit {
   int residuals = 0;  // rows of the least-squares problem with non-zero weight
 };
 
+// The names of the least-squares fit's values in their order: youngs_modulus,
+// poissons_ratio, tendon_slack, tendon_lag, tendon_length, then with
+// `release` tendon_release_lag, then with `water` drag_tangential,
+// drag_normal, thrust.
+std::vector<std::string> StarfishFitNames(bool release, bool water);
+// A fit's values in the order of StarfishFitNames(fit.actuation.release_lag,
+// fit.water_fitted) (physical units).
+std::vector<double> StarfishFitValues(const StarfishFit& fit);
+
 // The coordinate maps of the fitted values (5, or 6 with `arms`).
 std::vector<solvers::CoordinateMap> StarfishFitCoordinates(bool arms);
 // The fitted values of a starting point. Throws InvalidInputError for a
@@ -97,13 +109,15 @@ std::vector<double> StarfishFitStart(const MaterialParameters& material, const S
 StarfishFit FitStarfishLoss(solvers::RolloutFunction* model, bool arms, const MaterialParameters& guess,
                             const StarfishActuation& actuation_guess, int max_iterations, FILE* log);
 
-// Fits `model` (blocks: material {E, nu}, then TendonActuationBlock, and
+// Fits `model` (blocks: material {E, nu}, then TendonActuationBlock (with
+// release_lag when actuation_guess has one: then it is fitted too), and
 // with `water_guess` a StateForceBlock {drag_tangential, drag_normal,
 // thrust}; functional `residual_functional`: a MarkerResiduals) by
 // Levenberg-Marquardt (ceres::Problem, one residual block per capture frame,
-// Jacobians by the rollout function: forward-mode tangents for 5 or 8
+// Jacobians by the rollout function: forward-mode tangents for 5 to 9
 // parameters) on the manifolds of StarfishFitCoordinates(false) and
-// StarfishWaterCoordinates(), from `guess`, `actuation_guess` and
+// StarfishWaterCoordinates() (the release lag: the lag's), from `guess`,
+// `actuation_guess` and
 // `water_guess` (nullptr: the water is not fitted), at most `max_iterations`
 // iterations, then the parameters' covariance (see StarfishFit). The
 // iteration table goes to `log` (nullptr: silent). Throws what

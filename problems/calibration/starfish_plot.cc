@@ -30,8 +30,8 @@ void WriteStarfishTracePlot(const std::string& trace_csv, const std::string& png
       const char* name = axis == 0 ? "x" : "z";
       s << "set ylabel 'M" << m + 1 << " " << name << " displacement (mm)'\n"
         << "set y2label 'tendon (mm)'\n"
-        << (m == 3 ? "set xlabel 'time (s)'\n" : "unset xlabel\n")
-        << "plot " << data << " every ::1 using 1:2 axes x1y2 with lines lc rgb '#c8c8c8' title 'tendon', " << data
+        << (m == 3 ? "set xlabel 'time (s)'\n" : "unset xlabel\n") << "plot " << data
+        << " every ::1 using 1:2 axes x1y2 with lines lc rgb '#c8c8c8' title 'tendon', " << data
         << " every ::1 using 1:" << cap << " with lines lw 2 lc rgb '#1f77b4' title 'captured', " << data
         << " every ::1 using 1:" << sim << " with lines lw 2 lc rgb '#d62728' title 'simulated'\n";
     }
@@ -56,8 +56,8 @@ void WritePoints(const std::string& path, const Eigen::Matrix3Xd& points, const 
   for (Eigen::Index i = 0; i < n; ++i) out << i << (i + 1 < n ? " " : "\n");
   out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
   for (Eigen::Index i = 0; i < n; ++i) out << i + 1 << (i + 1 < n ? " " : "\n");
-  out << "</DataArray>\n</Verts>\n<PointData Vectors=\"" << field << "\">\n<DataArray type=\"Float64\" Name=\""
-      << field << "\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  out << "</DataArray>\n</Verts>\n<PointData Vectors=\"" << field << "\">\n<DataArray type=\"Float64\" Name=\"" << field
+      << "\" NumberOfComponents=\"3\" format=\"ascii\">\n";
   for (Eigen::Index i = 0; i < n; ++i) out << values(0, i) << " " << values(1, i) << " " << values(2, i) << "\n";
   out << "</DataArray>\n</PointData>\n</Piece>\n</PolyData>\n</VTKFile>\n";
   if (!out) throw InvalidInputError("cannot write '" + path + "'");
@@ -66,9 +66,8 @@ void WritePoints(const std::string& path, const Eigen::Matrix3Xd& points, const 
 }  // namespace
 
 std::array<std::string, 2> WriteStarfishVtk(const std::string& dir, const std::string& stem, const Mesh& mesh,
-                                            const std::array<int, 4>& marker_vertices,
-                                            const std::vector<State>& states, int substeps,
-                                            const std::vector<double>& frame_times,
+                                            const std::array<int, 4>& marker_vertices, const std::vector<State>& states,
+                                            int substeps, const std::vector<double>& frame_times,
                                             const StarfishDisplacements& captured, int stride) {
   if (stride < 1) throw InvalidInputError("stride = " + std::to_string(stride) + " is invalid: must be >= 1");
   const int frames = static_cast<int>(captured.size());

@@ -34,9 +34,8 @@ void WriteStarfishTracePlot(const std::string& trace_csv, const std::string& png
 // InvalidInputError for stride < 1 ("stride = 0 is invalid: must be >= 1"),
 // too few states for the frames, and what PvdWriter throws.
 std::array<std::string, 2> WriteStarfishVtk(const std::string& dir, const std::string& stem, const Mesh& mesh,
-                                            const std::array<int, 4>& marker_vertices,
-                                            const std::vector<State>& states, int substeps,
-                                            const std::vector<double>& frame_times,
+                                            const std::array<int, 4>& marker_vertices, const std::vector<State>& states,
+                                            int substeps, const std::vector<double>& frame_times,
                                             const StarfishDisplacements& captured, int stride);
 
 }  // namespace diffpd::problems

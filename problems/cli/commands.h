@@ -64,6 +64,7 @@ struct CommandArgs {
   double fit_start = -1;
   double fit_seconds = -1;
   std::string water;  // calibrate-starfish: "": the problem's; "fitted", "fixed"
+  std::string servo;  // calibrate-starfish: "": the problem's; "symmetric", "asymmetric"
 };
 
 int ListCommand(bool json);

@@ -78,6 +78,7 @@ void RefuseUnusedRunOptions(const CommandArgs& args, const Problem& problem) {
       {"--fit-start", args.fit_start != defaults.fit_start, kStarfish, "calibrate-starfish"},
       {"--fit-seconds", args.fit_seconds != defaults.fit_seconds, kStarfish, "calibrate-starfish"},
       {"--water", !args.water.empty(), kStarfish, "calibrate-starfish"},
+      {"--servo", !args.servo.empty(), kStarfish, "calibrate-starfish"},
   };
   const int kind = KindOf(problem);
   for (const RunOption& o : options)

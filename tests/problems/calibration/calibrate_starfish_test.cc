@@ -197,7 +197,7 @@ TEST(StarfishActivationsTest, SlackLagAndLengthShapeTheActivation) {
   // Derivatives vs central differences.
   for (int k = 0; k < 40; ++k) c[k] = 0.009 + 0.008 * std::sin(0.7 * k);
   const StarfishActuation at{0.004, 0.03, 0.05};
-  std::vector<std::array<double, 3>> d;
+  std::vector<std::array<double, 4>> d;
   StarfishActivations(c, h, at, &d);
   const double e = 1e-7;
   double largest[3] = {0, 0, 0};
@@ -221,12 +221,58 @@ TEST(StarfishActivationsTest, SlackLagAndLengthShapeTheActivation) {
   EXPECT_GT(largest[0], 1);    // 1/m
   EXPECT_GT(largest[1], 0.1);  // 1/s
   EXPECT_GT(largest[2], 1);    // 1/m
+  for (int k = 0; k < 40; ++k) EXPECT_EQ(d[k][3], 0.0) << "no release lag";
   EXPECT_THROW_MESSAGE(StarfishActivations(c, h, StarfishActuation{0, -1, 0.065}, nullptr), InvalidInputError,
                        "tendon lag = -1 is invalid: must be finite and >= 0 (s)");
+  EXPECT_THROW_MESSAGE(StarfishActivations(c, h, StarfishActuation{0, 0.03, 0.065, -1.0}, nullptr), InvalidInputError,
+                       "tendon release_lag = -1 is invalid: must be finite and >= 0 (s)");
   EXPECT_THROW_MESSAGE(
       StarfishActivations({0.0, 0.0105}, h, StarfishActuation{0, 0, 0.005}, nullptr), InvalidInputError,
       "tendon: activation -1 < 0 (the filtered contraction exceeds slack + length: slack 0 m, length 0.005 m) "
       "at step 1");
+}
+
+// An asymmetric servo: a release follows release_lag, a pull the lag; the
+// derivatives in lag and release_lag match central differences, each
+// non-zero only through its own direction of motion.
+TEST(StarfishActivationsTest, AReleaseFollowsTheReleaseLag) {
+  const double h = 0.01;
+  std::vector<double> c(60, 0.0);
+  for (int k = 5; k < 30; ++k) c[k] = 0.0179;  // a pull, held, then a release at step 30
+  StarfishActuation slow_release{0, 0.03, 0.065, 0.2}, fast_release{0, 0.03, 0.065, 0.001};
+  const std::vector<double> symmetric = StarfishActivations(c, h, StarfishActuation{0, 0.03, 0.065}, nullptr);
+  const std::vector<double> slow = StarfishActivations(c, h, slow_release, nullptr);
+  const std::vector<double> fast = StarfishActivations(c, h, fast_release, nullptr);
+  for (int k = 0; k < 30; ++k) {  // the pull: the same
+    EXPECT_EQ(slow[k], symmetric[k]) << k;
+    EXPECT_EQ(fast[k], symmetric[k]) << k;
+  }
+  EXPECT_LT(slow[35], symmetric[35]);  // still contracted
+  EXPECT_GT(fast[31], symmetric[31]);  // released at once
+  EXPECT_NEAR(fast[32], 1.0, 1e-3);
+  for (int k = 0; k < 60; ++k) c[k] = 0.009 + 0.008 * std::sin(0.7 * k);
+  const StarfishActuation at{0.004, 0.03, 0.05, 0.08};
+  std::vector<std::array<double, 4>> d;
+  StarfishActivations(c, h, at, &d);
+  const double e = 1e-7;
+  for (const int j : {1, 3}) {
+    StarfishActuation plus = at, minus = at;
+    if (j == 1) {
+      plus.lag += e;
+      minus.lag -= e;
+    } else {
+      *plus.release_lag += e;
+      *minus.release_lag -= e;
+    }
+    const std::vector<double> ap = StarfishActivations(c, h, plus, nullptr);
+    const std::vector<double> am = StarfishActivations(c, h, minus, nullptr);
+    double largest = 0;
+    for (int k = 0; k < 60; ++k) {
+      EXPECT_NEAR(d[k][j], (ap[k] - am[k]) / (2 * e), 1e-6) << "parameter " << j << ", step " << k;
+      largest = std::max(largest, std::abs(d[k][j]));
+    }
+    EXPECT_GT(largest, 0.1) << "parameter " << j;  // 1/s
+  }
 }
 
 // A tendon contraction the tendon cannot take names the recording's file and
@@ -586,6 +632,13 @@ TEST_F(StarfishFitTest, LeastSquaresFitLowersTheCostAndHasIntervals) {
       starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
                     StarfishCalibration::ActuationGuess(), 3, nullptr),
       InvalidInputError, "the lm fit has no tied arms' nu: fit body-arms regions with --fit lbfgs");
+  starfish_.set_regions(StarfishRegions::kNone);
+  starfish_.set_fit_method(StarfishFitMethod::kLbfgs);
+  starfish_.set_fit_release_lag(true);
+  EXPECT_THROW_MESSAGE(
+      starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
+                    StarfishCalibration::ActuationGuess(), 3, nullptr),
+      InvalidInputError, "the release lag is fitted by the lm fit only: use --fit lm with --servo asymmetric");
   EXPECT_THROW_MESSAGE(ParseStarfishFitMethod("newton"), InvalidInputError,
                        "--fit = 'newton' is invalid: calibrate-starfish fits with 'lm' or 'lbfgs'");
 }
