@@ -17,6 +17,7 @@ void WriteStarfishTracePlot(const std::string& trace_csv, const std::string& png
   std::ostringstream s;
   s << "set terminal pngcairo size 1400,1200 font ',10'\n"
     << "set output " << GnuplotQuote(png_path) << "\n"
+    << "set termoption noenhanced\n"
     << "set datafile separator ','\n"
     << "set key top left horizontal font ',8'\n"
     << "set grid\n"
