@@ -57,7 +57,6 @@ Swimmer StarfishControl::MakeSwimmer(bool small) const {
   s.scene.mesh = g.mesh;
   s.scene.material = MaterialParameters{1e6, 0.45, 1e3};
   s.scene.energies = {ElasticEnergy::kPdCorotated};
-  s.scene.mass_lumping = MassLumping::kEqualNodes;  // the original's rho dx^3 per node (387 kg, the body 168 kg)
   QuadHydrodynamics water;
   water.quads = BoundaryQuads(s.scene.mesh);
   s.scene.quad_hydrodynamics = water;
