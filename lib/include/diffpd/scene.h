@@ -33,6 +33,15 @@ struct MaterialRegion {
   MaterialParameters material;
 };
 
+// How the body's mass is spread over its nodes (inertia and gravity).
+enum class MassLumping {
+  kLumped,      // node a carries the integral of its shape function N_a times rho (the body's true mass)
+  kEqualNodes,  // every node carries rho times the mean element volume, as the original DiffPD code
+                // does (its total exceeds the body's mass; for reproducing its scenes)
+};
+// "lumped", "equal-nodes".
+const char* ToString(MassLumping lumping);
+
 struct Scene {
   Mesh mesh;
   // The base material: that of every element in no material region.
@@ -46,6 +55,8 @@ struct Scene {
   // Elastic energy densities, summed. PD solvers need all of them projective
   // (kPdCorotated, kPdVolume); Newton and PD-LBFGS accept any.
   std::vector<ElasticEnergy> energies = {ElasticEnergy::kPdCorotated, ElasticEnergy::kPdVolume};
+  // kEqualNodes needs a single material (no material_regions).
+  MassLumping mass_lumping = MassLumping::kLumped;
   // Uniform gravitational acceleration (m/s^2), applied as M g when declared.
   std::optional<Vec3> gravity;
   DirichletBoundary dirichlet;
@@ -75,7 +86,10 @@ struct Scene {
   // invalid material ("scene: material region 1: youngs_modulus = 0 is
   // invalid: ..."); no energy or one that is no ElasticEnergy ("scene:
   // energies[1] = 9 is invalid: must be an ElasticEnergy, 0 (linear) to 4
-  // (pd-volume)"), Dirichlet DoF out of range or not increasing, a size mismatch, or a non-finite gravity/Dirichlet
+  // (pd-volume)"), a mass_lumping that is no MassLumping ("scene: mass_lumping = 7 is
+  // invalid: must be 0 (lumped) or 1 (equal-nodes)") or kEqualNodes with material regions
+  // ("scene: mass_lumping = equal-nodes needs a single material (2 material regions declared)"),
+  // Dirichlet DoF out of range or not increasing, a size mismatch, or a non-finite gravity/Dirichlet
   // value; then the optional terms (messages listed in muscle.h, contact.h and state_forces.h).
   void Validate() const;
 };

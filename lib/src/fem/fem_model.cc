@@ -14,7 +14,7 @@ Vec3 HexCorner(int a) { return Vec3(2 * ((a >> 2) & 1) - 1, 2 * ((a >> 1) & 1) -
 
 }  // namespace
 
-FemModel::FemModel(const Mesh& mesh) : mesh_(mesh) {
+FemModel::FemModel(const Mesh& mesh, MassLumping lumping) : mesh_(mesh) {
   ValidateMesh(mesh_);
   k_ = NodesPerElement(mesh_.type);
   q_ = mesh_.type == ElementType::kTet4 ? 1 : 8;
@@ -73,6 +73,12 @@ FemModel::FemModel(const Mesh& mesh) : mesh_(mesh) {
         }
       }
     }
+  }
+
+  if (lumping == MassLumping::kEqualNodes) {
+    double total = 0;
+    for (int e = 0; e < m; ++e) total += element_volume(e);
+    unit_mass_.setConstant(total / m);
   }
 
   node_offsets_.assign(n + 1, 0);

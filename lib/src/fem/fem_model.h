@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "diffpd/mesh.h"
+#include "diffpd/scene.h"
 #include "diffpd/types.h"
 
 namespace diffpd::internal {
@@ -18,7 +19,9 @@ namespace diffpd::internal {
 class FemModel {
  public:
   // Validates the mesh (throws InvalidInputError) and precomputes everything.
-  explicit FemModel(const Mesh& mesh);
+  // `lumping` sets unit_lumped_mass() (Scene::mass_lumping); UnitLumpedMass
+  // of parts is the integral of N_a either way (kEqualNodes has one part).
+  explicit FemModel(const Mesh& mesh, MassLumping lumping = MassLumping::kLumped);
 
   const Mesh& mesh() const { return mesh_; }
   int num_nodes() const { return mesh_.num_vertices(); }
@@ -35,7 +38,8 @@ class FemModel {
   const double* sample_volumes(int s) const { return volume_.data() + s; }
   // Rest volume of element e, m^3.
   double element_volume(int e) const;
-  // Lumped mass per node for unit density: integral of N_a over the mesh (m^3).
+  // Mass per node for unit density (m^3): the integral of N_a over the mesh,
+  // or the mean element volume at every node (MassLumping::kEqualNodes).
   const VectorXd& unit_lumped_mass() const { return unit_mass_; }
   // The same restricted to the elements e with part_of_element[e] == part
   // (num_elements entries; see scene/material_regions.h), summed in element

@@ -10,6 +10,8 @@
 
 namespace diffpd {
 
+const char* ToString(MassLumping lumping) { return lumping == MassLumping::kEqualNodes ? "equal-nodes" : "lumped"; }
+
 void Scene::Validate() const {
   ValidateMesh(mesh);
   material.Validate();
@@ -22,6 +24,15 @@ void Scene::Validate() const {
           << " is invalid: must be an ElasticEnergy, 0 (linear) to 4 (pd-volume)";
       throw InvalidInputError(msg.str());
     }
+  if (mass_lumping != MassLumping::kLumped && mass_lumping != MassLumping::kEqualNodes) {
+    std::ostringstream msg;
+    msg << "scene: mass_lumping = " << static_cast<int>(mass_lumping)
+        << " is invalid: must be 0 (lumped) or 1 (equal-nodes)";
+    throw InvalidInputError(msg.str());
+  }
+  if (mass_lumping == MassLumping::kEqualNodes && !material_regions.empty())
+    throw InvalidInputError("scene: mass_lumping = equal-nodes needs a single material (" +
+                            std::to_string(material_regions.size()) + " material regions declared)");
   if (gravity && !gravity->allFinite()) throw InvalidInputError("scene: gravity has a non-finite component");
   const int n = mesh.num_dofs();
   if (static_cast<Eigen::Index>(dirichlet.dofs.size()) != dirichlet.values.size()) {

@@ -15,7 +15,7 @@ namespace diffpd::internal {
 SimulatorImpl::SimulatorImpl(const Scene& scene_in, const SolverOptions& options_in)
     : scene((scene_in.Validate(), scene_in)),
       options((options_in.Validate(), options_in)),
-      fem(scene.mesh),
+      fem(scene.mesh, scene.mass_lumping),
       part_of_element(PartOfElement(scene)),
       mass_model(fem, part_of_element, num_parts()),
       elastic(fem, scene.energies),
