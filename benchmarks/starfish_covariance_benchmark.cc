@@ -45,14 +45,22 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "--refits") check.refits = std::atoi(next());
-    else if (a == "--noise-mm") noise_mm = std::atof(next());
-    else if (a == "--start") start = std::atof(next());
-    else if (a == "--seconds") seconds = std::atof(next());
-    else if (a == "--substeps") substeps = std::atoi(next());
-    else if (a == "--seed") check.seed = std::strtoull(next(), nullptr, 10);
-    else if (a == "--no-water") water = false;
-    else if (a == "--json") json = true;
+    if (a == "--refits")
+      check.refits = std::atoi(next());
+    else if (a == "--noise-mm")
+      noise_mm = std::atof(next());
+    else if (a == "--start")
+      start = std::atof(next());
+    else if (a == "--seconds")
+      seconds = std::atof(next());
+    else if (a == "--substeps")
+      substeps = std::atoi(next());
+    else if (a == "--seed")
+      check.seed = std::strtoull(next(), nullptr, 10);
+    else if (a == "--no-water")
+      water = false;
+    else if (a == "--json")
+      json = true;
     else {
       std::fprintf(stderr, "unknown option %s\n", a.c_str());
       return 2;
@@ -95,15 +103,16 @@ int main(int argc, char** argv) {
                         {"empirical_sd", c.empirical_sd[i]},
                         {"reported_sd", c.reported_sd[i]},
                         {"ratio", c.empirical_sd[i] / c.reported_sd[i]}});
-      const nlohmann::json out = {{"refits", c.refits},   {"usable", c.usable},     {"noise_mm", noise_mm},
-                                  {"start_s", start},     {"seconds", seconds},     {"substeps", substeps},
-                                  {"frames", frames + 1}, {"wall_s", c.seconds},    {"parameters", rows}};
+      const nlohmann::json out = {{"refits", c.refits},   {"usable", c.usable},  {"noise_mm", noise_mm},
+                                  {"start_s", start},     {"seconds", seconds},  {"substeps", substeps},
+                                  {"frames", frames + 1}, {"wall_s", c.seconds}, {"parameters", rows}};
       std::printf("%s\n", out.dump(2).c_str());
       return 0;
     }
-    std::printf("# starfish covariance check: %d refits (%d usable), %g s of cyclic1 from %g s, %d steps per frame, "
-                "noise %g mm (weight-1 markers), %.1f s\n",
-                c.refits, c.usable, seconds, start, substeps, noise_mm, c.seconds);
+    std::printf(
+        "# starfish covariance check: %d refits (%d usable), %g s of cyclic1 from %g s, %d steps per frame, "
+        "noise %g mm (weight-1 markers), %.1f s\n",
+        c.refits, c.usable, seconds, start, substeps, noise_mm, c.seconds);
     std::printf("%-20s %12s %12s %14s %14s %8s\n", "parameter", "truth", "mean", "refit_spread", "reported_sd",
                 "ratio");
     for (size_t i = 0; i < c.names.size(); ++i)

@@ -24,7 +24,7 @@ namespace {
 constexpr double kMm = 1e-3;
 constexpr double kLossScale = 0.002;  // m: residuals in units of 2 mm
 constexpr double kFitStart = 1.0;     // s: the tendon first moves at 1.18 s in cyclic1
-constexpr double kFitSeconds = 2.0;   // s
+constexpr double kFitSeconds = 5.0;   // s
 constexpr double kDefaultSeconds = 10;
 constexpr int kDefaultIterations = 10;
 constexpr int kVtkStride = 6;  // camera frames per VTK frame: 10 per second
@@ -38,8 +38,8 @@ std::string Num(double v) {
 }  // namespace
 
 std::string StarfishCalibration::description() const {
-  return "fit E, nu, tendon slack, servo lag and tendon length of a soft starfish swimming underwater to real captured "
-         "motion, predict other recordings";
+  return "fit E, nu, tendon slack, servo lags and tendon length and the water's drag and thrust of a soft starfish "
+         "swimming underwater to real captured motion, predict other recordings";
 }
 
 void StarfishCalibration::set_substeps(int substeps) {
@@ -188,10 +188,8 @@ StarfishFit StarfishCalibration::Fit(const StarfishRecording& rec, const Starfis
   const bool arms = regions_ == StarfishRegions::kBodyArms;
   if (arms && fit_method_ == StarfishFitMethod::kLevenbergMarquardt)
     throw InvalidInputError("the lm fit has no tied arms' nu: fit body-arms regions with --fit lbfgs");
-  if (fit_release_lag_ && fit_method_ != StarfishFitMethod::kLevenbergMarquardt)
-    throw InvalidInputError("the release lag is fitted by the lm fit only: use --fit lm with --servo asymmetric");
   StarfishActuation start = actuation_guess;
-  if (fit_release_lag_ && !start.release_lag) start.release_lag = start.lag;
+  if (release_in_model() && !start.release_lag) start.release_lag = start.lag;
   const StarfishWater water = water_in_model() ? WaterGuess() : StarfishWater();
   std::unique_ptr<solvers::RolloutFunction> model = MakeModel(rec, w, options, guess, start, water);
   if (fit_method_ == StarfishFitMethod::kLevenbergMarquardt)
@@ -307,14 +305,17 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
   // The fit.
   const MaterialParameters guess = scene.material;
   const StarfishActuation actuation_guess = ActuationGuess();
-  std::fprintf(log,
-               "# fit: %s on E in (1e4, 5e6) Pa, nu in (0.2, 0.45), tendon slack in (0, 15) mm, servo lag in (1, 500) "
-               "ms, tendon length in (30, 130) mm%s (CoordinateManifold, log-logit but slack logit); "
-               "cost = 1/2 weighted mean squared marker error / (2 mm)^2\n",
-               fit_method_ == StarfishFitMethod::kLbfgs
-                   ? "Ceres L-BFGS on the scalar loss"
-                   : "Ceres Levenberg-Marquardt on per-frame marker residuals with forward-mode Jacobians",
-               regions_ == StarfishRegions::kBodyArms ? ", E_arms like E" : "");
+  std::fprintf(
+      log,
+      "# fit: %s on E in (1e4, 5e6) Pa, nu in (0.2, 0.45), tendon slack in (0, 15) mm, servo lag in (1, 500) "
+      "ms, tendon length in (30, 130) mm%s%s%s (CoordinateManifold, log-logit but slack logit); "
+      "cost = 1/2 weighted mean squared marker error / (2 mm)^2\n",
+      fit_method_ == StarfishFitMethod::kLbfgs
+          ? "Ceres L-BFGS on the scalar loss"
+          : "Ceres Levenberg-Marquardt on per-frame marker residuals with forward-mode Jacobians",
+      regions_ == StarfishRegions::kBodyArms ? ", E_arms like E" : "",
+      release_in_model() ? ", servo release lag in (1, 500) ms" : "",
+      water_in_model() ? ", water drag_tangential in (0.005, 5), drag_normal in (0.2, 20), thrust in (0.001, 10)" : "");
   if (regions_ == StarfishRegions::kBodyArms)
     std::fprintf(log,
                  "# regions: body-arms: E of the %zu arm elements (centroid beyond |y|, |z| < 18 mm) fitted apart "

@@ -60,9 +60,12 @@ class StarfishCalibration : public Problem {
   bool fit_water() const { return fit_water_; }
   void set_fit_water(bool fit) { fit_water_ = fit; }
   // Whether the lm fit models an asymmetric servo and fits its release lag
-  // (StarfishActuation::release_lag; default false).
+  // (StarfishActuation::release_lag; default true; the lbfgs fit keeps a
+  // symmetric servo).
   bool fit_release_lag() const { return fit_release_lag_; }
   void set_fit_release_lag(bool fit) { fit_release_lag_ = fit; }
+  // Whether Fit fits the release lag (fit_release_lag() and the lm fit).
+  bool release_in_model() const { return fit_release_lag_ && fit_method_ == StarfishFitMethod::kLevenbergMarquardt; }
   // Whether the water joins a model (fit_water() and the lm fit).
   bool water_in_model() const { return fit_water_ && fit_method_ == StarfishFitMethod::kLevenbergMarquardt; }
 
@@ -130,17 +133,15 @@ class StarfishCalibration : public Problem {
                                                       const CapturedMotion* motion = nullptr) const;
 
   // Fits E, nu, slack, lag and length (with kBodyArms also the arms' E;
-  // when water_in_model() also the water's coefficients from the scene's) on
-  // a window (with fit_release_lag() also the release lag, starting at the
+  // when water_in_model() also the water's coefficients from WaterGuess()) on
+  // a window (when release_in_model() also the release lag, starting at the
   // guess's lag): FitStarfishLeastSquares or FitStarfishLoss (fit_method()) on
   // MakeModel's functional, starting from `guess` (both regions) and
   // `actuation_guess`, at most `max_iterations` iterations; the iteration
   // table goes to `log` (nullptr: silent). Throws what MakeModel and
   // StarfishFitStart throw, and InvalidInputError for kBodyArms with
   // kLevenbergMarquardt ("the lm fit has no tied arms' nu: fit body-arms
-  // regions with --fit lbfgs") and for fit_release_lag() with kLbfgs ("the
-  // release lag is fitted by the lm fit only: use --fit lm with --servo
-  // asymmetric").
+  // regions with --fit lbfgs").
   StarfishFit Fit(const StarfishRecording& recording, const StarfishWindow& window, const SolverOptions& options,
                   const MaterialParameters& guess, const StarfishActuation& actuation_guess, int max_iterations,
                   FILE* log) const;
@@ -167,11 +168,13 @@ class StarfishCalibration : public Problem {
 
   // `diffpd run calibrate-starfish [--calibrate FILE] [--predict FILE ...]
   // [--seconds S] [--json] [--threads T] [--max-iterations N] [--out DIR]
-  // [--regions body-arms] [--fit lm|lbfgs] [--fit-start S] [--fit-seconds S]`:
-  // [--water fitted|fixed] [--servo symmetric|asymmetric]
-  // fits E, nu, tendon slack, lag and length (and, unless --water fixed or
-  // --fit lbfgs, the water's drag and thrust coefficients) on the calibration file's window
-  // (default [1 s, 3 s]: the tendon first moves at 1.18 s in cyclic1) by
+  // [--regions body-arms] [--fit lm|lbfgs] [--fit-start S] [--fit-seconds S]
+  // [--water fitted|fixed] [--servo symmetric|asymmetric]`:
+  // fits E, nu, tendon slack, lag and length (and with the lm fit, unless
+  // --servo symmetric, the servo's release lag, and unless --water fixed,
+  // the water's drag and thrust coefficients) on the calibration file's
+  // window (default [1 s, 6 s]: the tendon first moves at 1.18 s in cyclic1;
+  // 5 s take in the swimming, which a 2 s window does not pin down) by
   // Levenberg-Marquardt on the marker residuals (--fit lbfgs: L-BFGS on the
   // scalar loss; at most 10 iterations unless --max-iterations; 0: no fit,
   // predict at the starting values), prints the parameters' standard
@@ -196,7 +199,7 @@ class StarfishCalibration : public Problem {
   StarfishRegions regions_ = StarfishRegions::kNone;
   StarfishFitMethod fit_method_ = StarfishFitMethod::kLevenbergMarquardt;
   bool fit_water_ = true;
-  bool fit_release_lag_ = false;
+  bool fit_release_lag_ = true;
 };
 
 }  // namespace diffpd::problems

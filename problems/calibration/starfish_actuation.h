@@ -28,6 +28,9 @@ namespace diffpd::problems {
 // slack = 0, lag = 0, length = 65 mm is the fact sheet's a = 1 - c / 65 mm
 // except below 1 mm.
 struct StarfishActuation {
+  StarfishActuation() = default;
+  StarfishActuation(double slack, double lag, double length, std::optional<double> release_lag = std::nullopt)
+      : slack(slack), lag(lag), length(length), release_lag(release_lag) {}
   double slack = 0;                   // m, >= 0
   double lag = 0;                     // s, >= 0
   double length = 0.065;              // m, > 0

@@ -89,9 +89,10 @@ int RunCommandLine(const std::vector<std::string>& argv) {
       ->check(NonNegative("--fit-start"));
   run->add_option("--water", run_args.water,
                   "calibrate-starfish: 'fitted' (the lm fit fits drag and thrust, default) or 'fixed'");
-  run->add_option("--servo", run_args.servo,
-                  "calibrate-starfish: 'asymmetric' fits a release lag apart from the pull's (lm fit), or 'symmetric'");
-  run->add_option("--fit-seconds", run_args.fit_seconds, "calibrate-starfish: length of the fit window (s, default 2)")
+  run->add_option(
+      "--servo", run_args.servo,
+      "calibrate-starfish: 'asymmetric' fits a release lag apart from the pull's (lm fit, default), or 'symmetric'");
+  run->add_option("--fit-seconds", run_args.fit_seconds, "calibrate-starfish: length of the fit window (s, default 5)")
       ->check(Positive("--fit-seconds", "s"));
 
   CLI::App* grad = app.add_subcommand("gradcheck", "compare rollout gradients with central finite differences");
