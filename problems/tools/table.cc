@@ -18,6 +18,7 @@
 #if DIFFPD_WITH_IPOPT
 #include "paper/row_optimisation.h"
 #endif
+#include "tools/openmp_waits.h"
 
 #ifndef DIFFPD_SOURCE_DIR
 #define DIFFPD_SOURCE_DIR "."
@@ -77,6 +78,7 @@ std::string MachineLabel() {
   std::ostringstream s;
   s << std::thread::hardware_concurrency() << "-core " << arch;
   if (!model.empty()) s << ", " << model;
+  s << ", " << OpenMpWaitsLabel();
   return s.str();
 }
 
