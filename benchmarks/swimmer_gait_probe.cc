@@ -18,10 +18,14 @@
 // per channel (a stroke cycle changes sign twice) and the range of each
 // channel after the first 20 steps. The open loop tells how much reward the
 // simulated physics gives a cyclic gait at all; the closed loop's numbers
-// show whether its network still moves its outputs.
+// show whether its network still moves its outputs. A third row is one
+// rollout of the constant gait w = -1 on every channel (the bottom strips
+// contract fully once and hold: one stroke, then coasting).
+// --mass equal-nodes puts the original code's rho dx^3 on every node
+// (Scene::mass_lumping) instead of the problem's lumped masses.
 //
 // Usage: swimmer_gait_probe [--evaluations 100] [--seed 42] [--open-lr 0.05]
-//   [--threads 1] [--json]
+//   [--mass lumped|equal-nodes] [--threads 1] [--json]
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -34,6 +38,7 @@
 
 #include "control/starfish_control.h"
 #include "control/swimmer_optimizers.h"
+#include "diffpd/simulator.h"
 #include "diffpd/solvers/core/controller_block.h"
 #include "diffpd/strip_open_loop_controller.h"
 
@@ -47,6 +52,7 @@ struct Settings {
   int seed = 42;
   double open_learning_rate = 0.05;
   int threads = 1;
+  MassLumping mass = MassLumping::kLumped;
   bool json = false;
 };
 
@@ -87,7 +93,7 @@ struct Run {
 struct Probe {
   Settings settings;
   int dofs = 0, steps = 0;
-  Run closed, open;
+  Run closed, open, constant;
 };
 
 SolverOptions Options(const StarfishControl& problem, const Swimmer& swimmer, int threads) {
@@ -135,15 +141,32 @@ Run TrainOpenLoop(const StarfishControl& problem, const Swimmer& swimmer, const 
   return Run{name, budget.history(), Motion(w)};
 }
 
+// One rollout of w = -1 on every channel at every step.
+Run ConstantCurl(const StarfishControl& problem, const Swimmer& swimmer, const Settings& s) {
+  StripOpenLoopController controller(swimmer.steps, swimmer.channels,
+                                     MuscleDelayLine(swimmer.strips, static_cast<int>(swimmer.scene.muscles.size())),
+                                     swimmer.drives);
+  controller.SetParameters(VectorXd::Constant(controller.num_parameters(), -20.0));  // tanh(-20) = -1 in doubles
+  Simulator sim(swimmer.scene, Options(problem, swimmer, s.threads));
+  const Rollout rollout = sim.Simulate(sim.RestState(), controller, swimmer.steps);
+  TrainingEvaluation e;
+  e.reward = -swimmer.loss.Evaluate(rollout, nullptr);
+  std::vector<VectorXd> w;
+  for (int k = 0; k < swimmer.steps; ++k) w.push_back(controller.ChannelValues(k));
+  return Run{"constant w = -1 (no training)", {e}, Motion(w)};
+}
+
 Probe RunProbe(const Settings& settings) {
   const StarfishControl problem;
-  const Swimmer swimmer = problem.MakeSwimmer(false);
+  Swimmer swimmer = problem.MakeSwimmer(false);
+  swimmer.scene.mass_lumping = settings.mass;
   Probe p;
   p.settings = settings;
   p.dofs = swimmer.scene.mesh.num_dofs();
   p.steps = swimmer.steps;
   p.closed = TrainClosedLoop(problem, swimmer, settings);
   p.open = TrainOpenLoop(problem, swimmer, settings);
+  p.constant = ConstantCurl(problem, swimmer, settings);
   return p;
 }
 
@@ -161,11 +184,13 @@ double Best(const std::vector<TrainingEvaluation>& h) {
 
 void PrintTable(const Probe& p) {
   const int e = p.settings.evaluations;
-  std::printf("starfish-control, %d DoFs, %d steps, seed %d, %d evaluations each, %d thread(s)\n\n", p.dofs, p.steps,
-              p.settings.seed, e, p.settings.threads);
+  std::printf("starfish-control, %d DoFs, %d steps, %s masses, seed %d, %d evaluations each, %d thread(s)\n\n", p.dofs,
+              p.steps, ToString(p.settings.mass), p.settings.seed, e, p.settings.threads);
   std::printf("| controller | reward at 0 | %d | %d | %d | best | steps all saturated | sign changes per channel |\n",
               e / 4, e / 2, e - 1);
   std::printf("|---|---|---|---|---|---|---|---|\n");
+  std::printf("| %s | %.3f | | | | | %d of %d | |\n", p.constant.name.c_str(), p.constant.history[0].reward,
+              p.constant.motion.all_saturated_steps, p.constant.motion.steps);
   for (const Run* r : {&p.closed, &p.open}) {
     std::string changes;
     for (size_t c = 0; c < r->motion.sign_changes.size(); ++c)
@@ -205,6 +230,8 @@ json ProbeJson(const Probe& p) {
           {"evaluations", p.settings.evaluations},
           {"open_learning_rate", p.settings.open_learning_rate},
           {"threads", p.settings.threads},
+          {"mass", ToString(p.settings.mass)},
+          {"constant_curl_reward", p.constant.history[0].reward},
           {"closed_loop", RunJson(p.closed)},
           {"open_loop", RunJson(p.open)}};
 }
@@ -249,12 +276,19 @@ int main(int argc, char** argv) {
         return 2;
       }
       (a == "--evaluations" ? s.evaluations : s.threads) = static_cast<int>(v);
+    } else if (i + 1 < argc && a == "--mass") {
+      const std::string m = argv[++i];
+      if (m != "lumped" && m != "equal-nodes") {
+        std::fprintf(stderr, "swimmer_gait_probe: --mass = %s is invalid: must be lumped or equal-nodes\n", m.c_str());
+        return 2;
+      }
+      s.mass = m == "lumped" ? diffpd::MassLumping::kLumped : diffpd::MassLumping::kEqualNodes;
     } else if (i + 1 < argc && a == "--open-lr") {
       if (!ParsePositive("--open-lr", argv[++i], &s.open_learning_rate)) return 2;
     } else {
       std::fprintf(stderr,
-                   "usage: swimmer_gait_probe [--evaluations 100] [--seed 42] [--open-lr 0.05] [--threads 1] "
-                   "[--json]\n");
+                   "usage: swimmer_gait_probe [--evaluations 100] [--seed 42] [--open-lr 0.05] "
+                   "[--mass lumped|equal-nodes] [--threads 1] [--json]\n");
       return 2;
     }
   }
