@@ -7,7 +7,8 @@
 //                starfish-control` does), and
 //   open loop:   a free value per step and channel through the same drive
 //                and delay line (StripOpenLoopController, the original's
-//                open-loop form), from w = 0, with Adam at a probe setting
+//                open-loop form), from N(0, 1) draws of the seed (std::
+//                normal_distribution), with Adam at a probe setting
 //                (--open-lr, default 0.05; no clip, no decay, no schedule:
 //                the values need steps of order 1, which the original's
 //                1e-3 would take a thousand evaluations to make),
@@ -31,6 +32,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -121,8 +123,16 @@ Run TrainOpenLoop(const StarfishControl& problem, const Swimmer& swimmer, const 
   const StripOpenLoopController prototype(
       swimmer.steps, swimmer.channels, MuscleDelayLine(swimmer.strips, static_cast<int>(swimmer.scene.muscles.size())),
       swimmer.drives);
+  // Start from N(0, 1) draws (as the original's open-loop controller): at
+  // w = 0 exactly no strip contracts and the gradient is 0 (the kink of max).
+  std::mt19937_64 rng(static_cast<std::uint64_t>(s.seed));
+  std::normal_distribution<double> normal;
+  VectorXd start(prototype.num_parameters());
+  for (Eigen::Index i = 0; i < start.size(); ++i) start(i) = normal(rng);
+  StripOpenLoopController initial = prototype;
+  initial.SetParameters(start);
   solvers::RolloutFunction function(swimmer.scene, Options(problem, swimmer, s.threads), swimmer.steps);
-  function.AddBlock(std::make_unique<solvers::ControllerBlock>(prototype));
+  function.AddBlock(std::make_unique<solvers::ControllerBlock>(initial));
   function.AddFunctional(std::make_unique<SwimLossFunction>(swimmer.loss));
   EvaluationBudget budget(&function, s.evaluations, swimmer.steps, stderr);
   AdamOptions adam;
