@@ -43,6 +43,7 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/paper/row_evaluation.cc
   ${CMAKE_CURRENT_LIST_DIR}/paper/row_rollout_function.cc
   # tools
+  ${CMAKE_CURRENT_LIST_DIR}/tools/openmp_waits.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/derivative_verdict.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/gradcheck.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/bench.cc

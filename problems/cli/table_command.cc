@@ -36,6 +36,7 @@ A progress line per evaluation goes to stderr.)";
 struct TableArgs {
   std::vector<std::string> rows = PaperRowNames();
   std::vector<std::string> methods = {"pd-lbfgs", "newton-pcg", "newton-cholesky"};
+  std::string masses = "equal-nodes";
   TableOptions options;
   std::string json_file;
   bool resume = false;
@@ -66,7 +67,7 @@ std::string CommandLine(const TableArgs& a) {
   std::ostringstream s;
   s << "diffpd table --rows " << Joined(a.rows) << " --methods " << Joined(a.methods) << " --threads "
     << a.options.threads << " --evaluations " << a.options.evaluations << " --newton-evaluations "
-    << a.options.newton_evaluations << " --draws " << a.options.random_draws;
+    << a.options.newton_evaluations << " --draws " << a.options.random_draws << " --masses " << a.masses;
   if (a.small) s << " --small";
   if (a.options.optimise) s << " --optimise";
   if (a.options.optimiser_evaluations > 0) s << " --optimiser-evaluations " << a.options.optimiser_evaluations;
@@ -81,6 +82,7 @@ int RunTableArgs(const TableArgs& args) {
   TableOptions options = args.options;
   options.rows = args.rows;
   options.methods = ParseMethods(args.methods);
+  options.masses = ParseMassLumping(args.masses);
   options.size = args.small ? RowSize::kSmall : RowSize::kPaper;
   std::unique_ptr<TableResult> previous;
   if (args.report) {
@@ -122,8 +124,14 @@ Subcommand AddTableCommand(CLI::App* parent) {
   cmd->add_option("--rows", args->rows, "comma-separated rows, in the order to run them")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--methods", args->methods, "comma-separated methods: pd-lbfgs, pd, newton-cholesky, newton-pcg")
+  cmd->add_option("--methods", args->methods,
+                  "comma-separated methods: pd-lbfgs, pd, newton-cholesky, newton-pcg, newton-ldlt (the paper's "
+                  "Newton: simplicial LDL^T under AMD)")
       ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--masses", args->masses,
+                  "equal-nodes (the original code's rho dx^3 on every node: the paper's problems) or lumped (this "
+                  "library's masses)")
       ->capture_default_str();
   cmd->add_option("--threads", args->options.threads, "threads of every solve (0: OpenMP default)")
       ->check(CLI::NonNegativeNumber)

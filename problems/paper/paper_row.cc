@@ -1,5 +1,6 @@
 #include "paper/paper_row.h"
 
+#include <algorithm>
 #include <sstream>
 
 #include "diffpd/error.h"
@@ -118,10 +119,22 @@ void PaperRow::Prepare(const SolverOptions& options) {
   run(this, options);
 }
 
+namespace {
+constexpr const char* kLumpedMassNote =
+    "masses: lumped (each element's rho V shared by its 8 corners), where the original gives every node rho dx^3 "
+    "(heavier surface nodes there, and more total mass)";
+}  // namespace
+
+void SetRowMasses(PaperRow* row, MassLumping masses) {
+  row->scene.mass_lumping = masses;
+  auto& notes = row->notes;
+  notes.erase(std::remove(notes.begin(), notes.end(), std::string(kLumpedMassNote)), notes.end());
+  if (masses == MassLumping::kLumped) notes.insert(notes.begin(), kLumpedMassNote);
+}
+
 std::vector<std::string> CommonRowNotes() {
   return {
-      "masses: lumped (each element's rho V shared by its 8 corners), where the original gives every node rho dx^3 "
-      "(heavier surface nodes there, and more total mass)",
+      kLumpedMassNote,
       "step tolerance: the original's test, |grad g| <= abs_tol + rel_tol |(M / h^2)(x_i + h v_i) + f| on the free "
       "DoFs (relative to the inertial term; this library's default is relative to the step's first residual, a far "
       "tighter test), with this library's masses M",

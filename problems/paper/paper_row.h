@@ -143,6 +143,10 @@ struct PaperRow {
 // preconditioner, Newton-PCG's inner tolerance), and those of rows with
 // frictional contact.
 std::vector<std::string> CommonRowNotes();
+// Gives the row's body `masses`: kEqualNodes (the original code's rho dx^3 on
+// every node) or kLumped (this library's default; then a note says how it
+// differs from the original).
+void SetRowMasses(PaperRow* row, MassLumping masses);
 std::string FrictionalContactNote();
 
 }  // namespace diffpd::problems

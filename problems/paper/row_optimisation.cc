@@ -1,5 +1,6 @@
 #include "paper/row_optimisation.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -14,13 +15,15 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// The row's NLP, stopped by the evaluation and time budgets (Ipopt's
-// intermediate_callback returning false), reporting every new rollout.
+// The row's NLP, stopped by L-BFGS-B's relative-decrease test, the
+// evaluation budget and the time budget (Ipopt's intermediate_callback
+// returning false), reporting every new rollout.
 class BudgetedRowNlp : public solvers::RolloutNlp {
  public:
-  BudgetedRowNlp(std::unique_ptr<solvers::RolloutFunction> function, long max_evaluations, double budget_seconds,
-                 std::function<void(long, double, double)> on_evaluation)
+  BudgetedRowNlp(std::unique_ptr<solvers::RolloutFunction> function, double ftol, long max_evaluations,
+                 double budget_seconds, std::function<void(long, double, double)> on_evaluation)
       : RolloutNlp(std::move(function)),
+        ftol_(ftol),
         max_evaluations_(max_evaluations),
         budget_seconds_(budget_seconds),
         on_evaluation_(std::move(on_evaluation)),
@@ -55,6 +58,17 @@ class BudgetedRowNlp : public solvers::RolloutNlp {
                              Ipopt::IpoptCalculatedQuantities* ip_cq) override {
     RolloutNlp::intermediate_callback(mode, iter, obj_value, inf_pr, inf_du, mu, d_norm, regularization_size, alpha_du,
                                       alpha_pr, ls_trials, ip_data, ip_cq);
+    // L-BFGS-B's test, (f_k - f_k+1) / max(|f_k|, |f_k+1|, 1) <= ftol, on
+    // the change of f between Ipopt iterations (an increase, which an
+    // interior-point iteration may make, does not stop it).
+    const double decrease = previous_objective_ - obj_value;
+    const bool stalled = iter > 0 && decrease >= 0 &&
+                         decrease <= ftol_ * std::max({std::abs(previous_objective_), std::abs(obj_value), 1.0});
+    previous_objective_ = obj_value;
+    if (stalled) {
+      stopped_by_ = "relative decrease";
+      return false;
+    }
     if (statistics().rollouts >= max_evaluations_) {
       stopped_by_ = "evaluation budget";
       return false;
@@ -69,8 +83,10 @@ class BudgetedRowNlp : public solvers::RolloutNlp {
   const std::string& stopped_by() const { return stopped_by_; }
 
  private:
+  double ftol_;
   long max_evaluations_;
   double budget_seconds_;
+  double previous_objective_ = 0;
   std::function<void(long, double, double)> on_evaluation_;
   Clock::time_point start_;
   std::string stopped_by_ = "optimiser";
@@ -85,7 +101,7 @@ RowOptimisationResult OptimiseRow(const PaperRow& row, const SolverOptions& opti
   RowRolloutFunction f = MakeRowRolloutFunction(row, options);
   const long max_evaluations =
       optimisation.max_evaluations > 0 ? optimisation.max_evaluations : row.budget.max_evaluations;
-  Ipopt::SmartPtr<BudgetedRowNlp> nlp = new BudgetedRowNlp(std::move(f.function), max_evaluations,
+  Ipopt::SmartPtr<BudgetedRowNlp> nlp = new BudgetedRowNlp(std::move(f.function), row.budget.ftol, max_evaluations,
                                                            optimisation.budget_seconds, optimisation.on_evaluation);
   // One objective term per loss term (each functional has one row).
   for (size_t t = 0; t < f.loss_rows.size(); ++t) nlp->AddObjectiveRows({f.loss_rows[t]}, f.loss_weights[t]);

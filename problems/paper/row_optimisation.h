@@ -1,8 +1,10 @@
 // A paper row optimised the way the paper's L-BFGS-B run is mapped here:
 // Ipopt with a limited-memory Hessian (the row's history, maxcor) and the
 // row's variable bounds, on the row's rollout function
-// (row_rollout_function.h), from x_init, stopped after the row's evaluation
-// budget (maxfun), its iteration limit (maxiter) or a wall-clock limit.
+// (row_rollout_function.h), from x_init, stopped as L-BFGS-B stops: when an
+// iteration decreases the loss by at most ftol relative to its size
+// ((f_k - f_k+1) / max(|f_k|, |f_k+1|, 1) <= ftol), after the row's evaluation
+// budget (maxfun) or its iteration limit (maxiter); or at a wall-clock limit.
 //
 //   RowOptimisationOptions o;
 //   o.budget_seconds = 600;
@@ -35,7 +37,7 @@ struct RowOptimisationOptions {
 
 struct RowOptimisationResult {
   std::string status;      // Ipopt's return status ("Solve_Succeeded", "User_Requested_Stop", ...)
-  std::string stopped_by;  // "optimiser", "evaluation budget" or "time budget"
+  std::string stopped_by;  // "optimiser", "relative decrease", "evaluation budget" or "time budget"
   int iterations = 0;      // Ipopt iterations
   long evaluations = 0;    // rollouts (loss evaluations)
   long gradients = 0;      // adjoint passes

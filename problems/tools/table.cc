@@ -18,6 +18,7 @@
 #if DIFFPD_WITH_IPOPT
 #include "paper/row_optimisation.h"
 #endif
+#include "tools/openmp_waits.h"
 
 #ifndef DIFFPD_SOURCE_DIR
 #define DIFFPD_SOURCE_DIR "."
@@ -77,6 +78,7 @@ std::string MachineLabel() {
   std::ostringstream s;
   s << std::thread::hardware_concurrency() << "-core " << arch;
   if (!model.empty()) s << ", " << model;
+  s << ", " << OpenMpWaitsLabel();
   return s.str();
 }
 
@@ -208,6 +210,9 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
     if (previous->size != SizeName(options.size))
       msg << "resume: the file holds the " << previous->size << " instances, this run asks for "
           << SizeName(options.size);
+    else if (options.measure && previous->masses != ToString(options.masses))
+      msg << "resume: the file was measured with " << previous->masses << " masses, this run asks for "
+          << ToString(options.masses);
     else if (previous->threads != options.threads)
       msg << "resume: the file was measured with " << previous->threads << " threads, this run asks for "
           << options.threads;
@@ -232,6 +237,7 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
   }
   result.threads = options.threads;
   result.size = SizeName(options.size);
+  result.masses = previous ? previous->masses : ToString(options.masses);
   result.evaluations = options.evaluations;
   result.newton_evaluations = options.newton_evaluations;
   // The rows to run, then those of the previous file that this run does not
@@ -249,6 +255,7 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
     const bool requested =
         options.measure && std::find(options.rows.begin(), options.rows.end(), name) != options.rows.end();
     PaperRow row = MakePaperRow(name, options.size);
+    SetRowMasses(&row, previous ? ParseMassLumping(previous->masses) : options.masses);
     result.rows.push_back(Describe(row));
     TableRowResult& out = result.rows.back();
     const TableRowResult* before = nullptr;
@@ -557,6 +564,7 @@ json TableToJson(const TableResult& result) {
           {"machine", result.machine},
           {"threads", result.threads},
           {"size", result.size},
+          {"masses", result.masses},
           {"evaluations", result.evaluations},
           {"newton_evaluations", result.newton_evaluations},
           {"budget_exhausted", result.budget_exhausted},
@@ -571,6 +579,8 @@ TableResult TableFromJson(const json& j) {
   result.machine = Field<std::string>(j, "machine", "the document");
   result.threads = Field<int>(j, "threads", "the document");
   result.size = Field<std::string>(j, "size", "the document");
+  // Files written before masses were an option hold lumped rows.
+  if (j.contains("masses")) result.masses = Field<std::string>(j, "masses", "the document");
   result.evaluations = Field<int>(j, "evaluations", "the document");
   result.newton_evaluations = Field<int>(j, "newton_evaluations", "the document");
   result.budget_exhausted = Field<bool>(j, "budget_exhausted", "the document");

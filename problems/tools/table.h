@@ -44,6 +44,9 @@ struct TableOptions {
   // Wall-clock budget of the run in minutes; <= 0: none.
   double budget_minutes = 0;
   RowSize size = RowSize::kPaper;
+  // The rows' masses: the original code's (rho dx^3 on every node, so the
+  // rows are the paper's problems) or this library's lumped masses.
+  MassLumping masses = MassLumping::kEqualNodes;
   // Random draws evaluated per row in this run, at most the row's 16 (the
   // normalisation; the torus's x_init is the best of all 16, the first draw
   // until all are done). Fewer leave the row incomplete for a later resume.
@@ -71,7 +74,7 @@ struct TableOptions {
 // One optimisation of a row with one method (row_optimisation.h).
 struct TableOptimisation {
   std::string status;      // Ipopt's return status
-  std::string stopped_by;  // "optimiser", "evaluation budget" or "time budget"
+  std::string stopped_by;  // "optimiser", "relative decrease", "evaluation budget" or "time budget"
   int iterations = 0;
   long evaluations = 0, gradients = 0, failed_evaluations = 0;
   double forward_s = 0, backward_s = 0;  // means per rollout and per adjoint pass
@@ -130,6 +133,7 @@ struct TableResult {
   std::string machine;  // "<cores>-core <arch>, <CPU model>"
   int threads = 0;
   std::string size;
+  std::string masses = "lumped";  // ToString(MassLumping) of the rows' masses
   int evaluations = 0, newton_evaluations = 0;
   bool budget_exhausted = false;
   // "<date>, commit <commit>" of each later run that resumed this result.
@@ -140,7 +144,7 @@ struct TableResult {
 // Runs the table. `previous` (may be nullptr) is a result to resume from: its
 // complete rows and methods and its random-draw losses are kept, and so are
 // its date, commit and machine, this run being added to resumed_runs (it must
-// have the same size, threads and evaluation counts; InvalidInputError
+// have the same size, masses, threads and evaluation counts; InvalidInputError
 // otherwise). `checkpoint` (may be empty) receives the whole result after
 // every draw and method; progress lines (one per evaluation) go to
 // `progress` (nullptr: silent). Throws InvalidInputError on bad options.

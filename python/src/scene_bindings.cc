@@ -127,6 +127,9 @@ void BindScene(py::module_& m) {
       .def_readwrite("penalty_friction", &StateForceGradient::penalty_friction)
       .def_readwrite("quad_hydrodynamics", &StateForceGradient::quad_hydrodynamics);
 
+  LibraryNames(py::enum_<MassLumping>(m, "MassLumping", "How a body's mass is spread over its nodes.")
+                   .value("LUMPED", MassLumping::kLumped)
+                   .value("EQUAL_NODES", MassLumping::kEqualNodes));
   py::class_<Scene>(m, "Scene", "What a simulation contains (diffpd/scene.h).")
       .def(py::init<>())
       .def(py::init([](Mesh mesh, MaterialParameters material) {
@@ -140,6 +143,7 @@ void BindScene(py::module_& m) {
       .def_readwrite("material", &Scene::material)
       .def_readwrite("material_regions", &Scene::material_regions)
       .def_readwrite("energies", &Scene::energies)
+      .def_readwrite("mass_lumping", &Scene::mass_lumping)
       .def_readwrite("gravity", &Scene::gravity, "m/s^2 (length 3) or None")
       .def_readwrite("dirichlet", &Scene::dirichlet)
       .def_readwrite("muscles", &Scene::muscles)

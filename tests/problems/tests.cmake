@@ -29,6 +29,9 @@ if(TARGET diffpd_ipopt)
   diffpd_add_test(optimiser_tradeoff_test ${_dir}/tools/optimiser_tradeoff_test.cc LIBS diffpd_problems)
 endif()
 diffpd_add_test(command_line_test ${_dir}/cli/command_line_test.cc LIBS diffpd_problems)
+# The program's OpenMP waits (tools/openmp_waits.h), through the program itself.
+add_test(NAME diffpd_sets_short_openmp_waits
+         COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:diffpd_cli> -DSPIN=1000 -P ${_dir}/cli/openmp_waits.cmake)
 # Closed-loop swimming (Adam needs neither adapter).
 diffpd_add_test(adam_test ${_dir}/control/adam_test.cc LIBS diffpd_problems)
 diffpd_add_test(swimmer_scenes_test ${_dir}/control/swimmer_scenes_test.cc LIBS diffpd_problems)

@@ -39,8 +39,10 @@ enum class MassLumping {
   kEqualNodes,  // every node carries rho times the mean element volume, as the original DiffPD code
                 // does (its total exceeds the body's mass; for reproducing its scenes)
 };
-// "lumped", "equal-nodes".
+// "lumped", "equal-nodes", and back; Parse throws InvalidInputError for any
+// other name ("masses 'x' is unknown: use lumped or equal-nodes").
 const char* ToString(MassLumping lumping);
+MassLumping ParseMassLumping(const std::string& name);
 
 struct Scene {
   Mesh mesh;

@@ -12,6 +12,12 @@ namespace diffpd {
 
 const char* ToString(MassLumping lumping) { return lumping == MassLumping::kEqualNodes ? "equal-nodes" : "lumped"; }
 
+MassLumping ParseMassLumping(const std::string& name) {
+  if (name == "lumped") return MassLumping::kLumped;
+  if (name == "equal-nodes") return MassLumping::kEqualNodes;
+  throw InvalidInputError("masses '" + name + "' is unknown: use lumped or equal-nodes");
+}
+
 void Scene::Validate() const {
   ValidateMesh(mesh);
   material.Validate();

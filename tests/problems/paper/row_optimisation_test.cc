@@ -4,7 +4,9 @@
 // reports the optimiser's evaluations and final normalised loss.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "paper/paper_rows.h"
 #include "paper/row_evaluation.h"
@@ -17,7 +19,10 @@ namespace {
 
 TEST(RowOptimisationTest, TheRowsRolloutFunctionGivesTheRowsLossAndGradient) {
   PaperRow row = MakeBunnyRow(RowSize::kSmall);
-  const SolverOptions options = row.Options(Method::kPdLbfgs, 1);
+  SolverOptions options = row.Options(Method::kPdLbfgs, 1);
+  // One adjoint solver for both paths: the automatic choice follows measured
+  // times, and two adjoint solvers agree only to their tolerance.
+  options.adjoint_solver = AdjointSolver::kDirect;
   row.Prepare(options);
   Simulator sim(row.scene, options);
   const VectorXd x = row.initial();
@@ -60,6 +65,27 @@ TEST(RowOptimisationTest, AnOptimisationLowersThePlantLossAndStopsAtItsEvaluatio
     EXPECT_GE(r.x(j), row.lower()(j));
     EXPECT_LE(r.x(j), row.upper()(j));
   }
+}
+
+// L-BFGS-B's stopping test, mapped onto Ipopt's iterations: the run stops at
+// the first iteration whose relative decrease of the loss is at most ftol.
+TEST(RowOptimisationTest, ItStopsAtTheFirstIterationThatDecreasesTheLossByAtMostFtol) {
+  PaperRow row = MakePlantRow(RowSize::kSmall);
+  row.budget.ftol = 0.05;
+  const SolverOptions options = row.Options(Method::kPdLbfgs, 1);
+  row.Prepare(options);
+  RowOptimisationOptions o;
+  o.max_evaluations = 40;
+  const RowOptimisationResult r = OptimiseRow(row, options, o);
+  ASSERT_EQ(r.stopped_by, "relative decrease") << r.status;
+  const std::vector<double>& f = r.loss_history;
+  ASSERT_GE(f.size(), 2u);
+  const auto small_decrease = [&](size_t k) {
+    const double d = f[k - 1] - f[k];
+    return d >= 0 && d <= row.budget.ftol * std::max({std::abs(f[k - 1]), std::abs(f[k]), 1.0});
+  };
+  EXPECT_TRUE(small_decrease(f.size() - 1));
+  for (size_t k = 1; k + 1 < f.size(); ++k) EXPECT_FALSE(small_decrease(k)) << "iteration " << k;
 }
 
 TEST(RowOptimisationTest, TheTableReportsTheOptimisersEvaluationsAndFinalNormalisedLoss) {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -187,11 +188,43 @@ TEST(TableTest, BadOptionsAndAMismatchedResumeAreRefused) {
   }
 }
 
+TEST(TableTest, RowsHaveTheOriginalsMassesUnlessLumpedOnesAreAskedForAndThenSaySo) {
+  const TableResult& equal = SmallRun();
+  EXPECT_EQ(equal.masses, "equal-nodes");
+  TableOptions o = SmallOptions();
+  o.rows = {"plant"};
+  o.methods = {Method::kPdLbfgs};
+  o.evaluations = 1;
+  o.masses = MassLumping::kLumped;
+  const TableResult lumped = RunTable(o, nullptr, {}, nullptr);
+  EXPECT_EQ(lumped.masses, "lumped");
+  EXPECT_EQ(TableFromJson(TableToJson(lumped)).masses, "lumped");
+  const TableRowResult& plant = lumped.rows[0];
+  const auto noted = [](const TableRowResult& row) {
+    for (const std::string& note : row.notes)
+      if (note.rfind("masses: lumped", 0) == 0) return true;
+    return false;
+  };
+  EXPECT_TRUE(noted(plant));
+  EXPECT_FALSE(noted(equal.rows[1]));
+  // The masses change the plant's motion, so its loss at x_init.
+  const double l_equal = equal.rows[1].method("pd-lbfgs")->loss;
+  const double l_lumped = plant.method("pd-lbfgs")->loss;
+  EXPECT_GT(std::abs(l_equal - l_lumped), 1e-3 * std::abs(l_equal)) << l_equal << " " << l_lumped;
+  o.masses = MassLumping::kEqualNodes;
+  try {
+    RunTable(o, &lumped, {}, nullptr);
+    FAIL() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_STREQ(e.what(), "resume: the file was measured with lumped masses, this run asks for equal-nodes");
+  }
+}
+
 TEST(TableTest, ReportsCarryThePapersNumbersAndTheNotes) {
   const std::string md = TableMarkdown(SmallRun(), "diffpd table --small");
   EXPECT_NE(md.find("| 3 plant |"), std::string::npos) << md;
-  EXPECT_NE(md.find("929.6"), std::string::npos);  // the paper's Newton-Cholesky forward seconds for the plant
-  EXPECT_NE(md.find("masses: lumped"), std::string::npos);
+  EXPECT_NE(md.find("929.6"), std::string::npos);           // the paper's Newton-Cholesky forward seconds for the plant
+  EXPECT_EQ(md.find("masses: lumped"), std::string::npos);  // the rows have the original's masses
   EXPECT_NE(md.find("diffpd table --small"), std::string::npos);
   if (GnuplotAvailable()) {
     const std::string png = (std::filesystem::temp_directory_path() / "diffpd_table_test.png").string();
