@@ -21,6 +21,10 @@
 // 3.33e-2 s: sum_k -v_z + v_x^2 + v_y^2 of the centre node; reward = -loss.
 // The original's gradient treated the centre node's position in the
 // observation as a constant; here the gradient is exact.
+// Masses: lumped (the body's 168 kg). The original code put rho dx^3 on every
+// node (387 kg; Scene::mass_lumping = kEqualNodes reproduces it): with it the
+// constant full curl of the arms swims about half as far and Adam reaches a
+// lower reward on the same budget (docs/benchmarks.md, "Closed-loop control").
 //
 // Small instance: the same body and controller, 40 steps.
 #pragma once
