@@ -433,7 +433,8 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
     all_done = static_cast<int>(out.random_losses.size()) == out.random_draws;
     for (Method m : options.methods) all_done = all_done && method_done(m);
     out.complete = all_done;
-    if (!all_done) result.budget_exhausted = true;
+    // A row left incomplete on purpose (fewer draws) does not stop the run.
+    if (!all_done && budget.spent()) result.budget_exhausted = true;
     Summarise(row, &out);
     save();
   }

@@ -132,10 +132,12 @@ TEST(TableTest, ResumeMeasuresOnlyTheUnfinishedMethod) {
 
 TEST(TableTest, FewerDrawsLeaveTheRowIncompleteAndAResumeFinishesThem) {
   TableOptions o = SmallOptions();
-  o.rows = {"plant"};
+  o.rows = {"plant", "cantilever"};
   o.methods = {Method::kPdLbfgs};
   o.random_draws = 3;
   const TableResult part = RunTable(o, nullptr, {}, nullptr);
+  EXPECT_FALSE(part.budget_exhausted);
+  EXPECT_EQ(part.rows[1].method("pd-lbfgs")->evaluations, 2);  // the next row runs all the same
   EXPECT_EQ(part.rows[0].random_losses.size(), 3u);
   EXPECT_FALSE(part.rows[0].complete);
   EXPECT_FALSE(part.rows[0].random_loss_mean);
