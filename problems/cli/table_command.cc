@@ -64,6 +64,7 @@ std::string Joined(const std::vector<std::string>& items) {
 }
 
 std::string CommandLine(const TableArgs& a) {
+  if (a.report) return "diffpd table --report --json " + a.json_file;
   std::ostringstream s;
   s << "diffpd table --rows " << Joined(a.rows) << " --methods " << Joined(a.methods) << " --threads "
     << a.options.threads << " --evaluations " << a.options.evaluations << " --newton-evaluations "

@@ -205,12 +205,13 @@ void TableOptions::Validate() const {
 TableResult RunTable(const TableOptions& options, const TableResult* previous,
                      const std::function<void(const TableResult&)>& checkpoint, std::ostream* progress) {
   options.Validate();
-  if (previous) {
+  // A report (measure = false) takes the file's settings as they are.
+  if (previous && options.measure) {
     std::ostringstream msg;
     if (previous->size != SizeName(options.size))
       msg << "resume: the file holds the " << previous->size << " instances, this run asks for "
           << SizeName(options.size);
-    else if (options.measure && previous->masses != ToString(options.masses))
+    else if (previous->masses != ToString(options.masses))
       msg << "resume: the file was measured with " << previous->masses << " masses, this run asks for "
           << ToString(options.masses);
     else if (previous->threads != options.threads)
@@ -235,11 +236,13 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
     result.commit = previous->commit;
     result.machine = previous->machine;
   }
-  result.threads = options.threads;
-  result.size = SizeName(options.size);
+  const bool report = previous && !options.measure;
+  result.threads = report ? previous->threads : options.threads;
+  const RowSize size = report ? (previous->size == "small" ? RowSize::kSmall : RowSize::kPaper) : options.size;
+  result.size = SizeName(size);
   result.masses = previous ? previous->masses : ToString(options.masses);
-  result.evaluations = options.evaluations;
-  result.newton_evaluations = options.newton_evaluations;
+  result.evaluations = report ? previous->evaluations : options.evaluations;
+  result.newton_evaluations = report ? previous->newton_evaluations : options.newton_evaluations;
   // The rows to run, then those of the previous file that this run does not
   // name (kept as they are).
   std::vector<std::string> names = options.rows;
@@ -254,7 +257,7 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
   for (const std::string& name : names) {
     const bool requested =
         options.measure && std::find(options.rows.begin(), options.rows.end(), name) != options.rows.end();
-    PaperRow row = MakePaperRow(name, options.size);
+    PaperRow row = MakePaperRow(name, size);
     SetRowMasses(&row, previous ? ParseMassLumping(previous->masses) : options.masses);
     result.rows.push_back(Describe(row));
     TableRowResult& out = result.rows.back();

@@ -107,8 +107,12 @@ TEST(TableTest, AReportOnlyRunOfAPartialResultMeasuresNothingAndAddsNoRun) {
   partial.rows[0].complete = false;
   TableOptions o = SmallOptions();
   o.measure = false;
+  o.threads = 2;  // a report takes the file's settings, whatever the options say
+  o.evaluations = 5;
   std::ostringstream progress;
   const TableResult report = RunTable(o, &partial, {}, &progress);
+  EXPECT_EQ(report.threads, 1);
+  EXPECT_EQ(report.evaluations, 2);
   EXPECT_EQ(CountLines(progress.str(), "evaluation"), 0) << progress.str();
   EXPECT_TRUE(report.resumed_runs.empty());
   EXPECT_FALSE(report.rows[0].complete);
