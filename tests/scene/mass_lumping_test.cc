@@ -69,6 +69,10 @@ TEST(MassLumpingTest, InvalidSettingsAreRefused) {
                            std::to_string(scene.material_regions.size()) + " material regions declared)");
   EXPECT_STREQ(ToString(MassLumping::kEqualNodes), "equal-nodes");
   EXPECT_STREQ(ToString(MassLumping::kLumped), "lumped");
+  EXPECT_EQ(ParseMassLumping("equal-nodes"), MassLumping::kEqualNodes);
+  EXPECT_EQ(ParseMassLumping("lumped"), MassLumping::kLumped);
+  EXPECT_THROW_MESSAGE(ParseMassLumping("heavy"), InvalidInputError,
+                       "masses 'heavy' is unknown: use lumped or equal-nodes");
 }
 
 }  // namespace

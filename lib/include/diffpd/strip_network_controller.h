@@ -22,6 +22,7 @@
 #include "diffpd/controller.h"
 #include "diffpd/mlp.h"
 #include "diffpd/muscle_strip.h"
+#include "diffpd/strip_drive.h"
 
 namespace diffpd {
 
@@ -30,12 +31,6 @@ struct NodeObservation {
   int reference_node = 0;
   std::vector<int> nodes;
   int size() const { return 3 + 6 * static_cast<int>(nodes.size()); }
-};
-
-// Which channel drives a strip, and with which sign.
-struct StripDrive {
-  int channel = 0;
-  int sign = 1;  // +1: u = max(w, 0); -1: u = max(-w, 0)
 };
 
 class StripNetworkController : public Controller {
@@ -66,8 +61,6 @@ class StripNetworkController : public Controller {
               VectorXd* g_parameters) const override;
 
  private:
-  VectorXd Contractions(const VectorXd& channels) const;
-
   Mlp network_;
   NodeObservation observation_;
   MuscleDelayLine delay_line_;

@@ -19,7 +19,7 @@
 
 #include "diffpd/controller.h"
 #include "diffpd/muscle_strip.h"
-#include "diffpd/strip_network_controller.h"
+#include "diffpd/strip_drive.h"
 
 namespace diffpd {
 

@@ -1,6 +1,5 @@
 #include "diffpd/strip_network_controller.h"
 
-#include <algorithm>
 #include <sstream>
 
 #include "diffpd/error.h"
@@ -30,21 +29,8 @@ StripNetworkController::StripNetworkController(Mlp network, NodeObservation obse
   check_node(observation_.reference_node, "observation.reference_node");
   for (size_t p = 0; p < observation_.nodes.size(); ++p)
     check_node(observation_.nodes[p], "observation.nodes[" + std::to_string(p) + "]");
-  if (static_cast<int>(drives_.size()) != delay_line_.num_strips()) {
-    msg << drives_.size() << " strip drives given, expected " << delay_line_.num_strips() << " (one per strip)";
-    throw InvalidInputError(msg.str());
-  }
-  for (size_t s = 0; s < drives_.size(); ++s) {
-    if (drives_[s].channel < 0 || drives_[s].channel >= network_.num_outputs()) {
-      msg << "drives[" << s << "].channel = " << drives_[s].channel << " is out of range [0, " << network_.num_outputs()
-          << ") (the network's outputs)";
-      throw InvalidInputError(msg.str());
-    }
-    if (drives_[s].sign != 1 && drives_[s].sign != -1) {
-      msg << "drives[" << s << "].sign = " << drives_[s].sign << " is invalid: must be +1 or -1";
-      throw InvalidInputError(msg.str());
-    }
-  }
+  CheckStripDrives(drives_, delay_line_.num_strips(), network_.num_outputs(), "StripNetworkController",
+                   "the network's outputs");
 }
 
 VectorXd StripNetworkController::Observe(const State& state) const {
@@ -60,17 +46,11 @@ VectorXd StripNetworkController::Observe(const State& state) const {
   return o;
 }
 
-VectorXd StripNetworkController::Contractions(const VectorXd& channels) const {
-  VectorXd u(drives_.size());
-  for (size_t s = 0; s < drives_.size(); ++s) u(s) = std::max(drives_[s].sign * channels(drives_[s].channel), 0.0);
-  return u;
-}
-
 void StripNetworkController::Act(int step, const State& state, const VectorXd& memory, ControlAction* action,
                                  VectorXd* next_memory) const {
   const VectorXd channels = network_.Evaluate(Observe(state));
   action->external_force.resize(0);
-  delay_line_.Advance(memory, Contractions(channels), next_memory, &action->activation);
+  delay_line_.Advance(memory, StripContractions(drives_, channels), next_memory, &action->activation);
 }
 
 void StripNetworkController::ActVjp(int step, const State& state, const VectorXd& memory, const ControlAction& g_action,
@@ -81,10 +61,7 @@ void StripNetworkController::ActVjp(int step, const State& state, const VectorXd
   VectorXd g_u;
   delay_line_.AdvanceVjp(g_action.activation, g_next_memory, g_memory, &g_u);
   VectorXd g_channels = VectorXd::Zero(channels.size());
-  for (size_t s = 0; s < drives_.size(); ++s) {
-    const int c = drives_[s].channel, sign = drives_[s].sign;
-    if (sign * channels(c) > 0) g_channels(c) += sign * g_u(s);
-  }
+  AddStripContractionsVjp(drives_, channels, g_u, &g_channels);
   VectorXd g_obs;
   network_.Backward(tape, g_channels, &g_obs, g_parameters);
   const int p = static_cast<int>(observation_.nodes.size());

@@ -1,6 +1,5 @@
 #include "diffpd/strip_open_loop_controller.h"
 
-#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -25,21 +24,7 @@ StripOpenLoopController::StripOpenLoopController(int steps, int channels, Muscle
     msg << "channels = " << channels << " is invalid: must be >= 1";
     Invalid(msg.str());
   }
-  if (static_cast<int>(drives_.size()) != delay_line_.num_strips()) {
-    msg << drives_.size() << " strip drives given, expected " << delay_line_.num_strips() << " (one per strip)";
-    Invalid(msg.str());
-  }
-  for (size_t s = 0; s < drives_.size(); ++s) {
-    if (drives_[s].channel < 0 || drives_[s].channel >= channels) {
-      msg << "drives[" << s << "].channel = " << drives_[s].channel << " is out of range [0, " << channels
-          << ") (the channels)";
-      Invalid(msg.str());
-    }
-    if (drives_[s].sign != 1 && drives_[s].sign != -1) {
-      msg << "drives[" << s << "].sign = " << drives_[s].sign << " is invalid: must be +1 or -1";
-      Invalid(msg.str());
-    }
-  }
+  CheckStripDrives(drives_, delay_line_.num_strips(), channels, "StripOpenLoopController", "the channels");
   theta_ = VectorXd::Zero(static_cast<Eigen::Index>(steps) * channels);
 }
 
@@ -68,11 +53,8 @@ VectorXd StripOpenLoopController::ChannelValues(int step) const {
 
 void StripOpenLoopController::Act(int step, const State& state, const VectorXd& memory, ControlAction* action,
                                   VectorXd* next_memory) const {
-  const VectorXd w = ChannelValues(step);
-  VectorXd u(drives_.size());
-  for (size_t s = 0; s < drives_.size(); ++s) u(s) = std::max(drives_[s].sign * w(drives_[s].channel), 0.0);
   action->external_force.resize(0);
-  delay_line_.Advance(memory, u, next_memory, &action->activation);
+  delay_line_.Advance(memory, StripContractions(drives_, ChannelValues(step)), next_memory, &action->activation);
 }
 
 void StripOpenLoopController::ActVjp(int step, const State& state, const VectorXd& memory,
@@ -81,12 +63,11 @@ void StripOpenLoopController::ActVjp(int step, const State& state, const VectorX
   const VectorXd w = ChannelValues(step);
   VectorXd g_u;
   delay_line_.AdvanceVjp(g_action.activation, g_next_memory, g_memory, &g_u);
-  const Eigen::Index offset = static_cast<Eigen::Index>(step) * channels_;
-  for (size_t s = 0; s < drives_.size(); ++s) {
-    const int c = drives_[s].channel, sign = drives_[s].sign;
-    // d tanh(theta) / d theta = 1 - w^2.
-    if (sign * w(c) > 0) (*g_parameters)(offset + c) += sign * g_u(s) * (1 - w(c) * w(c));
-  }
+  VectorXd g_w = VectorXd::Zero(channels_);
+  AddStripContractionsVjp(drives_, w, g_u, &g_w);
+  // d tanh(theta) / d theta = 1 - w^2.
+  g_parameters->segment(static_cast<Eigen::Index>(step) * channels_, channels_).array() +=
+      g_w.array() * (1 - w.array().square());
 }
 
 }  // namespace diffpd
