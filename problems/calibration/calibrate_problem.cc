@@ -142,7 +142,7 @@ SolverOptions CalibrationProblem::FitOptions(Method method) const {
   SolverOptions options;
   options.method = method;
   options.time_step = default_time_step();
-  options.rel_tolerance = 1e-7;
+  options.rel_tolerance = 1e-4;
   options.abs_tolerance = 1e-9;
   options.max_iterations = 20000;
   options.backward_rel_tolerance = 1e-8;

@@ -64,7 +64,10 @@ class CalibrationProblem : public Problem {
   virtual std::uint64_t seed() const { return 2021; }
   // Methods fitted by default (the first is the main one).
   virtual std::vector<Method> default_methods() const { return {Method::kPdLbfgs, Method::kNewtonCholesky}; }
-  // Simulator settings of a fit with `method` (time step = default_time_step()).
+  // Simulator settings of a fit with `method`: time step default_time_step(),
+  // rel_tolerance 1e-4 (abs 1e-9, at most 20000 iterations a step), adjoint
+  // rel_tolerance 1e-8. Tighter forward tolerances give the same fit in more
+  // time (docs/benchmarks.md, "What a tolerance costs the optimiser").
   virtual SolverOptions FitOptions(Method method) const;
   virtual int max_iterations() const { return 25; }
 

@@ -1,6 +1,7 @@
 // `diffpd tradeoff`: the command-line edge of tradeoff.h and tradeoff_front.h.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -34,7 +35,13 @@ Every run starts from the problem's own settings ('default'); sweeps:
  resolution : cantilever, falling-cube: 3 fewer doublings per level
 Problems: every registered problem (small instances of the optimisation and
 control problems), the paper's rows as paper-<row> (small), the calibrations.
---all: every problem, small, reduced sweeps (a few minutes on 2 cores).
+--all: every problem's small instance, checked rather than measured: the
+tolerance sweep of pd-lbfgs at 1e-2, 1e-4, 1e-6 (unless --methods, --sweeps,
+--tolerances say otherwise), forward scenes at 3 steps on coarse meshes;
+with --check a few minutes on 2 cores in all (--shard K/N splits it).
+--quick: four tolerances (1e-2 to 1e-8), every --methods, the solver-option
+sweeps, two time-step and resolution levels, forward scenes at 10 steps
+(with --all: every problem so).
 --out DIR writes <problem>.json (the report below) and, with gnuplot,
 <problem>.png (log-log, one curve per method, the default marked); --all
 also writes summary.json. Report: default (method, tolerance, seconds,
@@ -42,6 +49,12 @@ gradient error, slowdown over the front), the front, for gradient-error
 bounds 1e-3, 1e-2, 1e-1 the fastest setting and how far the default's
 tolerance may be loosened, and the monotonicity violations (a tighter
 tolerance with a larger error than --noise times a looser one's plus 1e-9).
+Each setting runs once (--repeats N: N times, its fastest run kept: on a
+shared machine the default, run first, is otherwise measured slower).
+--clock wall (default): seconds are the wall time of the forward and
+backward passes; --clock cpu: the process's CPU seconds of the whole
+evaluation (with --threads 1 the measure to compare settings by on a machine
+shared with other work; every row also reports cpu_s).
 Exit code 6 with --check when a problem has a monotonicity violation.
 --optimiser: instead, the problem's own optimiser (Ipopt, Ceres or Adam) from
 its own start with every evaluation at each --tolerances value (default
@@ -54,6 +67,9 @@ struct TradeoffArgs {
   std::string problem;
   bool all = false;
   bool quick = false;
+  std::string shard;
+  // Whether the user named these (--all then keeps them).
+  bool methods_given = false, sweeps_given = false, tolerances_given = false;
   std::vector<std::string> methods = {"pd", "pd-lbfgs", "newton-pcg", "newton-cholesky", "newton-ldlt"};
   std::vector<std::string> sweeps = {"tolerance", "options", "time_step", "resolution"};
   TradeoffOptions options;
@@ -62,13 +78,15 @@ struct TradeoffArgs {
   double noise = 3;
   std::string out;
   std::string plot;
+  std::string clock = "wall";
   bool optimiser = false;
   int budget = 0;
   std::string replot;
 };
 
-// The reduced settings of --all and --quick: four tolerances, two time-step
-// and resolution levels, forward scenes at 10 steps on coarse meshes.
+// The reduced settings of --quick (and --all --quick): four tolerances, two
+// time-step and resolution levels, forward scenes at 10 steps on coarse
+// meshes.
 void Reduce(const std::string& problem, TradeoffOptions* o) {
   o->tolerances = {1e-2, 1e-4, 1e-6, 1e-8};
   o->backward_factors = {1, 0.01};
@@ -77,6 +95,33 @@ void Reduce(const std::string& problem, TradeoffOptions* o) {
   o->resolution_levels = 2;
   if (o->steps <= 0) o->steps = 10;
   if (o->refine == 0) o->refine = problem == "cantilever" ? -6 : problem == "falling-cube" ? -3 : 0;
+}
+
+// The check of --all: the tolerance sweep of pd-lbfgs (every problem's
+// default method) at 1e-2, 1e-4 and 1e-6, forward scenes at 3 steps on
+// coarse meshes; what the user names explicitly is kept.
+void ReduceToCheck(const std::string& problem, const TradeoffArgs& args, TradeoffOptions* o) {
+  if (!args.tolerances_given) o->tolerances = {1e-2, 1e-4, 1e-6};
+  if (!args.methods_given) o->methods = {Method::kPdLbfgs};
+  if (!args.sweeps_given) o->sweep_solver_options = o->sweep_time_step = o->sweep_resolution = false;
+  o->time_step_levels = std::min(o->time_step_levels, 2);
+  o->resolution_levels = std::min(o->resolution_levels, 2);
+  if (o->steps <= 0) o->steps = 3;
+  if (o->refine == 0) o->refine = problem == "cantilever" ? -6 : problem == "falling-cube" ? -3 : 0;
+}
+
+// The problems of shard "K/N" of `names`: those at positions i with
+// i mod N = K - 1. Throws InvalidInputError for anything but 1 <= K <= N.
+std::vector<std::string> Shard(const std::vector<std::string>& names, const std::string& shard) {
+  if (shard.empty()) return names;
+  long k = 0, n = 0;
+  char slash = 0, extra = 0;
+  if (std::sscanf(shard.c_str(), "%ld%c%ld%c", &k, &slash, &n, &extra) != 3 || slash != '/' || k < 1 || k > n)
+    throw InvalidInputError("--shard " + shard + " is invalid: must be K/N with 1 <= K <= N");
+  std::vector<std::string> out;
+  for (size_t i = 0; i < names.size(); ++i)
+    if (static_cast<long>(i % n) == k - 1) out.push_back(names[i]);
+  return out;
 }
 
 struct ProblemReport {
@@ -105,7 +150,7 @@ void PrintTable(const ProblemReport& p) {
                 r.rows[0].failure.c_str());
   else
     std::printf("default %s at rel_tolerance %g: %.4f s, gradient error %.3e, %.2fx the front's time at that error%s\n",
-                r.default_method.c_str(), r.default_rel_tolerance, r.rows[0].seconds, r.rows[0].grad_rel_error,
+                r.default_method.c_str(), r.default_rel_tolerance, p.front.default_seconds, r.rows[0].grad_rel_error,
                 p.front.default_slowdown, p.front.default_on_front ? " (on the front)" : "");
   for (const auto& b : p.front.bounds) {
     if (!b.met) {
@@ -195,6 +240,9 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
   if (args.all == !args.problem.empty())
     throw InvalidInputError("name one problem or give --all (diffpd tradeoff --help lists the problems)");
   TradeoffOptions options = args.options;
+  if (args.clock != "wall" && args.clock != "cpu")
+    throw InvalidInputError("--clock " + args.clock + " is invalid: valid clocks are wall, cpu");
+  options.clock = args.clock == "cpu" ? TradeoffClock::kCpu : TradeoffClock::kWall;
   options.methods = ParseMethods(args.methods);
   options.sweep_tolerance = options.sweep_solver_options = options.sweep_time_step = options.sweep_resolution = false;
   for (const auto& s : args.sweeps) {
@@ -225,14 +273,19 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
     if (!std::filesystem::is_directory(dir))
       throw InvalidInputError("--plot " + args.plot + " is invalid: directory " + dir.string() + " does not exist");
   }
-  const std::vector<std::string> problems = args.all ? ObjectiveProblemNames() : std::vector<std::string>{args.problem};
+  if (!args.shard.empty() && !args.all) throw InvalidInputError("--shard needs --all");
+  const std::vector<std::string> problems =
+      args.all ? Shard(ObjectiveProblemNames(), args.shard) : std::vector<std::string>{args.problem};
   if (args.optimiser) return RunOptimiserTradeoffArgs(args, problems);
   std::vector<ProblemReport> reports;
   nlohmann::json summary = nlohmann::json::array();
   bool monotone = true;
   for (const auto& name : problems) {
     TradeoffOptions o = options;
-    if (args.all || args.quick) Reduce(name, &o);
+    if (args.quick)
+      Reduce(name, &o);
+    else if (args.all)
+      ReduceToCheck(name, args, &o);
     ProblemReport p;
     p.result = RunTradeoff(name, o, &std::cerr);
     p.front = AnalyseFront(p.result);
@@ -270,8 +323,9 @@ Subcommand AddTradeoffCommand(CLI::App* parent) {
   cmd->footer(kTradeoffFooter);
   TradeoffOptions& o = args->options;
   cmd->add_option("problem", args->problem, "problem name (diffpd list; paper rows as paper-<row>)");
-  cmd->add_flag("--all", args->all, "every problem's small instance, reduced sweeps");
-  cmd->add_flag("--quick", args->quick, "the reduced sweeps of --all for one problem");
+  cmd->add_flag("--all", args->all, "every problem's small instance, pd-lbfgs's tolerance sweep (see below)");
+  cmd->add_option("--shard", args->shard, "--all: only the problems at positions i with i mod N = K - 1 (K/N)");
+  cmd->add_flag("--quick", args->quick, "reduced sweeps of every method (the fronts of docs/results/tradeoff)");
   cmd->add_option("--methods", args->methods,
                   "comma-separated methods: newton-cholesky, newton-pcg, newton-ldlt, pd, pd-lbfgs")
       ->delimiter(',')
@@ -302,6 +356,10 @@ Subcommand AddTradeoffCommand(CLI::App* parent) {
       ->capture_default_str();
   cmd->add_option("--threads", o.threads, "threads for element loops (0: OpenMP default)")
       ->check(ThreadCount("--threads"));
+  cmd->add_option("--repeats", o.repeats, "timed runs of each setting; each row keeps its fastest")
+      ->check(IntegerAtLeast("--repeats", 1))
+      ->capture_default_str();
+  cmd->add_option("--clock", args->clock, "what a row's seconds count: wall or cpu (see below)")->capture_default_str();
   cmd->add_option("--seed", o.seed, "seed of the forward scenes' loss vectors")->capture_default_str();
   cmd->add_option("--cache", o.cache_dir, "directory of cached references (default: <out>/reference_cache)");
   cmd->add_option("--out", args->out, "directory for <problem>.json, <problem>.png (and summary.json with --all)");
@@ -315,7 +373,12 @@ Subcommand AddTradeoffCommand(CLI::App* parent) {
   cmd->add_option("--budget", args->budget, "--optimiser: iterations of each run (0: the problem's own budget)")
       ->check(IntegerAtLeast("--budget", 0))
       ->capture_default_str();
-  return {cmd, [args] { return RunTradeoffArgs(*args); }};
+  return {cmd, [args, cmd] {
+            args->methods_given = cmd->count("--methods") > 0;
+            args->sweeps_given = cmd->count("--sweeps") > 0;
+            args->tolerances_given = cmd->count("--tolerances") > 0;
+            return RunTradeoffArgs(*args);
+          }};
 }
 
 }  // namespace diffpd::problems

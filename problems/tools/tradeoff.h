@@ -44,6 +44,12 @@
 
 namespace diffpd::problems {
 
+// What a row's `seconds` counts: wall-clock seconds of the forward and
+// backward passes, or the process's CPU seconds of the whole evaluation
+// (setup included; with threads = 1 about the wall time of an idle machine,
+// and much less disturbed by other work on a shared one).
+enum class TradeoffClock { kWall, kCpu };
+
 struct TradeoffOptions {
   std::vector<Method> methods = {Method::kPd, Method::kPdLbfgs, Method::kNewtonPcg, Method::kNewtonCholesky,
                                  Method::kNewtonLdlt};
@@ -56,6 +62,11 @@ struct TradeoffOptions {
   int steps = -1;         // forward scenes: <= 0 the problem's default
   double time_step = -1;  // forward scenes' h0; <= 0: the problem's default (s)
   int threads = 0;
+  // Timed runs of each setting (>= 1); a row keeps its fastest run (on a
+  // shared machine the least-disturbed one; the errors of repeated runs
+  // agree up to the rounding of threaded sums).
+  int repeats = 1;
+  TradeoffClock clock = TradeoffClock::kWall;
   int max_iterations = -1;    // of each step's solve; -1: the problem's (references: at least 1000)
   int refine = 0;             // cantilever, falling-cube: cell doublings (finest mesh of the resolution sweep)
   int time_step_levels = 4;   // >= 1
@@ -82,10 +93,14 @@ struct TradeoffRow {
   std::string setting;       // the value in words where it is not a number ("direct")
   double rel_tolerance = 0;  // the forward tolerance of the run
   std::string failure;       // "" when the run succeeded
-  double seconds = 0;        // forward_s + backward_s
+  double seconds = 0;        // forward_s + backward_s, or cpu_s (TradeoffClock::kCpu)
+  double cpu_s = 0;          // process CPU seconds of the evaluation
   double forward_s = 0, backward_s = 0, iters_per_step = 0;
   double state_rel_error = 0, loss_rel_error = 0, grad_rel_error = 0;
   int dofs = 0, steps = 0;
+  // The run computes what the default does (the same settings, measured
+  // again by another sweep).
+  bool default_settings = false;
   bool ok() const { return failure.empty(); }
   // Runs at the problem's time step and mesh (what the front is made of).
   bool at_problem_settings() const { return sweep != "time_step" && sweep != "resolution"; }
@@ -99,6 +114,8 @@ struct TradeoffResult {
   double default_rel_tolerance = 0;
   bool reference_cached = false;  // the tolerance-sweep reference came from the cache
   double reference_s = 0;         // seconds the reference took when it was computed
+  int repeats = 1;                // timed runs per row (TradeoffOptions::repeats)
+  TradeoffClock clock = TradeoffClock::kWall;
   std::vector<TradeoffRow> rows;  // rows[0]: the default
 };
 
@@ -112,7 +129,8 @@ TradeoffResult RunTradeoff(const std::string& problem, const TradeoffOptions& op
 
 // The rows as a JSON list of {sweep, method, parameter, value, setting,
 // rel_tolerance, seconds, state_rel_error, loss_rel_error, grad_rel_error,
-// status, forward_s, backward_s, iters_per_step, dofs, steps}; a failed run
+// status, forward_s, backward_s, cpu_s, default_settings, iters_per_step,
+// dofs, steps}; a failed run
 // has null numbers.
 nlohmann::json TradeoffToJson(const std::vector<TradeoffRow>& rows);
 

@@ -82,7 +82,10 @@ TradeoffFront AnalyseFront(const TradeoffResult& result) {
     double best = std::numeric_limits<double>::infinity();
     for (const auto& r : rows)
       if (r.ok() && r.at_problem_settings() && r.grad_rel_error <= d.grad_rel_error) best = std::min(best, r.seconds);
-    f.default_slowdown = d.seconds / best;
+    f.default_seconds = d.seconds;
+    for (const auto& r : rows)
+      if (r.ok() && r.default_settings) f.default_seconds = std::min(f.default_seconds, r.seconds);
+    f.default_slowdown = f.default_seconds / best;
     f.default_on_front = f.default_slowdown <= 1.1;
   }
   const auto default_sweep = SweepOf(rows, result.default_method);
@@ -146,10 +149,13 @@ nlohmann::json TradeoffReportJson(const TradeoffResult& result, const TradeoffFr
           {"time_step", result.time_step},
           {"reference_seconds", result.reference_s},
           {"reference_cached", result.reference_cached},
+          {"repeats", result.repeats},
+          {"clock", result.clock == TradeoffClock::kCpu ? "cpu" : "wall"},
           {"default",
            {{"method", result.default_method},
             {"rel_tolerance", result.default_rel_tolerance},
             {"seconds", d.seconds},
+            {"seconds_fastest_at_its_settings", front.default_seconds},
             {"grad_rel_error", d.grad_rel_error},
             {"status", d.ok() ? std::string("ok") : "failed: " + d.failure},
             {"slowdown_over_front", front.default_slowdown},

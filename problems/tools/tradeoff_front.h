@@ -49,7 +49,10 @@ struct TradeoffFront {
   // Indices into the rows of the runs at the problem's time step and mesh
   // that no other such run beats in both seconds and gradient error.
   std::vector<int> front;
-  // The default's seconds over the least seconds of a run (at the problem's
+  // The default's seconds: the least of the runs with its settings (the
+  // default row and the other sweeps' runs that repeat it).
+  double default_seconds = 0;
+  // default_seconds over the least seconds of a run (at the problem's
   // settings) whose gradient error is at most the default's; <= 1.1: on or
   // within 10% of the front.
   double default_slowdown = 0;
@@ -61,9 +64,11 @@ struct TradeoffFront {
 // InvalidInputError when it is not.
 TradeoffFront AnalyseFront(const TradeoffResult& result);
 
-// {problem, variables, loss, dofs, steps, time_step, default {method,
-// rel_tolerance, seconds, grad_rel_error, slowdown, on_front}, front [row
-// indices], bounds [...], monotonicity_violations [...], rows [...]}.
+// {problem, variables, loss, dofs, steps, time_step, reference_seconds,
+// reference_cached, repeats, clock ("wall" or "cpu"), default {method,
+// rel_tolerance, seconds, seconds_fastest_at_its_settings, grad_rel_error,
+// slowdown, on_front}, front [row indices], bounds [...],
+// monotonicity_violations [...], rows [...]}.
 nlohmann::json TradeoffReportJson(const TradeoffResult& result, const TradeoffFront& front,
                                   const std::vector<MonotonicityViolation>& violations);
 

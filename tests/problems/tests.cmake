@@ -34,6 +34,16 @@ diffpd_add_test(command_line_test ${_dir}/cli/command_line_test.cc LIBS diffpd_p
 # The program's OpenMP waits (tools/openmp_waits.h), through the program itself.
 add_test(NAME diffpd_sets_short_openmp_waits
          COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:diffpd_cli> -DSPIN=1000 -P ${_dir}/cli/openmp_waits.cmake)
+# Every problem's trade-off front is monotone: `diffpd tradeoff --all --check`
+# runs pd-lbfgs's tolerance sweep (1e-2, 1e-4, 1e-6) on every problem's small
+# instance against its converged reference and exits with status 6 when a
+# tighter tolerance gives a state, loss or gradient error above 3x (--noise) a
+# looser one's plus 1e-9. Four shards so that ctest -j spreads them.
+foreach(shard 1 2 3 4)
+  add_test(NAME tradeoff_fronts_monotone_shard_${shard}_of_4
+           COMMAND diffpd_cli tradeoff --all --shard ${shard}/4 --check --noise 3 --threads 1)
+  set_tests_properties(tradeoff_fronts_monotone_shard_${shard}_of_4 PROPERTIES ENVIRONMENT "OMP_NUM_THREADS=1")
+endforeach()
 # Closed-loop swimming (Adam needs neither adapter).
 diffpd_add_test(adam_test ${_dir}/control/adam_test.cc LIBS diffpd_problems)
 diffpd_add_test(swimmer_scenes_test ${_dir}/control/swimmer_scenes_test.cc LIBS diffpd_problems)

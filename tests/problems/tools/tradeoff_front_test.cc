@@ -61,6 +61,19 @@ TEST(TradeoffFrontTest, DefaultSlowdownIsOverTheFastestRunAsAccurate) {
   EXPECT_TRUE(AnalyseFront(r).default_on_front);
 }
 
+TEST(TradeoffFrontTest, DefaultTimeIsTheFastestRunWithItsSettings) {
+  TradeoffResult r = Made();
+  r.rows[0].default_settings = r.rows[2].default_settings = true;  // pd 1e-4 measured twice
+  r.rows[2].seconds = 0.63;
+  const TradeoffFront f = AnalyseFront(r);
+  EXPECT_DOUBLE_EQ(f.default_seconds, 0.63);
+  EXPECT_DOUBLE_EQ(f.default_slowdown, 0.63 / 0.6);
+  EXPECT_TRUE(f.default_on_front);
+  // A run not marked as repeating the default does not count, however fast.
+  r.rows[2].default_settings = false;
+  EXPECT_DOUBLE_EQ(AnalyseFront(r).default_seconds, 1.0);
+}
+
 TEST(TradeoffFrontTest, BoundsGiveTheFastestSettingAndHowFarTheDefaultMayLoosen) {
   const TradeoffFront f = AnalyseFront(Made());
   ASSERT_EQ(f.bounds.size(), 3u);

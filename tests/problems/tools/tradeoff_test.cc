@@ -125,6 +125,39 @@ TEST(TradeoffOptionsTest, ValidateNamesTheFieldValueAndRange) {
   EXPECT_THROW(o.Validate(), InvalidInputError);
 }
 
+TEST(TradeoffTest, RepeatsKeepTheErrorsAndTheCpuClockCountsCpuSeconds) {
+  TradeoffOptions o = Tiny();
+  o.sweep_tolerance = true;
+  o.methods = {Method::kPdLbfgs};
+  o.tolerances = {1e-3};
+  const auto once = RunTradeoff("cantilever", o);
+  o.repeats = 3;
+  o.clock = TradeoffClock::kCpu;
+  const auto thrice = RunTradeoff("cantilever", o);
+  EXPECT_EQ(thrice.repeats, 3);
+  ASSERT_EQ(once.rows.size(), 2u);
+  ASSERT_EQ(thrice.rows.size(), 2u);
+  for (size_t i = 0; i < once.rows.size(); ++i) {
+    const TradeoffRow &a = once.rows[i], &b = thrice.rows[i];
+    ASSERT_TRUE(a.ok() && b.ok()) << a.failure << b.failure;
+    // One thread: the repeated runs are the same computation.
+    EXPECT_EQ(a.grad_rel_error, b.grad_rel_error);
+    EXPECT_EQ(a.state_rel_error, b.state_rel_error);
+    EXPECT_EQ(a.iters_per_step, b.iters_per_step);
+    // Wall clock: the passes' seconds; CPU clock: the evaluation's CPU seconds.
+    EXPECT_DOUBLE_EQ(a.seconds, a.forward_s + a.backward_s);
+    EXPECT_GT(a.cpu_s, 0);
+    EXPECT_EQ(b.seconds, b.cpu_s);
+    EXPECT_GT(b.cpu_s, 0);
+  }
+}
+
+TEST(TradeoffTest, ZeroRepeatsIsRejected) {
+  TradeoffOptions o;
+  o.repeats = 0;
+  ASSERT_THROW_MESSAGE(o.Validate(), InvalidInputError, "repeats = 0 is invalid: must be >= 1");
+}
+
 std::vector<TradeoffRow> SyntheticRows() {
   std::vector<TradeoffRow> rows;
   for (const char* sweep : {"tolerance", "time_step", "resolution"})
