@@ -55,6 +55,22 @@ def factor(loosest, default):
     return "%s (/%.0f)" % (fmt(loosest), 1 / ratio)
 
 
+def loosest_of_default_method(report, bound):
+    """The loosest tolerance of the default method's sweep (with the default
+    run itself where its tolerance was not swept) at which it and every
+    tighter run stay below `bound` (0: none): tradeoff_front.h's rule."""
+    d = report["default"]
+    rows = [r for r in report["rows"] if r["sweep"] == "tolerance" and r["method"] == d["method"]]
+    if not any(r["value"] == d["rel_tolerance"] for r in rows):
+        rows.append(report["rows"][0])
+    loosest = 0
+    for r in sorted(rows, key=lambda r: r["value"]):
+        if r["status"] != "ok" or r["grad_rel_error"] > bound:
+            break
+        loosest = r["value"]
+    return loosest
+
+
 def slowdown(report):
     d = report["default"]
     return d.get("slowdown_over_front", 0)
@@ -68,7 +84,7 @@ def readme(fronts, defaults):
         d = r["default"]
         cells = [name, "%s %s" % (d["method"], fmt(d["rel_tolerance"])), "%.1e" % d["grad_rel_error"]]
         for b in r["bounds"]:
-            cells.append(factor(b["default_method_loosest_tolerance"], d["rel_tolerance"]))
+            cells.append(factor(loosest_of_default_method(r, b["grad_rel_error_bound"]), d["rel_tolerance"]))
         b3 = r["bounds"][0]
         cells.append("%.1fx" % (b3["best_newton_seconds"] / b3["pd_lbfgs_seconds"])
                      if b3["best_newton_seconds"] and b3["pd_lbfgs_seconds"] else "-")

@@ -88,7 +88,15 @@ TradeoffFront AnalyseFront(const TradeoffResult& result) {
     f.default_slowdown = f.default_seconds / best;
     f.default_on_front = f.default_slowdown <= 1.1;
   }
-  const auto default_sweep = SweepOf(rows, result.default_method);
+  // The default method's sweep with the default run itself where its
+  // tolerance was not swept (a default between the swept decades).
+  auto default_sweep = SweepOf(rows, result.default_method);
+  if (std::none_of(default_sweep.begin(), default_sweep.end(),
+                   [&](const TradeoffRow* r) { return r->value == d.value; })) {
+    default_sweep.push_back(&d);
+    std::sort(default_sweep.begin(), default_sweep.end(),
+              [](const TradeoffRow* a, const TradeoffRow* b) { return a->value > b->value; });
+  }
   const auto lbfgs_sweep = SweepOf(rows, ToString(Method::kPdLbfgs));
   for (double bound : {1e-3, 1e-2, 1e-1}) {
     ErrorBound b;
