@@ -97,7 +97,7 @@ def describe(row):
     what = row["sweep"]
     if row["setting"]:
         what += " " + row["setting"]
-    elif row["sweep"] == "backward_tolerance":
+    elif row["sweep"] in ("backward_tolerance", "screening"):
         what += " %g" % row["value"]
     return "%s %s at %s" % (row["method"], what, fmt(row["rel_tolerance"]))
 

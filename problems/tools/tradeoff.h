@@ -63,8 +63,9 @@ struct TradeoffOptions {
   double time_step = -1;  // forward scenes' h0; <= 0: the problem's default (s)
   int threads = 0;
   // Timed runs of each setting (>= 1); a row keeps its fastest run (on a
-  // shared machine the least-disturbed one; the errors of repeated runs
-  // agree up to the rounding of threaded sums).
+  // shared machine the least-disturbed one). Repeated runs' forward errors
+  // agree up to the rounding of threaded sums, their gradients up to the
+  // adjoint's tolerance (adjoint_solver auto picks by measured time).
   int repeats = 1;
   TradeoffClock clock = TradeoffClock::kWall;
   int max_iterations = -1;    // of each step's solve; -1: the problem's (references: at least 1000)
@@ -98,8 +99,7 @@ struct TradeoffRow {
   double forward_s = 0, backward_s = 0, iters_per_step = 0;
   double state_rel_error = 0, loss_rel_error = 0, grad_rel_error = 0;
   int dofs = 0, steps = 0;
-  // The run computes what the default does (the same settings, measured
-  // again by another sweep).
+  // The run has the default's settings (measured again by another sweep).
   bool default_settings = false;
   bool ok() const { return failure.empty(); }
   // Runs at the problem's time step and mesh (what the front is made of).

@@ -140,10 +140,12 @@ TEST(TradeoffTest, RepeatsKeepTheErrorsAndTheCpuClockCountsCpuSeconds) {
   for (size_t i = 0; i < once.rows.size(); ++i) {
     const TradeoffRow &a = once.rows[i], &b = thrice.rows[i];
     ASSERT_TRUE(a.ok() && b.ok()) << a.failure << b.failure;
-    // One thread: the repeated runs are the same computation.
-    EXPECT_EQ(a.grad_rel_error, b.grad_rel_error);
+    // One thread: the repeated forward passes are the same computation; the
+    // adjoint agrees to its tolerance (adjoint_solver auto picks the solve
+    // per step by measured time).
     EXPECT_EQ(a.state_rel_error, b.state_rel_error);
     EXPECT_EQ(a.iters_per_step, b.iters_per_step);
+    EXPECT_NEAR(a.grad_rel_error, b.grad_rel_error, 1e-2 * a.grad_rel_error);
     // Wall clock: the passes' seconds; CPU clock: the evaluation's CPU seconds.
     EXPECT_DOUBLE_EQ(a.seconds, a.forward_s + a.backward_s);
     EXPECT_GT(a.cpu_s, 0);
