@@ -1,4 +1,4 @@
-#include "paper/row_optimisation.h"
+#include "paper/row_optimisers.h"
 
 #include <algorithm>
 #include <chrono>
@@ -96,8 +96,8 @@ class BudgetedRowNlp : public solvers::RolloutNlp {
 
 }  // namespace
 
-RowOptimisationResult OptimiseRow(const PaperRow& row, const SolverOptions& options,
-                                  const RowOptimisationOptions& optimisation) {
+RowOptimisationResult OptimiseRowWithIpopt(const PaperRow& row, const SolverOptions& options,
+                                           const RowOptimisationOptions& optimisation) {
   RowRolloutFunction f = MakeRowRolloutFunction(row, options);
   const long max_evaluations =
       optimisation.max_evaluations > 0 ? optimisation.max_evaluations : row.budget.max_evaluations;
@@ -121,9 +121,11 @@ RowOptimisationResult OptimiseRow(const PaperRow& row, const SolverOptions& opti
   nlp->ReportNewRollout(summary.x);
 
   RowOptimisationResult out;
+  out.optimizer = ToString(RowOptimizer::kIpopt);
   out.total_s = std::chrono::duration<double>(Clock::now() - start).count();
   out.status = summary.status_name;
   out.stopped_by = nlp->stopped_by();
+  if (summary.status == Ipopt::Maximum_Iterations_Exceeded) out.stopped_by = "iteration limit";
   out.iterations = summary.iterations;
   const solvers::RolloutStatistics& stats = nlp->statistics();
   out.evaluations = stats.rollouts;

@@ -234,8 +234,8 @@ TEST(LbfgsbTest, TheStartingPointIsProjectedOntoTheBoxAndAFailureThereStopsTheRu
     *g = VectorXd::Zero(x.size());
     return false;
   };
-  const LbfgsbResult r = MinimizeLbfgsb(failing, (VectorXd(2) << 3, -3).finished(), VectorXd::Constant(2, -1),
-                                        VectorXd::Constant(2, 1));
+  const LbfgsbResult r =
+      MinimizeLbfgsb(failing, (VectorXd(2) << 3, -3).finished(), VectorXd::Constant(2, -1), VectorXd::Constant(2, 1));
   EXPECT_EQ(r.stop, LbfgsbStop::kStartFailed);
   EXPECT_STREQ(ToString(r.stop), "start failed");
   ASSERT_EQ(seen.size(), 1u);
@@ -272,8 +272,8 @@ TEST(LbfgsbTest, FailedEvaluationsAreSteppedBackFromAndNeverUsed) {
       iterates.push_back(x);
       return true;
     };
-    const LbfgsbResult r = MinimizeLbfgsb(f, VectorXd::Constant(2, 5), VectorXd::Constant(2, -10),
-                                          VectorXd::Constant(2, 10), o);
+    const LbfgsbResult r =
+        MinimizeLbfgsb(f, VectorXd::Constant(2, 5), VectorXd::Constant(2, -10), VectorXd::Constant(2, 10), o);
     EXPECT_EQ(r.stop, LbfgsbStop::kProjectedGradient) << "way " << way << ": " << ToString(r.stop);
     EXPECT_GE(r.failed_evaluations, 1) << "way " << way;
     EXPECT_LE((r.x - VectorXd::Ones(2)).norm(), 1e-9) << "way " << way;
@@ -312,8 +312,7 @@ TEST(LbfgsbTest, BadOptionsAndProblemsAreRefusedWithExactMessages) {
   };
   EXPECT_EQ(minimise(VectorXd(), VectorXd(), VectorXd()),
             "L-BFGS-B: x0 is empty: the problem needs at least one variable");
-  EXPECT_EQ(minimise(two, one, two),
-            "L-BFGS-B: lower has 1 entries and upper 2, expected 2 each (the size of x0)");
+  EXPECT_EQ(minimise(two, one, two), "L-BFGS-B: lower has 1 entries and upper 2, expected 2 each (the size of x0)");
   EXPECT_EQ(minimise((VectorXd(2) << 0, kInf).finished(), two, two),
             "L-BFGS-B: x0(1) = inf is invalid: must be finite");
   EXPECT_EQ(minimise(two, (VectorXd(2) << 0, std::nan("")).finished(), two),
