@@ -13,8 +13,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 }  // namespace
 
-CauchyPoint GeneralizedCauchyPoint(const VectorXd& x, const VectorXd& g, const VectorXd& lower,
-                                   const VectorXd& upper, const LimitedMemoryMatrix& b) {
+CauchyPoint GeneralizedCauchyPoint(const VectorXd& x, const VectorXd& g, const VectorXd& lower, const VectorXd& upper,
+                                   const LimitedMemoryMatrix& b) {
   const int n = static_cast<int>(x.size());
   const int k2 = static_cast<int>(b.W().cols());
   const double theta = b.theta();
@@ -47,9 +47,9 @@ CauchyPoint GeneralizedCauchyPoint(const VectorXd& x, const VectorXd& g, const V
   }
   std::sort(breaks.begin(), breaks.end());
 
-  VectorXd p = w.transpose() * d;  // W^T d
-  VectorXd c = VectorXd::Zero(k2);  // W^T (x(t) - x)
-  double f1 = -d.squaredNorm();     // f' = g^T d
+  VectorXd p = w.transpose() * d;                           // W^T d
+  VectorXd c = VectorXd::Zero(k2);                          // W^T (x(t) - x)
+  double f1 = -d.squaredNorm();                             // f' = g^T d
   double f2 = -theta * f1 - (k2 > 0 ? p.dot(m * p) : 0.0);  // f'' = d^T B d
   const double f2_initial = f2;
   double dt_min = f2 > 0 ? -f1 / f2 : (f1 < 0 ? kInf : 0.0);

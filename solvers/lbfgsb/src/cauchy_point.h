@@ -14,14 +14,14 @@
 namespace diffpd::solvers::lbfgsb_internal {
 
 struct CauchyPoint {
-  VectorXd x;              // the Cauchy point (within the bounds)
-  VectorXd c;              // W^T (x_cauchy - x), 2k entries
-  std::vector<int> free;   // variables not at a bound there, ascending
+  VectorXd x;             // the Cauchy point (within the bounds)
+  VectorXd c;             // W^T (x_cauchy - x), 2k entries
+  std::vector<int> free;  // variables not at a bound there, ascending
 };
 
 // x within [lower, upper]; g the gradient at x.
-CauchyPoint GeneralizedCauchyPoint(const VectorXd& x, const VectorXd& g, const VectorXd& lower,
-                                   const VectorXd& upper, const LimitedMemoryMatrix& b);
+CauchyPoint GeneralizedCauchyPoint(const VectorXd& x, const VectorXd& g, const VectorXd& lower, const VectorXd& upper,
+                                   const LimitedMemoryMatrix& b);
 
 // The minimiser xbar of the model over the free variables of the Cauchy
 // point (the others held there), projected onto the box when `project` and

@@ -52,8 +52,8 @@ void CheckProblem(const VectorXd& x0, const VectorXd& lower, const VectorXd& upp
   std::ostringstream msg;
   if (x0.size() == 0) throw InvalidInputError("L-BFGS-B: x0 is empty: the problem needs at least one variable");
   if (lower.size() != x0.size() || upper.size() != x0.size()) {
-    msg << "L-BFGS-B: lower has " << lower.size() << " entries and upper " << upper.size() << ", expected "
-        << x0.size() << " each (the size of x0)";
+    msg << "L-BFGS-B: lower has " << lower.size() << " entries and upper " << upper.size() << ", expected " << x0.size()
+        << " each (the size of x0)";
     throw InvalidInputError(msg.str());
   }
   for (int i = 0; i < x0.size(); ++i) {

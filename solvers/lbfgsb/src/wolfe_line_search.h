@@ -33,7 +33,7 @@ struct LineSearchResult {
   bool accepted = false;
   bool strong_wolfe = false;  // both conditions hold at the accepted point
   double step = 0;
-  VectorXd x, gradient;       // at the accepted point
+  VectorXd x, gradient;  // at the accepted point
   double f = 0;
   int trials = 0;
 };

@@ -41,11 +41,11 @@ using LbfgsbObjective = std::function<bool(const VectorXd& x, double* f, VectorX
 // One iterate: the start (iteration 0) or the point after an iteration.
 struct LbfgsbIteration {
   int iteration = 0;
-  long evaluations = 0;             // objective calls so far, failed ones included
-  double f = 0;                     // objective at the iterate
-  double projected_gradient = 0;    // inf-norm of P(x - g) - x
-  double step = 0;                  // line-search step length (0 at the start)
-  int free_variables = 0;           // variables free at the Cauchy point (all at the start)
+  long evaluations = 0;           // objective calls so far, failed ones included
+  double f = 0;                   // objective at the iterate
+  double projected_gradient = 0;  // inf-norm of P(x - g) - x
+  double step = 0;                // line-search step length (0 at the start)
+  int free_variables = 0;         // variables free at the Cauchy point (all at the start)
 };
 
 struct LbfgsbOptions {
@@ -107,7 +107,7 @@ struct LbfgsbResult {
   int memory_resets = 0;        // line searches that failed and restarted from steepest descent
   int skipped_updates = 0;      // pairs not stored (s^T y <= eps y^T y)
   LbfgsbStop stop = LbfgsbStop::kStartFailed;
-  std::string last_error;               // the latest failed evaluation's reason ("" if none)
+  std::string last_error;                // the latest failed evaluation's reason ("" if none)
   std::vector<LbfgsbIteration> history;  // the start, then every iteration
 };
 
