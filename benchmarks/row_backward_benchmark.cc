@@ -21,7 +21,9 @@
 //
 // Usage: row_backward_benchmark [--rows plant,routing-tendon] [--threads 1]
 //   [--evaluations 3] [--settings row,iterative,direct,...] [--clock wall|cpu]
-//   [--json]
+//   [--masses equal-nodes|lumped] [--json]
+// --masses: the rows' masses, as `diffpd table --masses` (default: the
+// original code's, equal-nodes).
 // --clock cpu: the process's CPU seconds instead of wall seconds (steadier
 // on a loaded machine with --threads 1; includes OpenMP's spinning with more).
 #include <time.h>
@@ -132,6 +134,7 @@ int Main(int argc, char** argv) {
   std::vector<std::string> names;
   int threads = 1, evaluations = 3;
   bool json = false, cpu = false;
+  MassLumping masses = MassLumping::kEqualNodes;  // the table's default
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -146,6 +149,8 @@ int Main(int argc, char** argv) {
       evaluations = std::stoi(next());
     } else if (a == "--settings") {
       names = Split(next());
+    } else if (a == "--masses") {
+      masses = ParseMassLumping(next());
     } else if (a == "--clock") {
       const std::string c = next();
       if (c != "cpu" && c != "wall") throw InvalidInputError("--clock " + c + " is invalid: must be cpu or wall");
@@ -176,6 +181,7 @@ int Main(int argc, char** argv) {
   std::vector<Result> results;
   for (const std::string& name : rows) {
     PaperRow row = problems::MakePaperRow(name, problems::RowSize::kPaper);
+    problems::SetRowMasses(&row, masses);
     row.Prepare(row.Options(Method::kPdLbfgs, threads));
     const VectorXd x = row.random_draws.empty() || row.initial_guess == problems::InitialGuess::kGiven
                            ? row.initial()
@@ -212,8 +218,9 @@ int Main(int argc, char** argv) {
       out.forward_iterations = runs[c].back().iterations_per_step;
       out.backward_iterations = runs[c].back().backward_iterations_per_step;
       out.fallbacks = runs[c].back().backward_fallbacks;
-      out.gradient_error = reference < 0 ? std::numeric_limits<double>::quiet_NaN()
-                                         : problems::RelativeError(runs[c].back().gradient, runs[reference].back().gradient);
+      out.gradient_error = reference < 0
+                               ? std::numeric_limits<double>::quiet_NaN()
+                               : problems::RelativeError(runs[c].back().gradient, runs[reference].back().gradient);
       results.push_back(out);
     }
   }
@@ -232,7 +239,8 @@ int Main(int argc, char** argv) {
     std::cout << j.dump(2) << std::endl;
     return 0;
   }
-  std::printf("| row | setting | fwd s | bwd s | bwd / fwd | iterations/step (fwd, adjoint) | dL/dx error vs direct |\n");
+  std::printf(
+      "| row | setting | fwd s | bwd s | bwd / fwd | iterations/step (fwd, adjoint) | dL/dx error vs direct |\n");
   std::printf("|---|---|---:|---:|---:|---|---:|\n");
   for (const Result& r : results)
     std::printf("| %s | %s | %.3g | %.3g | %.2f | %.1f, %.1f | %.1e |\n", r.row.c_str(), r.setting.c_str(), r.forward_s,
