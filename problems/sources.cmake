@@ -42,6 +42,8 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/paper/cow_row.cc
   ${CMAKE_CURRENT_LIST_DIR}/paper/row_evaluation.cc
   ${CMAKE_CURRENT_LIST_DIR}/paper/row_rollout_function.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/row_optimisation.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/row_lbfgsb_optimisation.cc
   # tools
   ${CMAKE_CURRENT_LIST_DIR}/tools/openmp_waits.cc
   ${CMAKE_CURRENT_LIST_DIR}/tools/derivative_verdict.cc
@@ -96,7 +98,7 @@ set(DIFFPD_PROBLEMS_CONTROL_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/control/bunny.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/routing_tendon_opt.cc
   ${CMAKE_CURRENT_LIST_DIR}/control/locomotion.cc
-  ${CMAKE_CURRENT_LIST_DIR}/paper/row_optimisation.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/row_ipopt_optimisation.cc
   # the swimmers' Ipopt training
   ${CMAKE_CURRENT_LIST_DIR}/control/swimmer_ipopt.cc)
 get_filename_component(DIFFPD_DEFAULT_SHARED_DATA_DIR "${CMAKE_CURRENT_LIST_DIR}/../../shared/data" ABSOLUTE)

@@ -43,7 +43,11 @@ finished by Newton), problem, dofs, adjoint_solver, ...}.
 --scaling: the problem at --scales x the elements (default 1,2,4,8); rows
 {method, factor, elements, vertices, dofs, forward_s, iters_per_step,
 forward_per_iteration_ms, factorization_s, iteration_ms, backward_per_step_ms,
-peak_rss_mib, exponent_per_iteration, exponent_with_factorization}. Methods
+backward_direct_steps, factor_copy_mib (the PD factor's copy for parallel
+solves; 0: CHOLMOD solves, SolverOptions::pd_factor_copy_max_bytes),
+peak_rss_mib, exponent_per_iteration, exponent_with_factorization}.
+--cells NXxNYxNZ starts the cantilever from these cells instead of 32x8x8
+(172x43x43: 334 928 vertices, 1.0 M DoFs). Methods
 run to --rtol, so iteration counts differ per mesh: compare iteration_ms (the
 forward without PD's one-off factorisation, per iteration);
 exponent_per_iteration is its log-log slope against DoFs (1 = linear),
@@ -65,6 +69,7 @@ struct BenchArgs {
   bool scaling = false;
   bool threads_compare = false;
   std::vector<int> scales = {1, 2, 4, 8};
+  std::string cells;  // "" : the problem's own
 };
 
 void PrintBenchTable(const BenchResult& r) {
@@ -135,6 +140,7 @@ int RunBenchArgs(const BenchArgs& args) {
   BenchOptions options = args.options;
   options.methods = ParseMethods(args.methods);
   options.adjoint_solver = ParseAdjointSolver(args.adjoint_solver);
+  if (!args.cells.empty()) options.cantilever_cells = ParseCells(args.cells);
   if (args.scaling) {
     const ScalingResult r = RunScaling(args.problem, options, args.scales, &std::cerr);
     if (args.json)
@@ -200,6 +206,11 @@ Subcommand AddBenchCommand(CLI::App* parent) {
                   "double the cells this many times (cycling x, y, z; negative halves); cantilever -9 = 4x1x1")
       ->check(IntegerIn("--refine", kMinRefinement, kMaxRefinement))
       ->capture_default_str();
+  cmd->add_option("--cells", args->cells,
+                  "cantilever: cells along x, y, z as NXxNYxNZ, before --refine's doublings (default 32x8x8)");
+  cmd->add_option("--factor-copy-max-gib", args->options.factor_copy_max_gib,
+                  "largest copy of the PD factor for parallel solves, GiB (default: the library's, 4; 0: none)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--seed", args->options.seed, "seed of the loss vectors")->capture_default_str();
   cmd->add_flag("--json", args->json, "print one JSON document (a list) on stdout");
   CLI::Option* scaling =

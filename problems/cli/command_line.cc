@@ -125,7 +125,7 @@ Exit code 4 when an input fails.)");
   const auto tradeoff = AddTradeoffCommand(&app);
   const auto stress = AddStressCommand(&app);
   const auto synth = AddSynthCommand(&app);
-  const auto table = AddTableCommand(&app);
+  const auto table = AddTableCommand(&app, argv);
 
   try {
     // CLI11 wants argv in reverse order, without the program name.

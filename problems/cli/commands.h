@@ -83,7 +83,8 @@ Subcommand AddBenchCommand(CLI::App* parent);     // bench_command.cc
 Subcommand AddTradeoffCommand(CLI::App* parent);  // tradeoff_command.cc
 Subcommand AddStressCommand(CLI::App* parent);    // stress_command.cc
 Subcommand AddSynthCommand(CLI::App* parent);     // synth_command.cc
-Subcommand AddTableCommand(CLI::App* parent);     // table_command.cc
+// `argv`: the program's whole command line, stored in the table's result.
+Subcommand AddTableCommand(CLI::App* parent, const std::vector<std::string>& argv);  // table_command.cc
 
 // `diffpd run`'s options that only some kinds of problem read (--small,
 // --no-compare, --ipopt: optimisation; --evaluations, --seed, --optimizer: control

@@ -29,6 +29,9 @@ evaluations of the loss and its gradient at x_init on a fresh simulator.
 Columns: mean forward and backward seconds per evaluation, evaluations, loss
 at x_init normalised as the paper does, speed-up (best Newton over pd-lbfgs),
 each beside the paper's number (8 threads, means over its optimisation).
+--optimise then optimises every optimised row with each PD method by
+--optimizer: lbfgsb (L-BFGS-B, the paper's optimiser, with the row's scipy
+settings) or ipopt (limited-memory Hessian, stopped by L-BFGS-B's ftol test).
 --json FILE is rewritten after every draw and method, so an interrupted run
 keeps what it measured; --resume reads FILE back and skips what is done.
 A progress line per evaluation goes to stderr.)";
@@ -37,6 +40,7 @@ struct TableArgs {
   std::vector<std::string> rows = PaperRowNames();
   std::vector<std::string> methods = {"pd-lbfgs", "newton-pcg", "newton-cholesky"};
   std::string masses = "equal-nodes";
+  std::string optimizer = "lbfgsb";
   TableOptions options;
   std::string json_file;
   bool resume = false;
@@ -70,7 +74,7 @@ std::string CommandLine(const TableArgs& a) {
     << a.options.threads << " --evaluations " << a.options.evaluations << " --newton-evaluations "
     << a.options.newton_evaluations << " --draws " << a.options.random_draws << " --masses " << a.masses;
   if (a.small) s << " --small";
-  if (a.options.optimise) s << " --optimise";
+  if (a.options.optimise) s << " --optimise --optimizer " << a.optimizer;
   if (a.options.optimiser_evaluations > 0) s << " --optimiser-evaluations " << a.options.optimiser_evaluations;
   if (a.options.optimiser_minutes > 0) s << " --optimiser-minutes " << a.options.optimiser_minutes;
   if (a.options.budget_minutes > 0) s << " --budget-minutes " << a.options.budget_minutes;
@@ -84,6 +88,7 @@ int RunTableArgs(const TableArgs& args) {
   options.rows = args.rows;
   options.methods = ParseMethods(args.methods);
   options.masses = ParseMassLumping(args.masses);
+  options.optimizer = ParseRowOptimizer(args.optimizer);
   options.size = args.small ? RowSize::kSmall : RowSize::kPaper;
   std::unique_ptr<TableResult> previous;
   if (args.report) {
@@ -115,10 +120,27 @@ int RunTableArgs(const TableArgs& args) {
   return 0;
 }
 
+// The arguments joined by spaces, those with characters a shell treats
+// specially single-quoted.
+std::string ShellLine(const std::vector<std::string>& argv) {
+  std::string line;
+  for (const std::string& a : argv) {
+    const bool plain = !a.empty() && a.find_first_not_of(
+                                         "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                                         "0123456789_./,=:+-@%") == std::string::npos;
+    std::string quoted = "'";
+    for (char c : a) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    quoted += "'";
+    line += (line.empty() ? "" : " ") + (plain ? a : quoted);
+  }
+  return line;
+}
+
 }  // namespace
 
-Subcommand AddTableCommand(CLI::App* parent) {
+Subcommand AddTableCommand(CLI::App* parent, const std::vector<std::string>& argv) {
   auto args = std::make_shared<TableArgs>();
+  args->options.command = ShellLine(argv);
   CLI::App* cmd =
       parent->add_subcommand("table", "the DiffPD paper's table (rows 1-9) measured here, beside the paper's numbers");
   cmd->footer(kTableFooter);
@@ -152,8 +174,11 @@ Subcommand AddTableCommand(CLI::App* parent) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_flag("--optimise", args->options.optimise,
-                "then optimise every optimised row with each PD method (Ipopt, limited-memory Hessian, the row's "
-                "bounds and evaluation budget); Newton methods stay timed at x_init");
+                "then optimise every optimised row with each PD method (--optimizer, the row's bounds and evaluation "
+                "budget); Newton methods stay timed at x_init");
+  cmd->add_option("--optimizer", args->optimizer,
+                  "the optimiser of --optimise: lbfgsb (L-BFGS-B, the paper's) or ipopt (limited-memory Hessian)")
+      ->capture_default_str();
   cmd->add_option("--optimiser-evaluations", args->options.optimiser_evaluations,
                   "loss evaluations per optimisation (0: the row's budget)")
       ->check(CLI::NonNegativeNumber)

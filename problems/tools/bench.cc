@@ -48,6 +48,7 @@ SolverOptions MethodOptions(Method method, const BenchOptions& o, double time_st
   s.max_iterations = o.max_iterations;
   s.lbfgs_weight_scale = o.lbfgs_weight_scale;
   s.rigid_mode_correction = o.rigid_mode_correction;
+  if (o.factor_copy_max_gib >= 0) s.pd_factor_copy_max_bytes = o.factor_copy_max_gib * 1073741824.0;
   return s;
 }
 
@@ -64,7 +65,7 @@ struct Setup {
 
 Setup MakeSetup(const std::string& name, int doublings, const BenchOptions& o) {
   Setup s;
-  s.problem = MakeRefinedProblem(name, doublings);
+  s.problem = MakeRefinedProblem(name, doublings, o.cantilever_cells);
   s.scene = s.problem->MakeScene();
   s.steps = o.steps > 0 ? o.steps : s.problem->default_steps();
   s.time_step = o.time_step > 0 ? o.time_step : s.problem->default_time_step();
@@ -96,9 +97,22 @@ nlohmann::json NumberOrNull(bool ok, double v) { return ok ? nlohmann::json(v) :
 
 }  // namespace
 
-std::unique_ptr<Problem> MakeRefinedProblem(const std::string& name, int doublings) {
+std::unique_ptr<Problem> MakeRefinedProblem(const std::string& name, int doublings,
+                                            const std::array<int, 3>& cantilever_cells) {
   std::unique_ptr<Problem> problem = MakeProblem(name);  // an unknown name: the list of problems
-  if (doublings == 0) return problem;
+  const bool own_cells = cantilever_cells != std::array<int, 3>{0, 0, 0};
+  if (own_cells) {
+    if (name != "cantilever")
+      throw InvalidInputError("cells are available for cantilever only, not for '" + name + "'");
+    for (int c : cantilever_cells)
+      if (c < 1 || c > kMaxCantileverCells) {
+        std::ostringstream msg;
+        msg << "cells = " << cantilever_cells[0] << "x" << cantilever_cells[1] << "x" << cantilever_cells[2]
+            << " is invalid: each count must be in [1, " << kMaxCantileverCells << "]";
+        throw InvalidInputError(msg.str());
+      }
+  }
+  if (doublings == 0 && !own_cells) return problem;
   const bool refinable =
       name == "cantilever" || name == "falling-cube" || name == "bouncing-ball" || name == "rolling-sphere";
   if (refinable && (doublings < kMinRefinement || doublings > kMaxRefinement)) {
@@ -108,13 +122,13 @@ std::unique_ptr<Problem> MakeRefinedProblem(const std::string& name, int doublin
     throw InvalidInputError(msg.str());
   }
   if (name == "cantilever") {
-    int cells[3] = {32, 8, 8};
+    std::array<int, 3> cells = own_cells ? cantilever_cells : std::array<int, 3>{32, 8, 8};
     for (int i = 0; i < std::abs(doublings); ++i) {
       const int axis = doublings > 0 ? i % 3 : 2 - i % 3;
       if (doublings > 0) {
         cells[axis] *= 2;
       } else {
-        cells[axis] /= 2;  // 32 x 8 x 8 halves 9 times, to 4 x 1 x 1
+        cells[axis] = std::max(1, cells[axis] / 2);  // 32 x 8 x 8 halves 9 times, to 4 x 1 x 1
       }
     }
     return std::make_unique<Cantilever>(cells[0], cells[1], cells[2]);
@@ -131,6 +145,16 @@ std::unique_ptr<Problem> MakeRefinedProblem(const std::string& name, int doublin
   throw InvalidInputError("problem '" + name +
                           "' cannot be refined: refinement is available for cantilever, falling-cube, bouncing-ball "
                           "and rolling-sphere");
+}
+
+std::array<int, 3> ParseCells(const std::string& text) {
+  std::array<int, 3> cells{};
+  std::istringstream in(text);
+  char x1 = 0, x2 = 0;
+  std::string rest;
+  if (!(in >> cells[0] >> x1 >> cells[1] >> x2 >> cells[2]) || x1 != 'x' || x2 != 'x' || (in >> rest))
+    throw InvalidInputError("cells = '" + text + "' is invalid: must be three cell counts NXxNYxNZ, e.g. 172x43x43");
+  return cells;
 }
 
 std::vector<Method> ParseMethods(const std::vector<std::string>& names) {
@@ -178,6 +202,7 @@ RolloutMeasurement MeasureRollout(const Scene& scene, const SolverOptions& optio
       m.backward_fallbacks = g.report.fallbacks;
       m.backward_iterative_steps = g.report.iterative_steps;
       m.backward_direct_steps = g.report.direct_steps;
+      m.factor_copy_bytes = static_cast<double>(sim.pd_factor_copy_bytes());
       const int n = sim.num_dofs();
       Eigen::Index activations = 0;
       for (const VectorXd& a : g.activation) activations += a.size();
@@ -246,6 +271,8 @@ void BenchOptions::Validate() const {
   if (max_iterations < 1) fail("max iterations", max_iterations, ">= 1");
   if (!(lbfgs_weight_scale > 0 && lbfgs_weight_scale <= 1)) fail("lbfgs scale", lbfgs_weight_scale, "in (0, 1]");
   if (!std::isfinite(time_step)) fail("dt", time_step, "finite (> 0, or <= 0 for the default)");
+  if (std::isnan(factor_copy_max_gib))
+    fail("factor copy max GiB", factor_copy_max_gib, ">= 0, infinity, or < 0 for the library's default");
 }
 
 BenchResult RunBench(const std::string& problem, const BenchOptions& options, std::ostream* progress) {
@@ -423,6 +450,8 @@ ScalingResult RunScaling(const std::string& problem, const BenchOptions& options
         row.factorization_s = m.factorization_s;
         row.iteration_ms = m.total_iterations > 0 ? 1e3 * (m.forward_s - m.factorization_s) / m.total_iterations : 0;
         row.backward_per_step_ms = 1e3 * m.backward_s / s.steps;
+        row.backward_direct_steps = m.backward_direct_steps;
+        row.factor_copy_mib = m.factor_copy_bytes / 1048576.0;
       }
       row.peak_rss_mib = PeakRssMib();
       result.rows.push_back(row);
@@ -467,6 +496,8 @@ nlohmann::json ScalingToJson(const ScalingResult& result) {
          {"factorization_s", NumberOrNull(ok, r.factorization_s)},
          {"iteration_ms", NumberOrNull(ok, r.iteration_ms)},
          {"backward_per_step_ms", NumberOrNull(ok, r.backward_per_step_ms)},
+         {"backward_direct_steps", ok ? nlohmann::json(r.backward_direct_steps) : nlohmann::json(nullptr)},
+         {"factor_copy_mib", NumberOrNull(ok, r.factor_copy_mib)},
          {"peak_rss_mib", r.peak_rss_mib},
          {"exponent_per_iteration",
           exponent == result.exponent_per_iteration.end() ? nlohmann::json(nullptr) : nlohmann::json(exponent->second)},

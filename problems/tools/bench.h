@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <array>
 #include <map>
 #include <memory>
 #include <optional>
@@ -46,6 +47,8 @@ inline constexpr double kReferenceBackwardRelTolerance = 1e-12;
 // million hexes for the cantilever), beyond what a run on one machine holds.
 inline constexpr int kMinRefinement = -9;
 inline constexpr int kMaxRefinement = 12;
+// The most cells along one axis of a cantilever given by its cells.
+inline constexpr int kMaxCantileverCells = 4096;
 
 // The registered problem `name` with its cell count doubled `doublings` times
 // (cycling over x, y, z; a negative count halves z, y, x in turn), so that
@@ -60,7 +63,15 @@ inline constexpr int kMaxRefinement = 12;
 // the problems), for other problems with doublings != 0, and for doublings
 // outside [kMinRefinement, kMaxRefinement]: "refinement = 100 is invalid for
 // cantilever: it must be in [-9, 12] (12: 4096 times the cells)".
-std::unique_ptr<Problem> MakeRefinedProblem(const std::string& name, int doublings);
+// `cantilever_cells` (cantilever only; all 0: its 32 x 8 x 8) are the cells
+// along x, y, z that the doublings start from.
+std::unique_ptr<Problem> MakeRefinedProblem(const std::string& name, int doublings,
+                                            const std::array<int, 3>& cantilever_cells = {0, 0, 0});
+
+// "NXxNYxNZ" (e.g. "172x43x43") as three cell counts; throws
+// InvalidInputError: "cells = '12x3' is invalid: must be three cell counts
+// NXxNYxNZ, e.g. 172x43x43". MakeRefinedProblem checks their range.
+std::array<int, 3> ParseCells(const std::string& text);
 
 // Methods from their names (ParseMethod each); throws InvalidInputError.
 std::vector<Method> ParseMethods(const std::vector<std::string>& names);
@@ -94,6 +105,9 @@ struct RolloutMeasurement {
   // Hessian (BackwardReport), of the last run.
   int backward_iterative_steps = 0;
   int backward_direct_steps = 0;
+  // Bytes of the PD factor's copy for parallel solves (0: none, CHOLMOD
+  // solves; Simulator::pd_factor_copy_bytes), of the last run.
+  double factor_copy_bytes = 0;
   // Forward steps of the last run that ended at the rounding floor or were
   // finished by Newton after a PD-LBFGS stall (StepReport).
   int rounding_floor_steps = 0;
@@ -134,7 +148,13 @@ struct BenchOptions {
   bool rigid_mode_correction = SolverOptions().rigid_mode_correction;  // pd-lbfgs, PD backward
   int repeat = 1;                                                      // runs per method (median), >= 1
   int refine = 0;                                                      // MakeRefinedProblem doublings
-  std::uint64_t seed = 20211;                                          // loss vectors
+  // The cantilever's cells along x, y, z before the doublings, each in [1,
+  // kMaxCantileverCells]; all 0 (default): the problem's 32 x 8 x 8.
+  std::array<int, 3> cantilever_cells = {0, 0, 0};
+  // SolverOptions::pd_factor_copy_max_bytes in GiB; < 0 (default): the
+  // library's default.
+  double factor_copy_max_gib = -1;
+  std::uint64_t seed = 20211;  // loss vectors
 
   // Throws InvalidInputError naming the field, its value and the valid range.
   void Validate() const;
@@ -216,6 +236,8 @@ struct ScalingRow {
   double factorization_s = 0;           // PD's one-off factorisation within forward_s
   double iteration_ms = 0;              // (forward_s - factorization_s) / iterations
   double backward_per_step_ms = 0;
+  int backward_direct_steps = 0;  // backward steps solved by a factorisation of H
+  double factor_copy_mib = 0;     // the PD factor's copy (0: CHOLMOD solves)
   double peak_rss_mib = 0;
 };
 struct ScalingResult {

@@ -15,9 +15,7 @@
 #include "diffpd/error.h"
 #include "paper/paper_rows.h"
 #include "paper/row_evaluation.h"
-#if DIFFPD_WITH_IPOPT
 #include "paper/row_optimisation.h"
-#endif
 #include "tools/openmp_waits.h"
 
 #ifndef DIFFPD_SOURCE_DIR
@@ -163,6 +161,13 @@ class Budget {
   double seconds_;
 };
 
+bool HoldsOptimisation(const TableResult& result) {
+  for (const TableRowResult& r : result.rows)
+    for (const TableMethodResult& m : r.methods)
+      if (m.optimisation) return true;
+  return false;
+}
+
 std::string Seconds(double s) {
   std::ostringstream out;
   out.precision(4);
@@ -198,8 +203,9 @@ void TableOptions::Validate() const {
   if (newton_evaluations < 1) ThrowInvalidOption("newton evaluations", newton_evaluations, ">= 1");
   if (!std::isfinite(optimiser_minutes))
     ThrowInvalidOption("optimiser minutes", optimiser_minutes, "finite (<= 0: none)");
-  if (optimise && !DIFFPD_WITH_IPOPT)
-    throw InvalidInputError("optimise: this build has no Ipopt adapter (configure with DIFFPD_WITH_IPOPT=ON)");
+  if (optimise && optimizer == RowOptimizer::kIpopt && !DIFFPD_WITH_IPOPT)
+    throw InvalidInputError(
+        "optimizer ipopt: this build has no Ipopt adapter (configure with DIFFPD_WITH_IPOPT=ON, or use lbfgsb)");
 }
 
 TableResult RunTable(const TableOptions& options, const TableResult* previous,
@@ -221,6 +227,9 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
       msg << "resume: the file has " << previous->evaluations << " evaluations per PD method and "
           << previous->newton_evaluations << " per Newton method, this run asks for " << options.evaluations << " and "
           << options.newton_evaluations;
+    else if (options.optimise && HoldsOptimisation(*previous) && previous->optimizer != ToString(options.optimizer))
+      msg << "resume: the file was optimised with " << previous->optimizer << ", this run asks for "
+          << ToString(options.optimizer);
     if (!msg.str().empty()) throw InvalidInputError(msg.str());
   }
   const Budget budget(options.budget_minutes);
@@ -228,13 +237,19 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
   result.date = UtcNow();
   result.commit = SourceCommit();
   result.machine = MachineLabel();
+  result.command = options.command;
+  result.optimizer = ToString(options.optimizer);
   if (previous) {
     result.resumed_runs = previous->resumed_runs;
     if (options.measure)
-      result.resumed_runs.push_back(result.date + ", commit " + result.commit + ", " + result.machine);
+      result.resumed_runs.push_back(result.date + ", commit " + result.commit + ", " + result.machine +
+                                    (options.command.empty() ? "" : ": " + options.command));
     result.date = previous->date;
     result.commit = previous->commit;
     result.machine = previous->machine;
+    result.command = previous->command;
+    // A file that holds no optimisation yet takes this run's optimizer.
+    if (!options.measure || HoldsOptimisation(*previous)) result.optimizer = previous->optimizer;
   }
   const bool report = previous && !options.measure;
   result.threads = report ? previous->threads : options.threads;
@@ -380,9 +395,9 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
           Progress(progress, line.str());
         }
         m.complete = m.evaluations == count;
-#if DIFFPD_WITH_IPOPT
         if (m.complete && optimises(method) && !m.optimisation && !budget.spent()) {
           RowOptimisationOptions o;
+          o.optimizer = options.optimizer;
           o.max_evaluations = options.optimiser_evaluations;
           o.budget_seconds = 60 * options.optimiser_minutes;
           o.on_evaluation = [&](long k, double loss, double forward_s) {
@@ -393,6 +408,7 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
           };
           const RowOptimisationResult r = OptimiseRow(row, row.Options(method, options.threads), o);
           TableOptimisation t;
+          t.optimizer = r.optimizer;
           t.status = r.status;
           t.stopped_by = r.stopped_by;
           t.iterations = r.iterations;
@@ -407,12 +423,12 @@ TableResult RunTable(const TableOptions& options, const TableResult* previous,
           t.loss_history = r.loss_history;
           m.optimisation = t;
           std::ostringstream line;
-          line << "[table] " << name << " " << m.method << " optimiser: " << r.status << " (stopped by " << r.stopped_by
-               << "), " << r.iterations << " iterations, " << r.evaluations << " evaluations, " << r.gradients
-               << " gradients, loss " << r.initial_loss << " -> " << r.final_loss << ", " << Seconds(r.total_s);
+          line << "[table] " << name << " " << m.method << " optimiser " << r.optimizer << ": " << r.status
+               << " (stopped by " << r.stopped_by << "), " << r.iterations << " iterations, " << r.evaluations
+               << " evaluations, " << r.gradients << " gradients, loss " << r.initial_loss << " -> " << r.final_loss
+               << ", " << Seconds(r.total_s);
           Progress(progress, line.str());
         }
-#endif
       } catch (const SolverError& e) {
         m.failure = std::string(ToString(e.status())) + ": " + e.what();
         m.complete = true;
@@ -475,7 +491,8 @@ T Field(const json& j, const std::string& key, const std::string& where) {
 json OptimisationJson(const TableOptimisation& t) {
   json history = json::array();
   for (double l : t.loss_history) history.push_back(Number(l));
-  return {{"status", t.status},
+  return {{"optimizer", t.optimizer},
+          {"status", t.status},
           {"stopped_by", t.stopped_by},
           {"iterations", t.iterations},
           {"evaluations", t.evaluations},
@@ -496,6 +513,8 @@ double NumberOrNan(const json& j, const std::string& key) {
 
 TableOptimisation OptimisationFromJson(const json& j, const std::string& where) {
   TableOptimisation t;
+  // Optimisations written before the optimizer was recorded are Ipopt's.
+  t.optimizer = j.contains("optimizer") ? Field<std::string>(j, "optimizer", where) : "ipopt";
   t.status = Field<std::string>(j, "status", where);
   t.stopped_by = Field<std::string>(j, "stopped_by", where);
   t.iterations = Field<int>(j, "iterations", where);
@@ -569,6 +588,8 @@ json TableToJson(const TableResult& result) {
           {"threads", result.threads},
           {"size", result.size},
           {"masses", result.masses},
+          {"optimizer", result.optimizer},
+          {"command", result.command},
           {"evaluations", result.evaluations},
           {"newton_evaluations", result.newton_evaluations},
           {"budget_exhausted", result.budget_exhausted},
@@ -585,6 +606,9 @@ TableResult TableFromJson(const json& j) {
   result.size = Field<std::string>(j, "size", "the document");
   // Files written before masses were an option hold lumped rows.
   if (j.contains("masses")) result.masses = Field<std::string>(j, "masses", "the document");
+  // Files written before these were stored: Ipopt, no command.
+  if (j.contains("optimizer")) result.optimizer = Field<std::string>(j, "optimizer", "the document");
+  if (j.contains("command")) result.command = Field<std::string>(j, "command", "the document");
   result.evaluations = Field<int>(j, "evaluations", "the document");
   result.newton_evaluations = Field<int>(j, "newton_evaluations", "the document");
   result.budget_exhausted = Field<bool>(j, "budget_exhausted", "the document");

@@ -32,6 +32,7 @@
 
 #include "diffpd/solver_options.h"
 #include "paper/paper_row.h"
+#include "paper/row_optimisation.h"
 
 namespace diffpd::problems {
 
@@ -56,14 +57,18 @@ struct TableOptions {
   // false: measure nothing; only rebuild the report of `previous` (RunTable).
   bool measure = true;
   // After the evaluations at x_init, optimise every optimised row with each
-  // PD method (pd-lbfgs, pd) through row_optimisation.h (Ipopt, limited-memory
-  // Hessian, the row's bounds); the Newton methods are timed at x_init only.
-  // Needs the Ipopt adapter (InvalidInputError otherwise).
+  // PD method (pd-lbfgs, pd) through row_optimisation.h with `optimizer`
+  // (L-BFGS-B, the paper's, or Ipopt; the row's bounds and budget); the
+  // Newton methods are timed at x_init only. Ipopt needs the Ipopt adapter
+  // (InvalidInputError otherwise).
   bool optimise = false;
+  RowOptimizer optimizer = RowOptimizer::kLbfgsb;
   // Loss evaluations per optimisation; <= 0: the row's budget (maxfun).
   int optimiser_evaluations = 0;
   // Wall-clock minutes per optimisation (it stops at its next iteration); <= 0: none.
   double optimiser_minutes = 0;
+  // The command line that runs the table, stored in the result ("" : none).
+  std::string command;
 
   TableOptions();  // rows = every row
   // Throws InvalidInputError naming the field, its value and the valid range
@@ -73,15 +78,16 @@ struct TableOptions {
 
 // One optimisation of a row with one method (row_optimisation.h).
 struct TableOptimisation {
-  std::string status;      // Ipopt's return status
-  std::string stopped_by;  // "optimiser", "relative decrease", "evaluation budget" or "time budget"
+  std::string optimizer;   // "lbfgsb" or "ipopt"
+  std::string status;      // L-BFGS-B's stop or Ipopt's return status
+  std::string stopped_by;  // RowOptimisationResult::stopped_by
   int iterations = 0;
   long evaluations = 0, gradients = 0, failed_evaluations = 0;
   double forward_s = 0, backward_s = 0;  // means per rollout and per adjoint pass
   double total_s = 0;
   double initial_loss = 0, final_loss = 0;
   std::optional<double> normalised_loss;  // of final_loss
-  std::vector<double> loss_history;       // per Ipopt iteration
+  std::vector<double> loss_history;       // per iteration
 };
 
 struct TableMethodResult {
@@ -134,18 +140,23 @@ struct TableResult {
   int threads = 0;
   std::string size;
   std::string masses = "lumped";  // ToString(MassLumping) of the rows' masses
+  // The optimiser of --optimise (ToString(RowOptimizer)); files written
+  // before it was an option were optimised with Ipopt.
+  std::string optimizer = "ipopt";
+  std::string command;  // the command line of the first run ("" if not stored)
   int evaluations = 0, newton_evaluations = 0;
   bool budget_exhausted = false;
-  // "<date>, commit <commit>" of each later run that resumed this result.
+  // "<date>, commit <commit>, <machine>[: <command>]" of each later run that
+  // resumed this result.
   std::vector<std::string> resumed_runs;
   std::vector<TableRowResult> rows;
 };
 
 // Runs the table. `previous` (may be nullptr) is a result to resume from: its
 // complete rows and methods and its random-draw losses are kept, and so are
-// its date, commit and machine, this run being added to resumed_runs (it must
-// have the same size, masses, threads and evaluation counts; InvalidInputError
-// otherwise). `checkpoint` (may be empty) receives the whole result after
+// its date, commit, machine and command, this run being added to resumed_runs
+// (it must have the same size, masses, threads, evaluation counts and, when it
+// optimises, optimizer; InvalidInputError otherwise). `checkpoint` (may be empty) receives the whole result after
 // every draw and method; progress lines (one per evaluation) go to
 // `progress` (nullptr: silent). Throws InvalidInputError on bad options.
 TableResult RunTable(const TableOptions& options, const TableResult* previous,

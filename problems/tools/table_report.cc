@@ -118,13 +118,22 @@ void SplitNotes(const TableResult& result, std::vector<std::string>* shared,
   }
 }
 
+// How the rows were optimised, by the optimizer that did it.
+std::string OptimiserDescription(const std::string& optimizer) {
+  if (optimizer == "lbfgsb")
+    return "L-BFGS-B, the paper's optimiser, with the row's memory, ftol, gtol, iteration limit, evaluation budget "
+           "and bounds";
+  return "Ipopt, limited-memory Hessian, the row's bounds and evaluation budget, stopped by L-BFGS-B's ftol test";
+}
+
 std::string Explanation(const TableResult& result) {
   std::ostringstream s;
   s << "Seconds are wall-clock means per evaluation of the loss and its gradient at x_init (" << result.evaluations
     << " evaluations per PD method, " << result.newton_evaluations
     << " per Newton method); the paper's are means over its whole optimisation, on 8 threads. evals and loss "
-       "(norm): for a method that optimised the row (Ipopt, limited-memory Hessian, the row's bounds and "
-       "evaluation budget), its loss evaluations and final loss; in parentheses, a method timed at x_init only: "
+       "(norm): for a method that optimised the row ("
+    << OptimiserDescription(result.optimizer)
+    << "), its loss evaluations and final loss; in parentheses, a method timed at x_init only: "
        "its evaluations there and the loss at x_init. loss (norm) is (L - l) / (L_random - l), L_random the mean "
        "pd-lbfgs loss of the row's 16 random draws, l = 0 or pd-lbfgs's final loss as the paper's row says. "
        "speed-up: best Newton (forward + backward at x_init) over pd-lbfgs (at x_init); on a Newton method's line, "
@@ -135,10 +144,11 @@ std::string Explanation(const TableResult& result) {
 // "<status>, stopped by <what>, 12 iterations, 15 evaluations, ..." of one optimisation.
 std::string OptimisationLine(const TableOptimisation& t) {
   std::ostringstream s;
-  s << t.status << " (stopped by " << t.stopped_by << "), " << t.iterations << " iterations, " << t.evaluations
-    << " evaluations (" << t.failed_evaluations << " failed), " << t.gradients << " gradients, forward "
-    << Seconds(t.forward_s) << " s and backward " << Seconds(t.backward_s) << " s per evaluation, "
-    << Seconds(t.total_s) << " s in all, loss " << Sci(t.initial_loss) << " -> " << Sci(t.final_loss);
+  s << t.optimizer << ", " << t.status << " (stopped by " << t.stopped_by << "), " << t.iterations << " iterations, "
+    << t.evaluations << " evaluations (" << t.failed_evaluations << " failed), " << t.gradients
+    << " gradients, forward " << Seconds(t.forward_s) << " s and backward " << Seconds(t.backward_s)
+    << " s per evaluation, " << Seconds(t.total_s) << " s in all, loss " << Sci(t.initial_loss) << " -> "
+    << Sci(t.final_loss);
   return s.str();
 }
 
@@ -148,6 +158,7 @@ void PrintTable(const TableResult& result, std::FILE* out) {
   std::fprintf(out, "# DiffPD paper table, %s instances, %s masses: %s, commit %s, %s, %d threads\n",
                result.size.c_str(), result.masses.c_str(), result.date.c_str(), result.commit.c_str(),
                result.machine.c_str(), result.threads);
+  if (!result.command.empty()) std::fprintf(out, "# command: %s\n", result.command.c_str());
   for (const std::string& run : result.resumed_runs) std::fprintf(out, "# resumed %s\n", run.c_str());
   const std::vector<Cells> cells = TableCells(result);
   std::vector<size_t> width(13);
@@ -185,7 +196,10 @@ void PrintTable(const TableResult& result, std::FILE* out) {
 std::string TableMarkdown(const TableResult& result, const std::string& command) {
   std::ostringstream s;
   s << "Measured " << result.date << ", commit " << result.commit << ", " << result.machine << ", " << result.threads
-    << " threads, " << result.size << " instances, " << result.masses << " masses:\n\n    " << command << "\n\n";
+    << " threads, " << result.size << " instances, " << result.masses << " masses:\n\n    "
+    << (result.command.empty() ? command : result.command) << "\n\n";
+  for (const std::string& run : result.resumed_runs) s << "Resumed " << run << "\n\n";
+  if (!result.command.empty() && command != result.command) s << "Reported by:\n\n    " << command << "\n\n";
   s << "|";
   for (const char* h : kHeader) s << " " << h << " |";
   s << "\n|";
@@ -225,7 +239,8 @@ void WriteTablePlot(const TableResult& result, const std::string& png_path) {
   double low = 1e300;
   bool any = false;
   for (const TableRowResult& r : result.rows) {
-    data << "'" << r.row << "'";
+    // Double quotes: gnuplot keeps single quotes in inline data as part of the label.
+    data << "\"" << r.row << "\"";
     for (const std::string& name : methods) {
       const TableMethodResult* m = r.method(name);
       const PaperMethodNumbers* p = PaperEntry(r, name);

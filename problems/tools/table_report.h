@@ -16,7 +16,9 @@ namespace diffpd::problems {
 void PrintTable(const TableResult& result, std::FILE* out);
 
 // The same as a Markdown document: a header with the date, commit, machine,
-// threads and `command`, the table, the model differences (shared ones once,
+// threads and the command that measured the result (`command` for a result
+// that does not store one; `command` too when it differs: the report's), the
+// resumed runs, the table, the model differences (shared ones once,
 // then per row).
 std::string TableMarkdown(const TableResult& result, const std::string& command);
 

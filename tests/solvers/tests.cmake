@@ -1,6 +1,7 @@
-# The optimiser side (solvers/), mirrored: the rollout core and each adapter
-# that is built.
+# The optimiser side (solvers/), mirrored: the rollout core, the L-BFGS-B
+# minimiser and each adapter that is built.
 include(${CMAKE_CURRENT_LIST_DIR}/core/tests.cmake)
+include(${CMAKE_CURRENT_LIST_DIR}/lbfgsb/tests.cmake)
 if(TARGET diffpd_ceres)
   include(${CMAKE_CURRENT_LIST_DIR}/ceres/tests.cmake)
 endif()

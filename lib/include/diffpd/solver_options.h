@@ -206,6 +206,18 @@ struct SolverOptions {
   // in use.
   double pd_factor_copy_max_bytes = 4294967296.0;
 
+  // The PD methods' direct adjoint and tangent solves factorise the 3n x 3n
+  // step Hessian H, whose factor holds about 9 times the entries of the PD
+  // factor (3 x 3 blocks per node pair; 8 bytes each): 18 GiB on a
+  // million-DoF beam. When that estimate exceeds this many bytes, kAuto
+  // keeps to the iteration (the direct solve is neither timed nor used) and
+  // an iterative solve that fails raises SolverError(kMaxIterations) naming
+  // this bound instead of falling back to a factorisation that may not fit
+  // in memory; kDirect is always honoured. Default 8 GiB, fixed for the same
+  // reason as the copy's bound; >= 0 (0: never a direct PD adjoint unless
+  // kDirect, infinity: no bound).
+  double adjoint_direct_max_bytes = 8589934592.0;
+
   // Each SVD of the elastic forces (one per quadrature sample) starts its
   // iterations from the previous evaluation's result at that sample (true,
   // default: fewer sweeps) or, false, from the identity at the start of

@@ -1,5 +1,6 @@
 #include "solver/pd_system.h"
 
+#include <algorithm>
 #include <chrono>
 #include <sstream>
 
@@ -171,6 +172,13 @@ std::size_t PdSystem::copy_bytes() const {
   for (const Group& g : groups_)
     if (g.solver->parallel_copy()) bytes += g.solver->parallel_copy()->bytes();
   return bytes;
+}
+
+double PdSystem::factor_nonzeros() const {
+  double entries = 0;
+  for (const Group& g : groups_)
+    if (g.solver->num_analyses() > 0) entries = std::max(entries, g.solver->factor_nonzeros());
+  return entries;
 }
 
 void PdSystem::SetAuxiliaryMatrix(const SparseMatrix& auxiliary) {

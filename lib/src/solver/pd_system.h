@@ -57,6 +57,9 @@ class PdSystem {
   void SetCopyMaxBytes(double bytes);
   // Bytes of the factors' copies in use (0: none, CHOLMOD solves).
   std::size_t copy_bytes() const;
+  // Entries of the largest factor (CholmodSolver::factor_nonzeros; 0 before
+  // the first Update).
+  double factor_nonzeros() const;
   // y = A x over the free DoFs (fixed rows and columns erased).
   VectorXd Apply(const VectorXd& x) const;
 

@@ -254,6 +254,11 @@ class StepLinearization {
   // solve used it since), sparse LU where H is indefinite. False for a
   // singular H; throws SolverError(kNonFinite) when z overflows.
   bool DirectSolve(const MatrixXd& b, MatrixXd* z);
+  // PD methods: the estimated bytes of a factor of H, and whether a direct
+  // solve may run (SolverOptions::adjoint_direct_max_bytes, or kDirect).
+  static constexpr double kHessianFactorEntriesPerPdEntry = 9;
+  double DirectAdjointBytes();
+  bool DirectAdjointFits();
   // The PD-preconditioned iteration (options.pd_backward) on the columns of
   // b in lockstep; ok[c] tells which converged.
   void IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, std::vector<char>* ok, int* iterations);

@@ -108,6 +108,9 @@ void SolverOptions::Validate() const {
   if (adjoint_guess_solutions < 0) Reject("adjoint_guess_solutions", adjoint_guess_solutions, ">= 0");
   if (!(pd_factor_copy_max_bytes >= 0))
     Reject("pd_factor_copy_max_bytes", pd_factor_copy_max_bytes, ">= 0 (0: never a copy, infinity: always)");
+  if (!(adjoint_direct_max_bytes >= 0))
+    Reject("adjoint_direct_max_bytes", adjoint_direct_max_bytes,
+           ">= 0 (0: no direct PD adjoint unless kDirect, infinity: no bound)");
   if (!(max_extent_ratio > 1)) Reject("max_extent_ratio", max_extent_ratio, "> 1 (infinity: no bound)");
   if (num_threads < 0 || num_threads > MaxSolverThreads()) {
     std::ostringstream range;

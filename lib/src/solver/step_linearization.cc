@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cstdio>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include <Eigen/IterativeLinearSolvers>
@@ -173,6 +174,15 @@ bool StepLinearization::PcgSolve(const VectorXd& b, VectorXd* z, int* iterations
   return cg.info() == Eigen::Success && z->allFinite();
 }
 
+double StepLinearization::DirectAdjointBytes() {
+  return kHessianFactorEntriesPerPdEntry * sizeof(double) * sim_.pd_system().factor_nonzeros();
+}
+
+bool StepLinearization::DirectAdjointFits() {
+  return sim_.options.adjoint_solver == AdjointSolver::kDirect ||
+         DirectAdjointBytes() <= sim_.options.adjoint_direct_max_bytes;
+}
+
 VectorXd StepLinearization::Solve(const VectorXd& b, BackwardReport* report) {
   return SolveSystem(b, &sim_.backward_cost_model(), /*tangent=*/false, report).col(0);
 }
@@ -206,8 +216,12 @@ MatrixXd StepLinearization::SolveSystem(const MatrixXd& b, AdjointCostModel* mod
         iterative = false;
         break;
       case AdjointSolver::kAuto:
-        iterative = model->Next() == AdjointCostModel::Solver::kIterative;
-        chosen = true;
+        if (DirectAdjointFits()) {
+          iterative = model->Next() == AdjointCostModel::Solver::kIterative;
+          chosen = true;
+        } else {
+          iterative = true;
+        }
         break;
     }
   }
@@ -227,6 +241,16 @@ MatrixXd StepLinearization::SolveSystem(const MatrixXd& b, AdjointCostModel* mod
   for (int c = 0; c < cols; ++c)
     if (!ok[c]) rest.push_back(c);
   if (!rest.empty()) {
+    if (iterative && IsPdMethod(m) && !DirectAdjointFits()) {
+      std::ostringstream msg;
+      msg << ToString(m) << " " << pass << ": the iterative solve did not converge in "
+          << sim_.options.backward_max_iterations
+          << " iterations, and no direct solve falls back: its factor of the step "
+          << "Hessian (about " << DirectAdjointBytes() / 1073741824.0
+          << " GiB) exceeds SolverOptions::adjoint_direct_max_bytes ("
+          << sim_.options.adjoint_direct_max_bytes / 1073741824.0 << " GiB)";
+      throw SolverError(SolverStatus::kMaxIterations, msg.str());
+    }
     if (iterative) {
       if (report) report->fallbacks += static_cast<int>(rest.size());
       if (sim_.options.verbosity >= 1) {

@@ -1,13 +1,16 @@
-// A paper row through the rollout core and the Ipopt adapter: the row's
-// rollout function gives the row's own loss and gradient, an optimisation
-// lowers the loss within its evaluation budget, and `diffpd table --optimise`
+// A paper row through the rollout core and either optimiser (L-BFGS-B, and
+// Ipopt where it is built): the row's rollout function gives the row's own
+// loss and gradient, an optimisation lowers the loss within its evaluation
+// budget and stops by L-BFGS-B's ftol test, and `diffpd table --optimise`
 // reports the optimiser's evaluations and final normalised loss.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
+#include "diffpd/error.h"
 #include "paper/paper_rows.h"
 #include "paper/row_evaluation.h"
 #include "paper/row_optimisation.h"
@@ -40,11 +43,22 @@ TEST(RowOptimisationTest, TheRowsRolloutFunctionGivesTheRowsLossAndGradient) {
   EXPECT_EQ(f.function->upper_bounds(), row.upper());
 }
 
-TEST(RowOptimisationTest, AnOptimisationLowersThePlantLossAndStopsAtItsEvaluationBudget) {
+std::vector<RowOptimizer> Optimizers() {
+#if DIFFPD_TEST_IPOPT
+  return {RowOptimizer::kLbfgsb, RowOptimizer::kIpopt};
+#else
+  return {RowOptimizer::kLbfgsb};
+#endif
+}
+
+class RowOptimiserTest : public ::testing::TestWithParam<RowOptimizer> {};
+
+TEST_P(RowOptimiserTest, AnOptimisationLowersThePlantLossAndStopsAtItsEvaluationBudget) {
   PaperRow row = MakePlantRow(RowSize::kSmall);
   const SolverOptions options = row.Options(Method::kPdLbfgs, 1);
   row.Prepare(options);
   RowOptimisationOptions o;
+  o.optimizer = GetParam();
   o.max_evaluations = 6;
   long reported = 0;
   o.on_evaluation = [&](long k, double loss, double forward_s) {
@@ -54,6 +68,7 @@ TEST(RowOptimisationTest, AnOptimisationLowersThePlantLossAndStopsAtItsEvaluatio
     reported = k;
   };
   const RowOptimisationResult r = OptimiseRow(row, options, o);
+  EXPECT_EQ(r.optimizer, ToString(GetParam()));
   EXPECT_EQ(r.stopped_by, "evaluation budget") << r.status;
   EXPECT_GE(r.evaluations, 6);
   EXPECT_EQ(reported, r.evaluations);
@@ -67,14 +82,16 @@ TEST(RowOptimisationTest, AnOptimisationLowersThePlantLossAndStopsAtItsEvaluatio
   }
 }
 
-// L-BFGS-B's stopping test, mapped onto Ipopt's iterations: the run stops at
-// the first iteration whose relative decrease of the loss is at most ftol.
-TEST(RowOptimisationTest, ItStopsAtTheFirstIterationThatDecreasesTheLossByAtMostFtol) {
+// L-BFGS-B's stopping test (L-BFGS-B's own, and mapped onto Ipopt's
+// iterations): the run stops at the first iteration whose relative decrease
+// of the loss is at most ftol.
+TEST_P(RowOptimiserTest, ItStopsAtTheFirstIterationThatDecreasesTheLossByAtMostFtol) {
   PaperRow row = MakePlantRow(RowSize::kSmall);
   row.budget.ftol = 0.05;
   const SolverOptions options = row.Options(Method::kPdLbfgs, 1);
   row.Prepare(options);
   RowOptimisationOptions o;
+  o.optimizer = GetParam();
   o.max_evaluations = 40;
   const RowOptimisationResult r = OptimiseRow(row, options, o);
   ASSERT_EQ(r.stopped_by, "relative decrease") << r.status;
@@ -88,6 +105,22 @@ TEST(RowOptimisationTest, ItStopsAtTheFirstIterationThatDecreasesTheLossByAtMost
   for (size_t k = 1; k + 1 < f.size(); ++k) EXPECT_FALSE(small_decrease(k)) << "iteration " << k;
 }
 
+INSTANTIATE_TEST_SUITE_P(Optimizers, RowOptimiserTest, ::testing::ValuesIn(Optimizers()),
+                         [](const ::testing::TestParamInfo<RowOptimizer>& info) {
+                           return std::string(ToString(info.param));
+                         });
+
+TEST(RowOptimisationTest, OptimizerNamesParseAndAnUnknownOneIsRefused) {
+  EXPECT_EQ(ParseRowOptimizer("lbfgsb"), RowOptimizer::kLbfgsb);
+  EXPECT_EQ(ParseRowOptimizer("ipopt"), RowOptimizer::kIpopt);
+  try {
+    ParseRowOptimizer("bfgs");
+    FAIL() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_STREQ(e.what(), "optimizer 'bfgs' is unknown: use lbfgsb or ipopt");
+  }
+}
+
 TEST(RowOptimisationTest, TheTableReportsTheOptimisersEvaluationsAndFinalNormalisedLoss) {
   TableOptions o;
   o.rows = {"plant"};
@@ -98,9 +131,11 @@ TEST(RowOptimisationTest, TheTableReportsTheOptimisersEvaluationsAndFinalNormali
   o.optimise = true;
   o.optimiser_evaluations = 6;
   const TableResult r = RunTable(o, nullptr, {});
+  EXPECT_EQ(r.optimizer, "lbfgsb");  // the default: the paper's optimiser
   const TableRowResult& plant = r.rows[0];
   const TableMethodResult* pd = plant.method("pd-lbfgs");
   ASSERT_TRUE(pd->optimisation);
+  EXPECT_EQ(pd->optimisation->optimizer, "lbfgsb");
   EXPECT_GE(pd->optimisation->evaluations, 6);
   ASSERT_TRUE(pd->optimisation->normalised_loss);
   ASSERT_TRUE(pd->normalised_loss);
@@ -111,6 +146,18 @@ TEST(RowOptimisationTest, TheTableReportsTheOptimisersEvaluationsAndFinalNormali
   ASSERT_TRUE(back.rows[0].method("pd-lbfgs")->optimisation);
   EXPECT_EQ(back.rows[0].method("pd-lbfgs")->optimisation->final_loss, pd->optimisation->final_loss);
   EXPECT_EQ(back.rows[0].method("pd-lbfgs")->optimisation->loss_history, pd->optimisation->loss_history);
+  EXPECT_EQ(back.rows[0].method("pd-lbfgs")->optimisation->optimizer, "lbfgsb");
+  EXPECT_EQ(back.optimizer, "lbfgsb");
+#if DIFFPD_TEST_IPOPT
+  // A resume that would optimise with the other optimizer is refused.
+  o.optimizer = RowOptimizer::kIpopt;
+  try {
+    RunTable(o, &back, {});
+    FAIL() << "expected InvalidInputError";
+  } catch (const InvalidInputError& e) {
+    EXPECT_STREQ(e.what(), "resume: the file was optimised with lbfgsb, this run asks for ipopt");
+  }
+#endif
 }
 
 }  // namespace

@@ -45,6 +45,20 @@ TEST(MakeRefinedProblemTest, DoublingsScaleTheCellCountCyclingAxes) {
   EXPECT_EQ(MakeRefinedProblem("rolling-sphere", 0)->MakeScene().mesh.num_elements(), 552);
 }
 
+TEST(MakeRefinedProblemTest, GivenCellsAreTheCantileversStartBeforeTheDoublings) {
+  EXPECT_EQ(ParseCells("172x43x43"), (std::array<int, 3>{172, 43, 43}));
+  EXPECT_EQ(MakeRefinedProblem("cantilever", 0, {5, 3, 2})->MakeScene().mesh.num_vertices(), 6 * 4 * 3);
+  EXPECT_EQ(MakeRefinedProblem("cantilever", 2, {5, 3, 2})->MakeScene().mesh.num_elements(), 10 * 6 * 2);
+  EXPECT_EQ(MakeRefinedProblem("cantilever", -2, {5, 3, 2})->MakeScene().mesh.num_elements(), 5 * 1 * 1);
+  for (const std::string bad : {"12x3", "12x3x", "axbxc", "1x2x3x4", "1,2,3", ""})
+    EXPECT_THROW_MESSAGE(ParseCells(bad), InvalidInputError,
+                         "cells = '" + bad + "' is invalid: must be three cell counts NXxNYxNZ, e.g. 172x43x43");
+  EXPECT_THROW_MESSAGE(MakeRefinedProblem("cantilever", 0, {0, 3, 2}), InvalidInputError,
+                       "cells = 0x3x2 is invalid: each count must be in [1, 4096]");
+  EXPECT_THROW_MESSAGE(MakeRefinedProblem("falling-cube", 0, {4, 4, 4}), InvalidInputError,
+                       "cells are available for cantilever only, not for 'falling-cube'");
+}
+
 TEST(MakeRefinedProblemTest, RejectsRefinementsOutOfRangeAndUnknownProblems) {
   std::string problems;
   for (const auto& p : AllProblems()) problems += (problems.empty() ? "" : ", ") + p->name();

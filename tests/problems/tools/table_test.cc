@@ -19,6 +19,7 @@ namespace {
 
 TableOptions SmallOptions() {
   TableOptions o;
+  o.command = "diffpd table --small --rows cantilever,plant";
   o.rows = {"cantilever", "plant"};
   o.methods = {Method::kPdLbfgs, Method::kNewtonCholesky};
   o.threads = 1;
@@ -226,12 +227,42 @@ TEST(TableTest, RowsHaveTheOriginalsMassesUnlessLumpedOnesAreAskedForAndThenSayS
   }
 }
 
+TEST(TableTest, TheCommandThatMeasuredTheResultIsStoredAndReported) {
+  const TableResult& r = SmallRun();
+  EXPECT_EQ(r.command, "diffpd table --small --rows cantilever,plant");
+  const TableResult back = TableFromJson(TableToJson(r));
+  EXPECT_EQ(back.command, r.command);
+  // A resume keeps the first run's command and labels itself with its own.
+  TableOptions o = SmallOptions();
+  o.command = "diffpd table --resume";
+  const TableResult resumed = RunTable(o, &back, {}, nullptr);
+  EXPECT_EQ(resumed.command, r.command);
+  ASSERT_EQ(resumed.resumed_runs.size(), 1u);
+  EXPECT_NE(resumed.resumed_runs[0].find(": diffpd table --resume"), std::string::npos) << resumed.resumed_runs[0];
+  std::FILE* text = std::tmpfile();
+  PrintTable(r, text);
+  std::rewind(text);
+  std::string printed;
+  for (int c; (c = std::fgetc(text)) != EOF;) printed += static_cast<char>(c);
+  std::fclose(text);
+  EXPECT_NE(printed.find("# command: diffpd table --small --rows cantilever,plant\n"), std::string::npos) << printed;
+  const std::string md = TableMarkdown(r, "diffpd table --report --json x.json");
+  EXPECT_NE(md.find("    diffpd table --small --rows cantilever,plant\n"), std::string::npos) << md;
+  EXPECT_NE(md.find("Reported by:\n\n    diffpd table --report --json x.json"), std::string::npos) << md;
+}
+
 TEST(TableTest, ReportsCarryThePapersNumbersAndTheNotes) {
   const std::string md = TableMarkdown(SmallRun(), "diffpd table --small");
   EXPECT_NE(md.find("| 3 plant |"), std::string::npos) << md;
   EXPECT_NE(md.find("929.6"), std::string::npos);           // the paper's Newton-Cholesky forward seconds for the plant
   EXPECT_EQ(md.find("masses: lumped"), std::string::npos);  // the rows have the original's masses
   EXPECT_NE(md.find("diffpd table --small"), std::string::npos);
+  EXPECT_EQ(TableFromJson(TableToJson(SmallRun())).optimizer, "lbfgsb");
+  nlohmann::json old = TableToJson(SmallRun());
+  old.erase("optimizer");  // a file from before the option: optimised with Ipopt
+  old.erase("command");
+  EXPECT_EQ(TableFromJson(old).optimizer, "ipopt");
+  EXPECT_EQ(TableFromJson(old).command, "");
   if (GnuplotAvailable()) {
     const std::string png = (std::filesystem::temp_directory_path() / "diffpd_table_test.png").string();
     std::filesystem::remove(png);
