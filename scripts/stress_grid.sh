@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
 # The whole `diffpd stress` grid in parallel shards (one per problem, method
-# and Young's modulus: 40 by default), then one summary.
+# and Young's modulus: 80 by default), then one summary.
 #
-#   scripts/stress_grid.sh [-j JOBS] [-o DIR] [-b DIFFPD] [-- extra stress options]
+#   scripts/stress_grid.sh [-j JOBS] [-o DIR] [-b DIFFPD] [-p PROBLEMS] [-l STEPS] [-- extra stress options]
 #
+# PROBLEMS: comma-separated (default cantilever,falling-cube,bouncing-ball,
+# rolling-sphere). -l STEPS adds one shard per problem and method with the
+# long cases (`diffpd stress --long-steps STEPS --long-only`: the grid's
+# extreme corners for STEPS steps), run first.
 # JOBS shards run at a time (default: the number of processors), each on one
 # thread. DIR (default out/stress) receives one JSON list and one log per
 # shard, all.json (every case) and summary.txt: case counts per outcome, the
@@ -15,9 +19,13 @@ set -euo pipefail
 jobs=$(nproc)
 out=out/stress
 diffpd=build/bin/diffpd
+problems=cantilever,falling-cube,bouncing-ball,rolling-sphere
+long_steps=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     -j) jobs="$2"; shift 2 ;;
+    -p) problems="$2"; shift 2 ;;
+    -l) long_steps="$2"; shift 2 ;;
     -o) out="$2"; shift 2 ;;
     -b) diffpd="$2"; shift 2 ;;
     --) shift; break ;;
@@ -28,7 +36,13 @@ extra=("$@")
 mkdir -p "$out"
 
 shards=()
-for problem in cantilever falling-cube; do
+IFS=, read -r -a problem_list <<<"$problems"
+if [[ "$long_steps" -gt 0 ]]; then
+  for problem in "${problem_list[@]}"; do
+    for method in newton-cholesky pd newton-pcg pd-lbfgs; do shards+=("$problem $method long"); done
+  done
+fi
+for problem in "${problem_list[@]}"; do
   for method in newton-cholesky pd newton-pcg pd-lbfgs; do
     for e in 1e10 1e8 1e6 1e4 1e2; do shards+=("$problem $method $e"); done
   done
@@ -37,11 +51,13 @@ done
 run_shard() {
   local problem=$1 method=$2 e=$3
   local name="$out/${problem}_${method}_E${e}"
-  "$diffpd" stress --problems "$problem" --methods "$method" --E "$e" --threads 1 --json "${extra[@]}" \
+  local grid=(--E "$e")
+  [[ "$e" == long ]] && grid=(--long-steps "$long_steps" --long-only)
+  "$diffpd" stress --problems "$problem" --methods "$method" "${grid[@]}" --threads 1 --json "${extra[@]}" \
     >"$name.json" 2>"$name.log" || [[ $? -eq 4 ]]  # 4: violations, reported in the summary
 }
 export -f run_shard
-export out diffpd
+export out diffpd long_steps
 export extra_joined="${extra[*]:-}"
 
 printf '%s\n' "${shards[@]}" |
@@ -66,7 +82,9 @@ unresolved = [c for c in checks if c["gradcheck_unresolved"]]
 tangent = [c for c in checks if c.get("gradcheck_tangent")]
 margins = [c["gradcheck_margin"] for c in checks if c["gradcheck_margin"] is not None]
 lines = [
-    f"{len(cases)} cases: {count('ok')} ok, {count('failed')} failed with a solver error, {count('violation')} violations",
+    f"{len(cases)} cases: {count('ok')} ok, {count('failed')} failed with a solver error, {count('violation')} violations"
+    f" ({sum(c.get('long_case', False) for c in cases)} long, {sum(c.get('contact_steps', 0) > 0 for c in cases)}"
+    f" with contact)",
     f"gradient checks: {len(checks)} run, {len(unresolved)} with unresolved inputs, "
     f"{len(tangent)} with inputs decided by the tangent, smallest margin of a resolved input "
     f"{min(margins) if margins else math.inf:.3g}",

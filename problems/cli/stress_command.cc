@@ -15,13 +15,18 @@ namespace diffpd::problems {
 namespace {
 
 constexpr const char* kStressFooter = R"(
-Runs every (problem, method, E, nu, dt) case for --steps steps and
-classifies it:
+Runs every (problem, method, E, nu, dt) case for --steps steps and, with
+--long-steps K, each problem and method at the grid's extreme corners for K
+steps (the long cases: (E, nu, dt) = (min, min, max), (min, max, min),
+(max, min, min), (max, max, max); --long-only: these alone), and
+classifies every case:
  ok        : finite states; total energy (kinetic + elastic + gravitational
              potential) never above its start by more than --energy-tol
-             relative (semi-implicit, which does not dissipate: 0.5, i.e.
+             relative (scenes with frictional contact: --contact-energy-tol;
+             semi-implicit, which does not dissipate: 0.5, i.e.
              not exploding); finite gradients from the backward pass of the whole
-             rollout; on the first --gradcheck-steps steps the gradient check
+             rollout; on the first --gradcheck-steps steps (long cases: the
+             last ones, from the state reached there) the gradient check
              (as `diffpd gradcheck`: solves at --gradcheck-rtol, a noise floor
              and verdict per input, the Newton-Cholesky reference for the
              iterative methods) passes within --gradcheck-tol or leaves the
@@ -30,8 +35,9 @@ classifies it:
  violation : a non-finite result without an error, energy growth, a gradient
              check that fails or an unexpected error - a library bug.
 Exit code 4 when any case is a violation. JSON: a list of {problem, method,
-youngs_modulus, poissons_ratio, time_step, outcome, message, steps_completed,
-rounding_floor_steps, newton_fallback_steps, max_energy_excess,
+youngs_modulus, poissons_ratio, time_step, steps, long_case, outcome,
+message, steps_completed, rounding_floor_steps, newton_fallback_steps,
+contact_steps, max_contact_nodes, max_energy_excess,
 gradcheck_run, gradcheck_error, gradcheck_floor, gradcheck_margin,
 gradcheck_unresolved, gradcheck_tangent, seconds}; the error is on each
 input's basis (the differences, or the forward-mode tangent where the
@@ -45,7 +51,10 @@ stalls at the library's own floor estimate end there (rounding_floor_steps;
 SolverOptions::accept_rounding_floor), and PD-LBFGS steps whose line search
 stalls above it are finished by Newton (newton_fallback_steps).
 Meshes: --refine doublings of each problem's cells (-6: cantilever 8x2x2,
-falling cube 2x2x2; -9: cantilever 4x1x1, cube 1 cell).)";
+falling cube 2x2x2, bouncing ball 8 voxels, rolling sphere 19; -9:
+cantilever 4x1x1, one cell of the others). The contact scenes (bouncing-ball,
+rolling-sphere) keep their frictional ground contact at every E, nu and dt;
+contact_steps counts the steps that ended with nodes in contact.)";
 
 struct StressArgs {
   std::vector<std::string> problems = {"cantilever", "falling-cube"};
@@ -74,6 +83,11 @@ int RunStressArgs(const StressArgs& args) {
         message += std::to_string(c.rounding_floor_steps) + " steps at the rounding floor, " +
                    std::to_string(c.newton_fallback_steps) + " finished by Newton";
       }
+      if (c.contact_steps > 0) {
+        message += message.empty() ? "" : "; ";
+        message += "contact in " + std::to_string(c.contact_steps) + " steps (up to " +
+                   std::to_string(c.max_contact_nodes) + " nodes)";
+      }
       if (!c.gradcheck_tangent.empty()) {
         message += message.empty() ? "" : "; ";
         message += "decided by the tangent:";
@@ -89,8 +103,9 @@ int RunStressArgs(const StressArgs& args) {
                   c.steps_completed, c.max_energy_excess, c.gradcheck_error, c.gradcheck_margin, c.seconds,
                   message.c_str());
     }
-    std::printf("# %d cases: %d ok, %d failed with a solver error, %d violations\n", summary.cases, summary.ok,
-                summary.failed, summary.violations);
+    std::printf("# %d cases: %d ok, %d failed with a solver error, %d violations (%d long, %d with contact)\n",
+                summary.cases, summary.ok, summary.failed, summary.violations, summary.long_cases,
+                summary.contact_cases);
     std::printf(
         "# gradient checks: %d run, %d with unresolved inputs, %d with inputs decided by the tangent, smallest margin "
         "of a resolved input %.3g\n",
@@ -112,7 +127,8 @@ Subcommand AddStressCommand(CLI::App* parent) {
       "stress", "stability at the extremes of E, nu and dt: each case ok or a clear solver error, never NaN");
   cmd->footer(kStressFooter);
   StressOptions& o = args->options;
-  cmd->add_option("--problems", args->problems, "comma-separated problems: cantilever, falling-cube")
+  cmd->add_option("--problems", args->problems,
+                  "comma-separated problems: cantilever, falling-cube, bouncing-ball, rolling-sphere")
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--methods", args->methods,
@@ -148,6 +164,13 @@ Subcommand AddStressCommand(CLI::App* parent) {
   cmd->add_option("--energy-tol", o.energy_tolerance, "allowed relative rise of the total energy")
       ->check(NonNegative("--energy-tol"))
       ->capture_default_str();
+  cmd->add_option("--contact-energy-tol", o.contact_energy_tolerance, "the same for scenes with frictional contact")
+      ->check(NonNegative("--contact-energy-tol"))
+      ->capture_default_str();
+  cmd->add_option("--long-steps", o.long_steps, "steps of the long cases at the grid's extreme corners (0: none)")
+      ->check(IntegerAtLeast("--long-steps", 0))
+      ->capture_default_str();
+  cmd->add_flag("--long-only", o.long_only, "run only the long cases (needs --long-steps)");
   cmd->add_option("--gradcheck-steps", o.gradcheck_steps, "steps of the finite-difference check (0: skip)")
       ->check(IntegerAtLeast("--gradcheck-steps", 0))
       ->capture_default_str();

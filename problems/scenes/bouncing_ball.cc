@@ -12,7 +12,7 @@ std::string BouncingBall::description() const {
 Scene BouncingBall::MakeScene() const {
   Scene scene;
   scene.mesh = VoxelizeSdf([](const Vec3& p) { return p.norm() - kRadius; }, Vec3::Constant(-kRadius),
-                           Eigen::Vector3i(8, 8, 8), 2 * kRadius / 8);
+                           Eigen::Vector3i::Constant(cells_), 2 * kRadius / cells_);
   scene.mesh.vertices.row(2).array() += kDropHeight - scene.mesh.vertices.row(2).minCoeff();
   scene.material.youngs_modulus = 5e5;
   scene.material.poissons_ratio = 0.4;

@@ -26,7 +26,7 @@ Vec3 RollingSphere::Center(const Scene& scene) {
 Scene RollingSphere::MakeScene() const {
   Scene scene;
   scene.mesh = VoxelizeSdf([](const Vec3& p) { return p.norm() - kRadius; }, Vec3::Constant(-kRadius),
-                           Eigen::Vector3i(10, 10, 10), 0.01);
+                           Eigen::Vector3i::Constant(cells_), 2 * kRadius / cells_);
   std::mt19937 rng(kJitterSeed);
   std::uniform_real_distribution<double> jitter(-kJitter, kJitter);
   for (int i = 0; i < scene.mesh.num_vertices(); ++i)

@@ -1,6 +1,7 @@
 // The paper's rolling-sphere benchmark (DiffPD Sec. 6.2), with frictional
 // contact: a sphere of radius 0.05 m voxelised on a 10 x 10 x 10 grid of 1 cm
-// cells (cells whose centre is inside: 823 nodes, 552 hexahedra, 2469 DoFs),
+// cells (cells whose centre is inside: 823 nodes, 552 hexahedra, 2469 DoFs;
+// `cells` per axis in general, of size 0.1 m / cells),
 // E = 2e6 Pa, nu = 0.4, rho = 1e3 kg/m^3, pd-corotated + pd-volume, gravity
 // -9.81 m/s^2 along z. The rest positions get a fixed-seed jitter (each
 // coordinate uniform in [-1, 1] mm, seed 2021) and the body is then lifted so
@@ -20,8 +21,9 @@ namespace diffpd::problems {
 class RollingSphere : public Problem {
  public:
   // linear_solve: how PD erases the active set (Woodbury or refactorisation).
-  explicit RollingSphere(ContactLinearSolve linear_solve = ContactLinearSolve::kWoodbury)
-      : linear_solve_(linear_solve) {}
+  // cells >= 1 per axis (not checked here: MakeRefinedProblem chooses it).
+  explicit RollingSphere(ContactLinearSolve linear_solve = ContactLinearSolve::kWoodbury, int cells = kCells)
+      : linear_solve_(linear_solve), cells_(cells) {}
   std::string name() const override { return "rolling-sphere"; }
   std::string description() const override;
   Scene MakeScene() const override;
@@ -32,11 +34,13 @@ class RollingSphere : public Problem {
   static constexpr double kRadius = 0.05;  // m
   static constexpr double kSpin = 10.0;    // rad/s about +y
   static constexpr double kScreeningRelTolerance = 0.1;
+  static constexpr int kCells = 10;  // per axis, the default grid
   // The sphere's centre (m): the midpoint of the mesh's bounding box.
   static Vec3 Center(const Scene& scene);
 
  private:
   ContactLinearSolve linear_solve_;
+  int cells_;
 };
 
 }  // namespace diffpd::problems

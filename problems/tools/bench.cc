@@ -8,7 +8,9 @@
 #include <random>
 #include <sstream>
 
+#include "scenes/bouncing_ball.h"
 #include "scenes/cantilever.h"
+#include "scenes/rolling_sphere.h"
 #include "diffpd/error.h"
 #include "problem_registry.h"
 #include "cli/invalid_option.h"
@@ -111,7 +113,9 @@ std::unique_ptr<Problem> MakeRefinedProblem(const std::string& name, int doublin
       }
   }
   if (doublings == 0 && !own_cells) return problem;
-  if ((name == "cantilever" || name == "falling-cube") && (doublings < kMinRefinement || doublings > kMaxRefinement)) {
+  const bool refinable =
+      name == "cantilever" || name == "falling-cube" || name == "bouncing-ball" || name == "rolling-sphere";
+  if (refinable && (doublings < kMinRefinement || doublings > kMaxRefinement)) {
     std::ostringstream msg;
     msg << "refinement = " << doublings << " is invalid for " << name << ": it must be in [" << kMinRefinement << ", "
         << kMaxRefinement << "] (" << kMaxRefinement << ": " << (1 << kMaxRefinement) << " times the cells)";
@@ -129,11 +133,18 @@ std::unique_ptr<Problem> MakeRefinedProblem(const std::string& name, int doublin
     }
     return std::make_unique<Cantilever>(cells[0], cells[1], cells[2]);
   }
-  if (name == "falling-cube") {
-    return std::make_unique<FallingCube>(static_cast<int>(std::lround(8.0 * std::pow(2.0, doublings / 3.0))));
-  }
+  // Cells per axis of a cubic grid of `base` cells per axis, scaled to
+  // 2^doublings times the cells (at least one).
+  auto per_axis = [&](double base) {
+    return std::max(1, static_cast<int>(std::lround(base * std::pow(2.0, doublings / 3.0))));
+  };
+  if (name == "falling-cube") return std::make_unique<FallingCube>(per_axis(8));
+  if (name == "bouncing-ball") return std::make_unique<BouncingBall>(per_axis(BouncingBall::kCells));
+  if (name == "rolling-sphere")
+    return std::make_unique<RollingSphere>(ContactLinearSolve::kWoodbury, per_axis(RollingSphere::kCells));
   throw InvalidInputError("problem '" + name +
-                          "' cannot be refined: refinement is available for cantilever and falling-cube");
+                          "' cannot be refined: refinement is available for cantilever, falling-cube, bouncing-ball "
+                          "and rolling-sphere");
 }
 
 std::array<int, 3> ParseCells(const std::string& text) {

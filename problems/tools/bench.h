@@ -54,7 +54,10 @@ inline constexpr int kMaxCantileverCells = 4096;
 // (cycling over x, y, z; a negative count halves z, y, x in turn), so that
 // `doublings` = 3 is 8x the elements and -3 an eighth. Cantilever: the default
 // 32 x 8 x 8 cells; -9 gives 4 x 1 x 1. Falling cube: 8^3 cells, scaled to
-// round(8 * 2^(doublings / 3)) cells per axis (exact for multiples of 3).
+// round(8 * 2^(doublings / 3)) cells per axis (exact for multiples of 3);
+// likewise the bouncing ball's voxel grid (8 cells per axis by default: -6
+// gives 2, -9 a single hexahedron) and the rolling sphere's (10: -6 gives 3,
+// 19 cells whose centre is inside, -9 one), at least one cell per axis.
 // With 0 doublings, any registered problem (MakeProblem). Throws
 // InvalidInputError for an unknown problem (MakeProblem's message, listing
 // the problems), for other problems with doublings != 0, and for doublings

@@ -101,6 +101,16 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   dl.dv[steps] = cv;
   const Rollout rollout = sim.Simulate(initial, inputs);
   const RolloutGradient grad = sim.Backward(rollout, dl);
+  // With frictional contact the gradient is that of the rollout's smooth
+  // piece, its active sets held fixed (contact.h): a rollout whose sets
+  // differ lies on another piece. Returns the first step whose set differs
+  // from the checked rollout's, or -1.
+  auto other_piece = [&](const Rollout& r) {
+    for (size_t k = 0; k < r.reports.size() && k < rollout.reports.size(); ++k)
+      if (r.reports[k].contact_nodes != rollout.reports[k].contact_nodes) return static_cast<int>(k);
+    return -1;
+  };
+  int set_changes = 0;  // perturbed rollouts that left the piece (their differences count as non-finite)
 
   GradCheckResult result;
   result.method = ToString(options.method);
@@ -117,7 +127,15 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     tight.max_iterations = std::max(options.max_iterations, 200);
     try {
       Simulator newton(scene, tight);
-      reference = newton.Backward(newton.Simulate(initial, inputs), dl);
+      const Rollout converged = newton.Simulate(initial, inputs);
+      const int k = other_piece(converged);
+      if (k >= 0) {
+        result.reference = false;
+        result.reference_failure = "its contact active set differs from the checked rollout's at step " +
+                                   std::to_string(k + 1) + " (another piece of the trajectory): not compared";
+      } else {
+        reference = newton.Backward(converged, dl);
+      }
     } catch (const SolverError& e) {
       result.reference = false;
       result.reference_failure = std::string(ToString(e.status())) + ": " + e.what();
@@ -177,10 +195,21 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
       result.inputs.push_back(fresh);
       entry = &result.inputs.back();
     }
+    const int changes_before = set_changes;
     std::vector<FiniteDifference> differences;
     double e = check.largest_step;
+    // A perturbed rollout whose solves fail (e.g. a contact step that would
+    // gain energy from a perturbed state) gives no difference: non-finite.
+    auto central = [&](double step) {
+      try {
+        return (perturbed(step) - perturbed(-step)) / (2 * step);
+      } catch (const SolverError&) {
+        ++set_changes;
+        return std::numeric_limits<double>::quiet_NaN();
+      }
+    };
     for (int k = 0; k < check.step_count; ++k, e /= 10)
-      differences.push_back({e, (perturbed(e) - perturbed(-e)) / (2 * e), rounding / e, solve_bound / e});
+      differences.push_back({e, central(e), rounding / e, solve_bound / e});
     DerivativeJudgement j = JudgeDerivative(analytic, differences, check.tolerance);
     if (j.verdict == CheckVerdict::kUnresolved && check.widen_steps) {
       // Larger steps, where the perturbed input may leave the scene's valid
@@ -201,6 +230,9 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     }
     CheckVerdict verdict = j.verdict;
     std::string reason = j.reason;
+    if (set_changes > changes_before && verdict != CheckVerdict::kPass)
+      reason += "; " + std::to_string(set_changes - changes_before) +
+                " perturbed rollouts changed the contact active set or failed (no difference there)";
     std::string basis = "differences";
     double margin = j.margin;
     double tangent_error = std::numeric_limits<double>::quiet_NaN();
@@ -273,7 +305,12 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     return result.reference ? along(reference) : 0.0;
   };
   auto rollout_loss = [&](Simulator& s, const State& init, const std::vector<StepInput>& in) {
-    return loss_of(s.Simulate(init, in).states.back());
+    const Rollout r = s.Simulate(init, in);
+    if (other_piece(r) >= 0) {
+      ++set_changes;
+      return std::numeric_limits<double>::quiet_NaN();
+    }
+    return loss_of(r.states.back());
   };
 
   for (int k = 0; k < check.directions; ++k) {

@@ -53,6 +53,16 @@
 // so one of them is wrong); otherwise (iterative solves in both) the input
 // stays unresolved, the reason giving the floor and the comparisons.
 //
+// Frictional contact: the gradient is that of the rollout's smooth piece,
+// each step's active set held fixed (contact.h). A perturbed rollout whose
+// active set differs at some step lies on another piece: its loss counts as
+// non-finite (that difference is not used; the reason counts them, with the
+// perturbed rollouts whose solves failed, which count the same), and
+// where no step keeps the piece (a node resting exactly on the surface
+// leaves the set when lifted by any amount) the tangent, which holds the
+// sets fixed as the adjoint does, decides. A reference rollout on another
+// piece is not compared (reference_failure says so).
+//
 // Reference: for the iterative methods (pd, pd-lbfgs, newton-pcg) by
 // default, the same loss's gradient from a Newton-Cholesky rollout at
 // rel_tolerance reference_rel_tolerance is compared too, per direction:

@@ -1,5 +1,6 @@
 #include "tools/stress.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -69,6 +70,9 @@ void StressOptions::Validate() const {
   if (max_iterations < 1) fail("max_iterations", max_iterations, ">= 1");
   if (!(energy_tolerance >= 0)) fail("energy_tolerance", energy_tolerance, ">= 0");
   if (!(explicit_energy_tolerance >= 0)) fail("explicit_energy_tolerance", explicit_energy_tolerance, ">= 0");
+  if (!(contact_energy_tolerance >= 0)) fail("contact_energy_tolerance", contact_energy_tolerance, ">= 0");
+  if (long_steps < 0) fail("long_steps", long_steps, ">= 0 (0: no long cases)");
+  if (long_only && long_steps == 0) throw InvalidInputError("long_only is set without long cases: give long_steps > 0");
   if (gradcheck_steps < 0) fail("gradcheck_steps", gradcheck_steps, ">= 0");
   if (!(gradcheck_tolerance > 0)) fail("gradcheck_tolerance", gradcheck_tolerance, "> 0");
   if (!(gradcheck_rel_tolerance > 0 && gradcheck_rel_tolerance < 1))
@@ -76,8 +80,10 @@ void StressOptions::Validate() const {
 }
 
 StressCase RunStressCase(const StressProblem& problem, Method method, double youngs_modulus, double poissons_ratio,
-                         double time_step, const StressOptions& options, std::ostream* progress) {
+                         double time_step, const StressOptions& options, std::ostream* progress, int steps) {
   StressCase c;
+  c.long_case = steps > 0;
+  c.steps = steps > 0 ? steps : options.steps;
   c.problem = problem.name;
   c.method = ToString(method);
   c.youngs_modulus = youngs_modulus;
@@ -104,7 +110,8 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
     so.max_iterations = options.max_iterations;
     so.rigid_mode_correction = options.rigid_mode_correction;
     Simulator sim(scene, so);
-    const int steps = options.steps;
+    steps = c.steps;
+    const bool contact = !scene.frictional_contacts.empty();
     const VectorXd mass = sim.LumpedMass();
     VectorXd gravity = VectorXd::Zero(sim.num_dofs());
     if (scene.gravity)
@@ -161,13 +168,17 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
       c.steps_completed = k + 1;
       c.rounding_floor_steps += rollout.reports[k].rounding_floor_stop;
       c.newton_fallback_steps += rollout.reports[k].newton_fallback;
+      const int in_contact = static_cast<int>(rollout.reports[k].contact_nodes.size());
+      c.contact_steps += in_contact > 0;
+      c.max_contact_nodes = std::max(c.max_contact_nodes, in_contact);
       if (progress && std::chrono::duration<double>(Clock::now() - last_report).count() > 10) {
         last_report = Clock::now();
         *progress << "  ... step " << k + 1 << " of " << steps << std::endl;
       }
     }
-    const double energy_tolerance =
-        method == Method::kSemiImplicit ? options.explicit_energy_tolerance : options.energy_tolerance;
+    const double energy_tolerance = method == Method::kSemiImplicit ? options.explicit_energy_tolerance
+                                    : contact                       ? options.contact_energy_tolerance
+                                                                    : options.energy_tolerance;
     if (c.max_energy_excess > energy_tolerance) {
       std::ostringstream msg;
       msg << "the total energy rose by " << c.max_energy_excess << " (relative) > energy tolerance " << energy_tolerance
@@ -187,7 +198,10 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
       return finish("failed", "backward pass: " + Describe(e));
     }
 
+    // The check's steps: the first ones, or a long case's last ones (from
+    // the state the rollout reached there).
     const int prefix = std::min(options.gradcheck_steps, steps);
+    const State& check_start = c.long_case ? rollout.states[steps - prefix] : initial;
     if (prefix > 0) {
       SolverOptions tight = so;
       tight.rel_tolerance = options.gradcheck_rel_tolerance;
@@ -200,7 +214,7 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
       gc.seed = options.seed;
       GradCheckResult check;
       try {
-        check = CheckRolloutGradient(scene, tight, initial, prefix, gc);
+        check = CheckRolloutGradient(scene, tight, check_start, prefix, gc);
       } catch (const SolverError& e) {
         std::ostringstream msg;
         msg << "gradient check (solves at rel_tolerance " << options.gradcheck_rel_tolerance << "): " << Describe(e);
@@ -237,25 +251,55 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
   return finish("ok", "");
 }
 
+std::vector<std::array<double, 3>> LongCaseCorners(const StressOptions& options) {
+  auto extremes = [](const std::vector<double>& values) {
+    return std::array<double, 2>{*std::min_element(values.begin(), values.end()),
+                                 *std::max_element(values.begin(), values.end())};
+  };
+  const auto e = extremes(options.youngs_moduli), nu = extremes(options.poissons_ratios),
+             h = extremes(options.time_steps);
+  // (lo, lo, hi), (lo, hi, lo), (hi, lo, lo), (hi, hi, hi): every pair of
+  // axes meets (lo, lo), (lo, hi), (hi, lo) and (hi, hi).
+  const int pick[4][3] = {{0, 0, 1}, {0, 1, 0}, {1, 0, 0}, {1, 1, 1}};
+  std::vector<std::array<double, 3>> corners;
+  for (const auto& p : pick) {
+    const std::array<double, 3> corner = {e[p[0]], nu[p[1]], h[p[2]]};
+    if (std::find(corners.begin(), corners.end(), corner) == corners.end()) corners.push_back(corner);
+  }
+  return corners;
+}
+
 std::vector<StressCase> RunStress(const StressOptions& options, std::ostream* progress) {
   options.Validate();
   for (const auto& p : options.problems) MakeRefinedProblem(p.name, p.refine);  // fail early on a bad name
   std::vector<StressCase> cases;
-  const size_t total = options.problems.size() * options.methods.size() * options.youngs_moduli.size() *
-                       options.poissons_ratios.size() * options.time_steps.size();
-  for (const auto& p : options.problems)
-    for (Method method : options.methods)
-      for (double e : options.youngs_moduli)
-        for (double nu : options.poissons_ratios)
-          for (double h : options.time_steps) {
-            cases.push_back(RunStressCase(p, method, e, nu, h, options, progress));
-            if (progress) {
-              const StressCase& c = cases.back();
-              *progress << "[stress " << cases.size() << "/" << total << "] " << c.problem << " " << c.method
-                        << " E=" << e << " nu=" << nu << " h=" << h << ": " << c.outcome
-                        << (c.message.empty() ? "" : " (" + c.message + ")") << " " << c.seconds << " s" << std::endl;
-            }
-          }
+  const auto corners = LongCaseCorners(options);
+  const size_t grid = options.long_only
+                          ? 0
+                          : options.problems.size() * options.methods.size() * options.youngs_moduli.size() *
+                                options.poissons_ratios.size() * options.time_steps.size();
+  const size_t total =
+      grid + (options.long_steps > 0 ? options.problems.size() * options.methods.size() * corners.size() : 0);
+  auto run = [&](const StressProblem& p, Method method, double e, double nu, double h, int steps) {
+    cases.push_back(RunStressCase(p, method, e, nu, h, options, progress, steps));
+    if (progress) {
+      const StressCase& c = cases.back();
+      *progress << "[stress " << cases.size() << "/" << total << "] " << c.problem << " " << c.method << " E=" << e
+                << " nu=" << nu << " h=" << h << (steps > 0 ? " (" + std::to_string(steps) + " steps)" : "") << ": "
+                << c.outcome << (c.message.empty() ? "" : " (" + c.message + ")") << " " << c.seconds << " s"
+                << std::endl;
+    }
+  };
+  if (!options.long_only)
+    for (const auto& p : options.problems)
+      for (Method method : options.methods)
+        for (double e : options.youngs_moduli)
+          for (double nu : options.poissons_ratios)
+            for (double h : options.time_steps) run(p, method, e, nu, h, 0);
+  if (options.long_steps > 0)
+    for (const auto& p : options.problems)
+      for (Method method : options.methods)
+        for (const auto& [e, nu, h] : corners) run(p, method, e, nu, h, options.long_steps);
   return cases;
 }
 
@@ -264,6 +308,8 @@ StressSummary SummarizeStress(const std::vector<StressCase>& cases) {
   s.min_gradcheck_margin = std::numeric_limits<double>::infinity();
   for (const auto& c : cases) {
     ++s.cases;
+    s.long_cases += c.long_case;
+    s.contact_cases += c.contact_steps > 0;
     if (c.outcome == "ok") ++s.ok;
     if (c.outcome == "failed") ++s.failed;
     if (c.outcome == "violation") ++s.violations;
@@ -285,11 +331,15 @@ nlohmann::json StressToJson(const std::vector<StressCase>& cases) {
                    {"youngs_modulus", c.youngs_modulus},
                    {"poissons_ratio", c.poissons_ratio},
                    {"time_step", c.time_step},
+                   {"steps", c.steps},
+                   {"long_case", c.long_case},
                    {"outcome", c.outcome},
                    {"message", c.message},
                    {"steps_completed", c.steps_completed},
                    {"rounding_floor_steps", c.rounding_floor_steps},
                    {"newton_fallback_steps", c.newton_fallback_steps},
+                   {"contact_steps", c.contact_steps},
+                   {"max_contact_nodes", c.max_contact_nodes},
                    {"max_energy_excess", c.max_energy_excess},
                    {"gradcheck_run", c.gradcheck_run},
                    {"gradcheck_error", c.gradcheck_error},

@@ -7,8 +7,10 @@
 //    (gravity's work is the drop of its potential) never rose above its
 //    initial value by more than energy_tolerance * (the magnitude of the
 //    energies involved, see StressCase::max_energy_excess), as implicit Euler
-//    only dissipates; the backward pass of the whole rollout returned finite
-//    gradients; and on the first gradcheck_steps steps the reverse-mode
+//    only dissipates (scenes with frictional contact: contact_energy_tolerance,
+//    see there); the backward pass of the whole rollout returned finite
+//    gradients; and on the first gradcheck_steps steps (long cases: the last
+//    ones, from the rollout's state there) the reverse-mode
 //    gradient passes CheckRolloutGradient (gradcheck.h: one direction per
 //    input kind, six steps (two more where needed), the forward-mode tangent
 //    where the differences cannot decide, the Newton-Cholesky reference for
@@ -21,6 +23,7 @@
 //    an unexpected exception). A violation is a bug in the library.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <ostream>
 #include <string>
@@ -36,7 +39,10 @@ namespace diffpd::problems {
 
 struct StressProblem {
   std::string name;  // a problem MakeRefinedProblem accepts
-  int refine = -6;   // its doublings (bench.h): -6 is 8x2x2 cantilever, 2^3 cube
+  // Its doublings (bench.h): -6 is the 8x2x2 cantilever, the 2^3 cube, the
+  // bouncing ball's 2^3 voxels and the rolling sphere's 19; -9 the 4x1x1
+  // cantilever and a single cell of the others.
+  int refine = -6;
 };
 
 struct StressOptions {
@@ -58,6 +64,23 @@ struct StressOptions {
   // energy oscillates by O(h omega) when stable; a rise above half the
   // energy scale (the measure tends to 1 as energy explodes) is instability.
   double explicit_energy_tolerance = 0.5;
+  // The same for scenes with frictional contact (contact.h). Friction
+  // dissipates (a pinned node sticks), but a node is pinned where its
+  // previous position projects onto the surface, not where the unconstrained
+  // step would put it: the previous state violates the new pins, so the
+  // argument that bounds an implicit step's energy by the previous one does
+  // not hold exactly; the pins move a landing node by up to the gap it
+  // closes in one step, and a penetrating one back out (see
+  // docs/benchmarks.md for the measured rises).
+  double contact_energy_tolerance = 1e-6;
+  // Long rollouts: > 0 adds, for each problem and method, the grid's
+  // extreme corners (smallest and largest E, nu, h, as the half of the 2^3
+  // corners in which every pair of axes meets its four combinations) run for
+  // this many steps, the gradient checked on their last gradcheck_steps
+  // steps; 0: none.
+  int long_steps = 0;
+  // Only the long cases (long_steps > 0), not the grid.
+  bool long_only = false;
   int gradcheck_steps = 3;  // prefix checked by finite differences (0: skip)
   // Relative tolerance of the check's verdicts (GradCheckOptions::tolerance).
   double gradcheck_tolerance = 1e-4;
@@ -77,14 +100,20 @@ struct StressCase {
   std::string problem;
   std::string method;
   double youngs_modulus = 0, poissons_ratio = 0, time_step = 0;
-  std::string outcome;  // "ok", "failed" or "violation"
-  std::string message;  // empty for ok; the error or the violated property
+  int steps = 0;           // requested (StressOptions::steps, or long_steps for a long case)
+  bool long_case = false;  // one of the long cases (StressOptions::long_steps)
+  std::string outcome;     // "ok", "failed" or "violation"
+  std::string message;     // empty for ok; the error or the violated property
   int steps_completed = 0;
   // Steps of the rollout that ended at g's rounding floor above the
   // tolerance (StepReport::rounding_floor_stop), and PD-LBFGS steps that
   // Newton finished after a line-search stall (StepReport::newton_fallback).
   int rounding_floor_steps = 0;
   int newton_fallback_steps = 0;
+  // Frictional contact: steps that ended with a non-empty active set, and
+  // the largest active set (nodes); 0 for scenes without it.
+  int contact_steps = 0;
+  int max_contact_nodes = 0;
   // max over steps of (T_k - T_0) / (|T_0 parts| + |T_k parts| + 1e-300),
   // where the parts are kinetic, elastic and gravitational (relative to T_0).
   double max_energy_excess = 0;
@@ -114,13 +143,20 @@ struct StressCase {
 // falling for minutes) can still reach it.
 double AutoAbsTolerance(const Scene& scene, double time_step);
 
-// Runs one case; a line every 10 s of a long rollout goes to `progress`
-// (nullptr: silent).
+// Runs one case of options.steps steps (steps > 0: that many, the gradient
+// then checked on the last gradcheck_steps steps); a line every 10 s of a long
+// rollout goes to `progress` (nullptr: silent).
 StressCase RunStressCase(const StressProblem& problem, Method method, double youngs_modulus, double poissons_ratio,
-                         double time_step, const StressOptions& options, std::ostream* progress = nullptr);
+                         double time_step, const StressOptions& options, std::ostream* progress = nullptr,
+                         int steps = 0);
 
-// Runs the whole grid (problems x methods x E x nu x h), one progress line per
-// case on `progress` (nullptr: silent). Throws InvalidInputError on bad options.
+// The long cases' (E, nu, h): the grid's extreme corners as described at
+// StressOptions::long_steps, without repeats (fewer where an axis has one value).
+std::vector<std::array<double, 3>> LongCaseCorners(const StressOptions& options);
+
+// Runs the whole grid (problems x methods x E x nu x h), then the long cases
+// (StressOptions::long_steps), one progress line per case on `progress`
+// (nullptr: silent). Throws InvalidInputError on bad options.
 std::vector<StressCase> RunStress(const StressOptions& options, std::ostream* progress = nullptr);
 
 // Summary of a grid: case counts per outcome, the cases whose gradient check
@@ -129,6 +165,8 @@ struct StressSummary {
   int cases = 0, ok = 0, failed = 0, violations = 0;
   int gradchecks = 0, unresolved_cases = 0;
   int tangent_cases = 0;            // checks where the tangent decided some input
+  int long_cases = 0;               // cases longer than the grid's (StressOptions::long_steps)
+  int contact_cases = 0;            // cases with at least one step in frictional contact
   double min_gradcheck_margin = 0;  // infinite when no input was resolved
 };
 StressSummary SummarizeStress(const std::vector<StressCase>& cases);

@@ -37,7 +37,8 @@ void BindErrors(py::module_& m) {
                    .value("FACTORIZATION_FAILED", SolverStatus::kFactorizationFailed)
                    .value("INVERTED_ELEMENT", SolverStatus::kInvertedElement)
                    .value("DIVERGED", SolverStatus::kDiverged)
-                   .value("ACTIVE_SET_NOT_CONVERGED", SolverStatus::kActiveSetNotConverged));
+                   .value("ACTIVE_SET_NOT_CONVERGED", SolverStatus::kActiveSetNotConverged)
+                   .value("CONTACT_ENERGY_GAIN", SolverStatus::kContactEnergyGain));
 
   g_error = NewException("diffpd.Error", PyExc_Exception, nullptr, "Base of the DiffPD library's exceptions.");
   g_invalid_input_error = NewException("diffpd.InvalidInputError", g_error, PyExc_ValueError,

@@ -6,12 +6,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "diffpd/error.h"
 #include "diffpd/simulator.h"
 #include "diffpd/state_forces.h"
 #include "diffpd/voxelizer.h"
+#include "tools/bench.h"
 #include "tools/gradcheck.h"
+#include "tools/stress.h"
 #include "test_scenes.h"
 #include "util/expect_message.h"
 
@@ -255,6 +258,54 @@ TEST(FrictionalContactTest, ActiveSetThatDoesNotSettleWithinMaxPassesIsReported)
   ok.Step(s, StepInput(), &report);
   EXPECT_EQ(report.active_set_passes, 2);
   EXPECT_TRUE(report.contact_nodes.empty());
+}
+
+// A one-cell ball (the bouncing ball at its coarsest, 0.1 m across) that
+// falls its own size in one step of 0.1 s: in its second step the top
+// nodes' predictions reach the ground and they are pinned below where they
+// were; PD-LBFGS's active set settles with the cell squashed and its total
+// energy goes from about 0.5 J to 1.5e6 J. The check stops that step with
+// a SolverError naming both energies; without it the step returns the
+// energy-gaining state.
+TEST(FrictionalContactTest, AStepWhosePinsRaiseTheEnergyIsAnError) {
+  Scene scene = problems::MakeRefinedProblem("bouncing-ball", -9)->MakeScene();
+  ASSERT_EQ(scene.mesh.num_elements(), 1);
+  scene.material.youngs_modulus = 1e10;
+  scene.material.poissons_ratio = 0.3;
+  SolverOptions options;
+  options.method = Method::kPdLbfgs;
+  options.time_step = 0.1;
+  options.abs_tolerance = problems::AutoAbsTolerance(scene, options.time_step);
+  options.num_threads = 1;
+  auto total_energy = [](Simulator& sim, const State& s) {
+    const VectorXd m = sim.LumpedMass();
+    double gravity = 0;
+    for (int i = 0; i < s.x.size() / 3; ++i) gravity += 9.81 * m(3 * i + 2) * s.x(3 * i + 2);
+    return 0.5 * s.v.cwiseProduct(m).dot(s.v) + sim.ElasticEnergy(s.x) + gravity;
+  };
+  for (const bool check : {true, false}) {
+    if (!check) scene.frictional_contact_options.max_energy_gain = std::numeric_limits<double>::infinity();
+    Simulator sim(scene, options);
+    State s = sim.RestState();
+    for (int i = 0; i < s.v.size() / 3; ++i) s.v.segment<3>(3 * i) = Vec3(0.5, 0.0, -1.0);
+    s = sim.Step(s, StepInput());  // lands: the bottom nodes pinned where they were
+    const double before = total_energy(sim, s);
+    if (check) {
+      try {
+        sim.Step(s, StepInput());
+        FAIL() << "expected SolverError";
+      } catch (const SolverError& e) {
+        EXPECT_EQ(e.status(), SolverStatus::kContactEnergyGain);
+        EXPECT_NE(std::string(e.what()).find("frictional contact: the step raised the total energy from"),
+                  std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("max_energy_gain = 0.0001"), std::string::npos) << e.what();
+      }
+    } else {
+      const State next = sim.Step(s, StepInput());
+      EXPECT_GT(total_energy(sim, next), before + 1e3) << "the pins store energy the step did not have";
+    }
+  }
 }
 
 TEST(FrictionalContactTest, SemiImplicitEulerRejectsFrictionalContact) {

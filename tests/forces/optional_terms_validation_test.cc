@@ -95,6 +95,11 @@ TEST(OptionalTermsValidationTest, ContactErrorsNameTheContactAndTheValue) {
   ExpectMessage(
       [](Scene* s) { s->frictional_contact_options.screening_rel_tolerance = 1; },
       "scene: frictional_contact_options.screening_rel_tolerance = 1 is invalid: must be finite and in [0, 1)");
+  ExpectMessage([](Scene* s) { s->frictional_contact_options.max_energy_gain = -1; },
+                "scene: frictional_contact_options.max_energy_gain = -1 is invalid: must be >= 0 (infinity: no check)");
+  ExpectMessage(
+      [](Scene* s) { s->frictional_contact_options.max_energy_gain = std::nan(""); },
+      "scene: frictional_contact_options.max_energy_gain = nan is invalid: must be >= 0 (infinity: no check)");
   ExpectMessage([](Scene* s) { s->frictional_contact_options.screening_rel_tolerance = std::nan(""); },
                 "scene: frictional_contact_options.screening_rel_tolerance = nan is invalid: must be finite and in [0, "
                 "1)");

@@ -23,7 +23,24 @@
 // step is not released again in that step (no cycling). Only passes solved to
 // the step's tolerance lock a node, so that the loose solves of screening
 // (below) cannot choose the final set. Each step's active
-// set and contact forces are recorded in its StepReport. With
+// set and contact forces are recorded in its StepReport.
+//
+// Energy. Sticking friction and inelastic landing only take energy out, but
+// the pins are not where the unconstrained step would put the nodes: a
+// landing node is pinned where its previous position projects, up to
+// h |v| from where it would touch, and the pinned positions hold whatever the
+// elements between them store. Where a node moves far in one step compared
+// with the cells (large h, a coarse or very stiff body), that stored energy
+// can exceed what the step took out (a one-cell ball dropped at h = 0.1 s
+// was pinned squashed flat, 1.5e6 J from 0.6 J). After the set settles,
+// a step with pinned nodes is therefore checked: its total energy
+//   T = 1/2 v^T M v + E(x) - f . x        (f: the step's explicit force)
+// may rise over the previous state's by at most max_energy_gain times the
+// energies involved (1/2 v^T M v and E of both states and |f . (x_i+1 - x_i)|)
+// plus the solve's own slack (|grad g| |x_i+1 - x_i|); more throws
+// SolverError(kContactEnergyGain) naming both energies. Steps at ordinary
+// time steps lose energy (measured in docs/benchmarks.md, "Stability at the
+// extremes"). With
 // screening_rel_tolerance = r > rel_tolerance, each pass's solve pauses at a
 // checkpoint, the first iterate with |grad g| <= abs_tolerance + r |grad g(x0)|,
 // and applies the test there (screening): if the set changes, the pass ends
@@ -77,6 +94,7 @@
 //   "scene: frictional_contact_options.max_passes = 0 is invalid: must be >= 1",
 //   "scene: frictional_contact_options.penetration_tolerance = -1 is invalid: must be finite and >= 0 (m)",
 //   "scene: frictional_contact_options.screening_rel_tolerance = 1 is invalid: must be finite and in [0, 1)",
+//   "scene: frictional_contact_options.max_energy_gain = -1 is invalid: must be >= 0 (infinity: no check)",
 //   "scene: penalty_contacts[0].stiffness = 0 is invalid: must be finite and > 0 (N/m)",
 //   "scene: penalty_contacts[0].friction = nan is invalid: must be finite and >= 0"
 // (likewise normal, offset, friction_velocity of penalty contacts).
@@ -146,6 +164,9 @@ struct FrictionalContactOptions {
   // [0, 1); 0 or <= the step's rel_tolerance: no screening.
   double screening_rel_tolerance = 0;
   ContactLinearSolve pd_linear_solve = ContactLinearSolve::kWoodbury;
+  // Largest rise of the total energy in a step with pinned nodes, relative
+  // to the energies involved (see "Energy" above); >= 0, infinity: no check.
+  double max_energy_gain = 1e-4;
 };
 
 struct PenaltyContact {

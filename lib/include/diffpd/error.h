@@ -24,14 +24,15 @@ class InvalidInputError : public std::invalid_argument {
 // Why a numerical solve failed.
 enum class SolverStatus {
   kConverged = 0,
-  kMaxIterations,         // the iteration limit was reached before the tolerance
-  kLineSearchFailed,      // no step along the search direction decreased the objective
-  kNonFinite,             // a NaN or infinity appeared in the state or a residual
-  kFactorizationFailed,   // the (sparse) matrix was not positive definite
-  kInvertedElement,       // a material that cannot handle inversion met J <= 0
-  kDiverged,              // an iterative linear solve's residual grew or stagnated, or a step
-                          // tore the body apart (SolverOptions::max_extent_ratio)
-  kActiveSetNotConverged  // the contact active-set loop did not settle
+  kMaxIterations,          // the iteration limit was reached before the tolerance
+  kLineSearchFailed,       // no step along the search direction decreased the objective
+  kNonFinite,              // a NaN or infinity appeared in the state or a residual
+  kFactorizationFailed,    // the (sparse) matrix was not positive definite
+  kInvertedElement,        // a material that cannot handle inversion met J <= 0
+  kDiverged,               // an iterative linear solve's residual grew or stagnated, or a step
+                           // tore the body apart (SolverOptions::max_extent_ratio)
+  kActiveSetNotConverged,  // the contact active-set loop did not settle
+  kContactEnergyGain       // a step with frictional contact gained energy (contact.h)
 };
 
 const char* ToString(SolverStatus status);

@@ -46,6 +46,38 @@ class ToleranceScope {
   double abs_, rel_;
 };
 
+// Throws SolverError(kContactEnergyGain) when the step from `state` to x
+// (with pinned nodes) raised the total energy beyond what
+// FrictionalContactOptions::max_energy_gain allows (diffpd/contact.h).
+void CheckContactEnergy(SimulatorImpl& sim, const State& state, const VectorXd& xhat, const VectorXd& force,
+                        const VectorXd& x, double residual) {
+  const double allowed_ratio = sim.scene.frictional_contact_options.max_energy_gain;
+  if (std::isinf(allowed_ratio)) return;
+  const double h = sim.h();
+  const VectorXd& mass = sim.Mass();
+  const VectorXd v1 = (x - state.x) / h;
+  const double k0 = 0.5 * state.v.cwiseProduct(mass).dot(state.v);
+  const double k1 = 0.5 * v1.cwiseProduct(mass).dot(v1);
+  // g with the inertia centred on x_i is 1/2 |v_i+1|_M^2 + E(x) - f . x at x;
+  // centred on x_i + h v_i, at x_i, the previous total 1/2 |v_i|_M^2 + E(x_i) - f . x_i.
+  StepObjective at_rest(sim, state.x, force);
+  StepObjective predicted(sim, xhat, force);
+  const double t1 = at_rest.Evaluate(x, nullptr);
+  const double t0 = predicted.Evaluate(state.x, nullptr);
+  const double e0 = sim.elastic.EnergyAndGradient(state.x, sim.lame(), nullptr, sim.threads());
+  const double e1 = sim.elastic.EnergyAndGradient(x, sim.lame(), nullptr, sim.threads());
+  const double involved = k0 + k1 + std::abs(e0) + std::abs(e1) + std::abs(force.dot(x - state.x));
+  const double allowed = allowed_ratio * involved + residual * (x - state.x).norm();
+  if (!(t1 - t0 > allowed)) return;
+  std::ostringstream msg;
+  msg << "frictional contact: the step raised the total energy from " << t0 << " J to " << t1 << " J (by "
+      << (t1 - t0) / involved << " of the " << involved
+      << " J involved; frictional_contact_options.max_energy_gain = " << allowed_ratio
+      << "): nodes are pinned where their previous positions project onto the surface, too far from where this "
+         "step would put them for the body's cells and stiffness; a smaller time step resolves the contact";
+  throw SolverError(SolverStatus::kContactEnergyGain, msg.str());
+}
+
 }  // namespace
 
 ContactPin ComputeContactPin(const ContactSurface& surface, const Vec3& x, const Vec3& /*v*/, double /*h*/) {
@@ -175,6 +207,7 @@ VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const Vector
       std::fprintf(stderr, "  contact pass %d%s: %zu pinned nodes%s\n", pass, screening_pass ? " (screening)" : "",
                    nodes.size(), changed ? ", set changed" : "");
     if (!changed) {
+      if (!nodes.empty()) CheckContactEnergy(sim, state, xhat, force, x, pass_report.final_residual);
       report->contact_nodes = nodes;
       report->contact_forces.resize(3, static_cast<Eigen::Index>(nodes.size()));
       for (size_t k = 0; k < nodes.size(); ++k)

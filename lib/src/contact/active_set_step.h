@@ -27,7 +27,9 @@ ContactPin ComputeContactPin(const ContactSurface& surface, const Vec3& x, const
 // The active-set loop of one step from `state` with explicit force `force`
 // (3n). Fills report (iterations summed over passes, contact_nodes,
 // contact_forces, active_set_passes) and returns x_{i+1}. Throws
-// SolverError(kActiveSetNotConverged) after max_passes solves.
+// SolverError(kActiveSetNotConverged) after max_passes solves, and
+// SolverError(kContactEnergyGain) when a step with pinned nodes gains more
+// energy than FrictionalContactOptions::max_energy_gain allows.
 VectorXd SolveWithActiveSet(SimulatorImpl& sim, const State& state, const VectorXd& force, const ImplicitSolver& solve,
                             StepReport* report);
 

@@ -135,6 +135,8 @@ void ValidateContacts(const Scene& scene) {
         opt.screening_rel_tolerance < 1))
     Invalid("frictional_contact_options.screening_rel_tolerance", Str(opt.screening_rel_tolerance),
             "finite and in [0, 1)");
+  if (!(opt.max_energy_gain >= 0))
+    Invalid("frictional_contact_options.max_energy_gain", Str(opt.max_energy_gain), ">= 0 (infinity: no check)");
   for (size_t c = 0; c < scene.penalty_contacts.size(); ++c) {
     const PenaltyContact& contact = scene.penalty_contacts[c];
     const std::string name = Indexed("penalty_contacts", c);

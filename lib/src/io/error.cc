@@ -23,6 +23,8 @@ const char* ToString(SolverStatus status) {
       return "diverged";
     case SolverStatus::kActiveSetNotConverged:
       return "contact active set did not converge";
+    case SolverStatus::kContactEnergyGain:
+      return "contact gained energy";
   }
   return "unknown";
 }

@@ -250,9 +250,10 @@ TEST(CommandLineTest, RefusesBadMeshSizesThreadsAndProblemsOfTheTools) {
        2,
        Invalid("--dt is invalid for starfish-control: the problem fixes its time step")},
       {{"stress", "--problems", "nosuch"}, 2, Invalid("unknown problem 'nosuch': valid problems are " + problems)},
-      {{"stress", "--problems", "bouncing-ball"},
+      {{"stress", "--problems", "starfish-control"},
        2,
-       Invalid("problem 'bouncing-ball' cannot be refined: refinement is available for cantilever and falling-cube")},
+       Invalid("problem 'starfish-control' cannot be refined: refinement is available for cantilever, falling-cube, "
+               "bouncing-ball and rolling-sphere")},
       {{"run", "nosuch"}, 2, Invalid("unknown problem 'nosuch': valid problems are " + problems)},
   });
 }

@@ -38,6 +38,11 @@ TEST(MakeRefinedProblemTest, DoublingsScaleTheCellCountCyclingAxes) {
     EXPECT_EQ(MakeRefinedProblem("cantilever", doublings)->MakeScene().mesh.num_elements(), elements) << doublings;
   EXPECT_EQ(MakeRefinedProblem("falling-cube", -6)->MakeScene().mesh.num_elements(), 8);
   EXPECT_EQ(MakeRefinedProblem("falling-cube", 3)->MakeScene().mesh.num_elements(), 16 * 16 * 16);
+  // The contact scenes' voxel grids: cells whose centre lies inside the ball.
+  EXPECT_EQ(MakeRefinedProblem("bouncing-ball", -9)->MakeScene().mesh.num_elements(), 1);
+  EXPECT_EQ(MakeRefinedProblem("bouncing-ball", -6)->MakeScene().mesh.num_elements(), 8);
+  EXPECT_EQ(MakeRefinedProblem("rolling-sphere", -6)->MakeScene().mesh.num_elements(), 27 - 8);
+  EXPECT_EQ(MakeRefinedProblem("rolling-sphere", 0)->MakeScene().mesh.num_elements(), 552);
 }
 
 TEST(MakeRefinedProblemTest, GivenCellsAreTheCantileversStartBeforeTheDoublings) {
@@ -71,8 +76,11 @@ TEST(MakeRefinedProblemTest, RejectsRefinementsOutOfRangeAndUnknownProblems) {
        "refinement = 13 is invalid for falling-cube: it must be in [-9, 12] (12: 4096 times the cells)"},
       {"no-such-problem", 3, "unknown problem 'no-such-problem': valid problems are " + problems},
       {"no-such-problem", 0, "unknown problem 'no-such-problem': valid problems are " + problems},
-      {"bouncing-ball", -6,
-       "problem 'bouncing-ball' cannot be refined: refinement is available for cantilever and falling-cube"},
+      {"bouncing-ball", 13,
+       "refinement = 13 is invalid for bouncing-ball: it must be in [-9, 12] (12: 4096 times the cells)"},
+      {"starfish-control", -6,
+       "problem 'starfish-control' cannot be refined: refinement is available for cantilever, falling-cube, "
+       "bouncing-ball and rolling-sphere"},
   };
   for (const Case& c : cases) {
     EXPECT_THROW_MESSAGE(MakeRefinedProblem(c.name, c.doublings), InvalidInputError, c.message);

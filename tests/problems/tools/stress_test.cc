@@ -26,7 +26,9 @@ const char* const kStatusNames[] = {"maximum number of iterations reached",
                                     "non-finite value",
                                     "factorization failed",
                                     "inverted element",
-                                    "diverged"};
+                                    "diverged",
+                                    "contact active set did not converge",
+                                    "contact gained energy"};
 
 StressOptions ReducedGrid() {
   StressOptions o;
@@ -98,6 +100,98 @@ TEST(StressTest, EveryExtremeCaseIsOkOrAClearSolverError) {
   // nu = 0.499, h = 0.1 s.
   EXPECT_GE(ok, 10);
   EXPECT_EQ(tested_inputs.size(), 6u) << "every input kind is checked somewhere";
+}
+
+// The contact scenes (one cell of the bouncing ball and of the rolling
+// sphere, frictional ground contact) at the same extremes with the two
+// methods users run on them: each case ok - finite, its total energy never
+// above its start (contact_energy_tolerance), every gradient input resolved
+// with a margin of 3 - or stopped by a specific SolverError, e.g. a step
+// whose pins would raise the energy (contact.h, "Energy").
+TEST(StressTest, ContactScenesAtTheExtremesAreOkOrAClearSolverError) {
+  StressOptions o = ReducedGrid();
+  o.problems = {{"bouncing-ball", -9}, {"rolling-sphere", -9}};
+  o.methods = {Method::kPdLbfgs, Method::kNewtonCholesky};
+  const double corners[][3] = {{1e2, 0, 0.1}, {1e2, 0.499, 1e-5}, {1e10, 0, 1e-5}, {1e10, 0.499, 0.1}};
+  int ok = 0, in_contact = 0;
+  for (const auto& p : o.problems)
+    for (Method m : o.methods)
+      for (const auto& [e, nu, h] : corners) {
+        // PD-LBFGS on the sphere only: the ball's cases take its check's time without adding a property.
+        if (m == Method::kPdLbfgs && p.name == "bouncing-ball") continue;
+        const StressCase c = RunStressCase(p, m, e, nu, h, o);
+        SCOPED_TRACE(Name(c) + ": " + c.outcome + " " + c.message);
+        ASSERT_NE(c.outcome, "violation");
+        if (c.outcome == "failed") {
+          ExpectSpecificFailure(c);
+          continue;
+        }
+        ASSERT_EQ(c.outcome, "ok");
+        ++ok;
+        in_contact += c.contact_steps > 0;
+        if (p.name == "rolling-sphere") {
+          EXPECT_GT(c.contact_steps, 0) << "the sphere starts on the ground";
+        }
+        EXPECT_EQ(c.steps_completed, 20);
+        EXPECT_LE(c.max_energy_excess, o.contact_energy_tolerance);
+        EXPECT_TRUE(c.gradcheck_run);
+        EXPECT_GE(c.gradcheck_margin, 3.0) << "every resolved input at least 3x inside the tolerance";
+        EXPECT_TRUE(c.gradcheck_unresolved.empty());
+      }
+  EXPECT_GE(ok, 8);
+  EXPECT_GE(in_contact, 6);
+}
+
+// The long cases: 10 000 steps on the 4 x 1 x 1 cantilever and the one-cell
+// rolling sphere at the corners of a grid of two time steps, the gradient
+// checked on the last steps (the sphere then rests in contact). The
+// extremes' long cases are in the full grid (docs/benchmarks.md): there the
+// soft sphere (E = 1e2 Pa) pressed flat for 100 s gains energy under the
+// check's random forces and stops with a clear SolverError.
+TEST(StressTest, LongCasesAtTheCornersStayFiniteAndDissipative) {
+  StressOptions o = ReducedGrid();
+  o.problems = {{"cantilever", -9}, {"rolling-sphere", -9}};
+  o.methods = {Method::kNewtonCholesky};
+  o.youngs_moduli = {1e6};
+  o.poissons_ratios = {0.3};
+  o.time_steps = {1e-3, 0.01};
+  o.long_steps = 10000;
+  o.long_only = true;
+  ASSERT_EQ(LongCaseCorners(o).size(), 2u);  // (1e6, 0.3, 0.01), (1e6, 0.3, 1e-3)
+  const std::vector<StressCase> cases = RunStress(o);
+  ASSERT_EQ(cases.size(), 4u);
+  for (const StressCase& c : cases) {
+    SCOPED_TRACE(Name(c) + ": " + c.outcome + " " + c.message);
+    EXPECT_TRUE(c.long_case);
+    EXPECT_EQ(c.steps, 10000);
+    ASSERT_EQ(c.outcome, "ok");
+    EXPECT_EQ(c.steps_completed, 10000);
+    EXPECT_LE(c.max_energy_excess, c.problem == "cantilever" ? o.energy_tolerance : o.contact_energy_tolerance);
+    EXPECT_GE(c.gradcheck_margin, 3.0);
+    EXPECT_TRUE(c.gradcheck_unresolved.empty());
+    if (c.problem == "rolling-sphere") {
+      EXPECT_GT(c.contact_steps, 9000);
+    }
+  }
+  const StressSummary summary = SummarizeStress(cases);
+  EXPECT_EQ(summary.long_cases, 4);
+  EXPECT_EQ(summary.contact_cases, 2);
+}
+
+TEST(StressOptionsTest, LongCaseCornersCoverEveryPairOfExtremes) {
+  StressOptions o;  // E 1e2..1e10, nu 0..0.499, h 1e-5..0.1
+  const std::vector<std::array<double, 3>> expected = {
+      {1e2, 0, 0.1}, {1e2, 0.499, 1e-5}, {1e10, 0, 1e-5}, {1e10, 0.499, 0.1}};
+  EXPECT_EQ(LongCaseCorners(o), expected);
+  o.youngs_moduli = {1e6};
+  o.poissons_ratios = {0.3};
+  o.time_steps = {0.01};
+  EXPECT_EQ(LongCaseCorners(o).size(), 1u);
+  o = StressOptions();
+  o.long_only = true;
+  ASSERT_THROW_MESSAGE(o.Validate(), InvalidInputError, "long_only is set without long cases: give long_steps > 0");
+  o.long_steps = -1;
+  ASSERT_THROW_MESSAGE(o.Validate(), InvalidInputError, "long_steps = -1 is invalid: must be >= 0 (0: no long cases)");
 }
 
 // 10 000 steps on a single-cell cube: long rollouts stay finite, the energy
