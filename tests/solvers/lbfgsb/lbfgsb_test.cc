@@ -144,6 +144,8 @@ TEST(LbfgsbTest, TakesScipysIterationsAndEvaluationsOnBoundedProblems) {
   //   Steep, 5 variables in [-10, 10] from 5:            3 6 7 8 9 10 11 12 13 14 15 16
   //   Exponentials, 6 variables in [-5, 5] from 3:       2 9 12 14 15 17 18 19 ... 29
   //   Rosenbrock, 2 variables in [-2, 0.5] x [-1, 2]:    3 4 5 7 8 12 14 15 16 17 19 21 22 23 25 ... 30
+  //   Rosenbrock, 10 variables, no bounds, from -1.2 (first step 1 / |d|): 2 3 ... 13 15 16 18 19 20 21 23 25 ...
+  //     84 evaluations in 69 iterations
   //   Rosenbrock with a noisy gradient, 10 variables in [-2, 0.6] from -1.2: 27 iterations, 30 evaluations,
   //     x = (0.6, 0.37496961002, 0.15222888399, ...)
   // The line searches of the first iterations interpolate (More and
@@ -193,6 +195,17 @@ TEST(LbfgsbTest, TakesScipysIterationsAndEvaluationsOnBoundedProblems) {
        20,
        30,
        (VectorXd(2) << 0.5, 0.25).finished()},
+      {"unbounded Rosenbrock",
+       Rosenbrock,
+       VectorXd::Constant(10, -1.2),
+       VectorXd::Constant(10, -kInf),
+       VectorXd::Constant(10, kInf),
+       1e-12,
+       1e-8,
+       {2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 15, 16, 18, 19, 20, 21, 23, 25},
+       69,
+       84,
+       VectorXd::Ones(10)},
       {"noisy gradient",
        RosenbrockNoisyGradient,
        VectorXd::Constant(10, -1.2),
