@@ -7,21 +7,20 @@
 // The iteration: every product with H reads the packed element Hessians
 // once; every solve with A's factors passes PdSystem::SolveEntries() factor
 // entries forward and back per vector; every iteration makes a few vector
-// passes over the 3n DoFs. The factorisation: the assembly of H from the
-// packed element Hessians, CHOLMOD's numeric factorisation (its flop count),
-// a call overhead, and a forward and back solve per right-hand side. Its
-// one-off symbolic analysis is charged in proportion to the factor's
-// entries. Before H's first analysis its factor is estimated from A's: H is
-// A's pattern with 3 x 3 blocks, so about 9 times the entries and 27 times
-// the flops.
+// passes over the 3n DoFs; every solve has a set-up. The factorisation:
+// CHOLMOD's numeric factorisation (its flop count, and a cost per factor
+// entry), the assembly and bookkeeping per DoF, and a forward and back solve
+// per right-hand side. Its one-off symbolic analysis (with the first
+// factorisation's set-up) costs a call and a cost per factor entry. Before H's first analysis its factor is estimated
+// from A's: H is A's pattern with 3 x 3 blocks, so about 9 times the entries and 27 times the flops.
 #pragma once
 
 namespace diffpd::internal {
 
 // The sizes the estimates need.
 struct AdjointWorkSizes {
-  double dofs = 0;            // 3n
-  double packed_entries = 0;  // entries of the packed element Hessians
+  double dofs = 0;              // 3n
+  double packed_entries = 0;    // entries of the packed element Hessians
   double pd_solve_entries = 0;  // PdSystem::SolveEntries()
   // H's factor: its entries and the flops of one numeric factorisation
   // (estimated from A's before H is analysed), and whether the analysis is

@@ -100,7 +100,7 @@ class SimulatorImpl {
   // adjoint or tangent solve (simplicial LDL^T for newton-ldlt, else
   // CHOLMOD's supernodal Cholesky, its analysis kept across steps).
   HessianFactorization& hessian_factorization();
-  // The measured costs behind AdjointSolver::kAuto: one model for the
+  // The cost estimates behind AdjointSolver::kAuto: one model for the
   // backward pass (one right-hand side per step) and one per number of
   // tangent directions. Reset by ResetAdjointCostModels (SetOptions).
   AdjointCostModel& backward_cost_model() { return backward_cost_; }
@@ -214,7 +214,7 @@ class StepObjective {
 // (step_linearization.cc): a direct factorisation for newton-cholesky and
 // newton-ldlt, PCG for newton-pcg; for PD and PD-LBFGS the PD-preconditioned
 // iteration (with a direct fallback), a direct factorisation, or either per
-// step by measured cost (SolverOptions::adjoint_solver).
+// step by estimated cost (SolverOptions::adjoint_solver).
 class StepLinearization {
  public:
   StepLinearization(SimulatorImpl& sim, const VectorXd& x, bool static_problem = false);
@@ -283,7 +283,7 @@ class StepLinearization {
   SparseMatrix matrix_;  // assembled exact H (lazily)
   bool have_matrix_ = false;
   bool factored_ = false;
-  int factor_id_ = -1;           // HessianFactorization::num_factorizations() after ours
+  int factor_id_ = -1;  // HessianFactorization::num_factorizations() after ours
   AdjointRecycling* recycling_ = nullptr;
   int steps_left_ = 1;
   int hessian_products_ = 0;  // products with H so far (Apply, ApplyUnmasked)

@@ -7,11 +7,10 @@
 // either apply H element by element and iterate with the forward factor of A
 // as preconditioner (preconditioned_iteration.h: CG, the DiffPD fixed point
 // or L-BFGS), or factorise the assembled H like Newton, or choose between
-// the two per step by their measured costs (adjoint_cost_model.h).
+// the two per step by their estimated costs (adjoint_cost_model.h).
 // Residual growth, stagnation or negative curvature of the iteration
 // triggers a reported fallback to the direct solve (sparse LU when H is
 // indefinite).
-#include <chrono>
 #include <cstdio>
 #include <optional>
 #include <sstream>
@@ -28,8 +27,6 @@
 
 namespace diffpd::internal {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 bool IsPdMethod(Method m) { return m == Method::kPd || m == Method::kPdLbfgs; }
 
