@@ -13,9 +13,12 @@ int AdjointCostModel::RecheckInterval() const {
   return std::max(kMinRecheck, static_cast<int>(steps));
 }
 
+bool AdjointCostModel::DirectLeads() const {
+  return measured_iteration_ && direct_estimate_ > 0 && direct_estimate_ * (1 + kDirectMargin) < iteration_estimate_;
+}
+
 AdjointCostModel::Solver AdjointCostModel::Next() const {
-  if (!measured_iteration_ || !(direct_estimate_ > 0)) return Solver::kIterative;
-  if (!(direct_estimate_ < iteration_estimate_)) return Solver::kIterative;
+  if (!DirectLeads()) return Solver::kIterative;
   return direct_steps_ < RecheckInterval() ? Solver::kDirect : Solver::kIterative;
 }
 

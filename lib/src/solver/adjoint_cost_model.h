@@ -4,12 +4,16 @@
 // deterministic cost estimates (adjoint_work.h): the iteration's from the
 // operations its latest steps counted (Hessian products, solves with A's
 // factor, iterations), the factorisation's from the sizes of its factor,
-// known before it runs. Neither solver is tried to be timed, so the choice
-// depends on the problem alone, never on the machine's load, and a
-// factorisation is never made only to be measured.
+// known before it runs. No clock enters, so the choice depends on the
+// problem alone (not on the machine's load), and no factorisation is made
+// only to be measured.
 //
 // The first step iterates (its counts are the iteration's first estimate).
-// Afterwards the solver with the smaller estimate runs. While the iteration
+// Afterwards the factorisation runs where its estimate is below the
+// iteration's by more than kDirectMargin (the estimates' error on the
+// problems they were fitted to; in a closer race the iteration keeps the
+// steps, as a switch would save less than the estimates can tell apart),
+// else the iteration. While the iteration
 // leads, the factorisation's estimate (fixed by the factor's size) needs no
 // recheck. While the factorisation leads, the iteration's estimate, which
 // follows the state along the rollout, is measured again after
@@ -27,6 +31,7 @@ class AdjointCostModel {
   enum class Solver { kIterative = 0, kDirect = 1 };
   static constexpr int kMinRecheck = 8;
   static constexpr double kRecheckShare = 0.05;
+  static constexpr double kDirectMargin = 0.15;
 
   // The estimated cost of the next step's direct solve (seconds, > 0; its
   // one-off analysis included where still to come). Unset or <= 0: the
@@ -42,6 +47,9 @@ class AdjointCostModel {
   // Estimated seconds of one step's iteration (0 before a measurement).
   double iteration_estimate() const { return iteration_estimate_; }
   double direct_estimate() const { return direct_estimate_; }
+  // Whether the factorisation leads: both estimated, and direct x (1 +
+  // kDirectMargin) < iteration.
+  bool DirectLeads() const;
   // Direct steps between rechecks of the iteration, from the estimates.
   int RecheckInterval() const;
 
