@@ -52,7 +52,7 @@ enum class PdBackwardMethod {
 // own linear solver (a factorisation of H, or PCG for newton-pcg).
 enum class AdjointSolver {
   // Per step, whichever of the two below is estimated cheaper on this
-  // problem (the factorisation only when more than 15% cheaper). The estimates are deterministic, from counts and
+  // problem (the factorisation only when more than 10% cheaper). The estimates are deterministic, from counts and
   // sizes, never
   // from clocks: the iteration's from the Hessian products, factor solves
   // and iterations its latest step made, the factorisation's from its

@@ -31,7 +31,7 @@ class AdjointCostModel {
   enum class Solver { kIterative = 0, kDirect = 1 };
   static constexpr int kMinRecheck = 8;
   static constexpr double kRecheckShare = 0.05;
-  static constexpr double kDirectMargin = 0.15;
+  static constexpr double kDirectMargin = 0.10;
 
   // The estimated cost of the next step's direct solve (seconds, > 0; its
   // one-off analysis included where still to come). Unset or <= 0: the
