@@ -57,6 +57,7 @@ void AdjointSweep::Step(int i, const State& s0, const State& s1, const StepInput
     if (contact) pins.emplace(sim, report->contact_nodes, s1.x);
     StepLinearization lin(sim, s1.x);
     lin.set_recycling(&recycling_);
+    lin.set_steps_left(i + 1);  // steps i, i - 1, ..., 0
     lin.set_rel_tolerance(AdjointRelTolerance(sim.options, forward_rel_tolerance_, report));
     VectorXd z = lin.Solve(b, &out_.report);  // zero at fixed DoFs
     sim.elastic.PartLameDots(s1.x, z, sim.part_of_element, parts, &part_mu, &part_lambda, sim.threads());
