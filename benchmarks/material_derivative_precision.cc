@@ -439,7 +439,8 @@ int main(int argc, char** argv) {
     std::printf("%s\n", out.dump(2).c_str());
     return 0;
   }
-  std::printf("# one cell, one step: E = %g Pa, nu = %g, h = %g s; errors relative to the exact derivative\n", E, nu, h);
+  std::printf("# one cell, one step: E = %g Pa, nu = %g, h = %g s; errors relative to the exact derivative\n", E, nu,
+              h);
   std::printf("%-5s %-16s %11s %11s %11s %11s %11s %11s %11s\n", "seed", "method", "rev_nu", "tan_nu", "gap_nu",
               "exact@state", "rev_E", "tan_E", "state_m");
   for (const SeedResult& s : results) {
@@ -449,10 +450,11 @@ int main(int argc, char** argv) {
                   std::abs(m.reverse_nu - m.tangent_nu) / std::abs(s.exact_nu),
                   Relative(m.exact_at_state_nu, s.exact_nu), Relative(m.reverse_e, s.exact_e),
                   Relative(m.tangent_e, s.exact_e), m.state_error);
-    std::printf("#   seed %d: exact dL/dnu %.12e, dL/dE %.12e; quadruple-precision central differences agree to %.1e "
-                "and %.1e; dL/dnu at the exact state rounded to double %+.1e\n",
-                s.seed, s.exact_nu, s.exact_e, s.central_nu_error, s.central_e_error,
-                Relative(s.exact_at_rounded_state_nu, s.exact_nu));
+    std::printf(
+        "#   seed %d: exact dL/dnu %.12e, dL/dE %.12e; quadruple-precision central differences agree to %.1e "
+        "and %.1e; dL/dnu at the exact state rounded to double %+.1e\n",
+        s.seed, s.exact_nu, s.exact_e, s.central_nu_error, s.central_e_error,
+        Relative(s.exact_at_rounded_state_nu, s.exact_nu));
   }
   return 0;
 }
