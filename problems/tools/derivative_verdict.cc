@@ -70,7 +70,14 @@ DerivativeJudgement JudgeDerivative(const std::vector<double>& analytic,
       const double r = differences[k - 1].step / d.step;
       u = std::max(u, distance(differences[k - 1].value, d.value) / (r * r - 1));
     } else if (n > 1) {
-      u = std::max(u, distance(differences[1].value, d.value));
+      // No larger step: the truncation is at most the distance to the next
+      // difference plus that difference's own noise (measured from the one
+      // after it), which can hide the truncation by cancelling it.
+      double next_noise = differences[1].noise;
+      if (n > 2)
+        next_noise = std::max(next_noise, distance(differences[2].value, differences[1].value) * differences[2].step /
+                                              differences[1].step);
+      u = std::max(u, distance(differences[1].value, d.value) + next_noise);
     }
     if (k + 1 < n) u = std::max(u, distance(differences[k + 1].value, d.value) * differences[k + 1].step / d.step);
     return std::isfinite(u) ? u : std::numeric_limits<double>::infinity();

@@ -12,7 +12,11 @@
 //   noise(e_k)                                the declared rounding;
 //   |fd(e_k-1) - fd(e_k)| / (r^2 - 1)         its truncation error, measured
 //                                             Richardson-style from the larger
-//                                             step (|fd(e_0) - fd(e_1)| for e_0);
+//                                             step (for e_0, which has none:
+//                                             |fd(e_0) - fd(e_1)| plus the noise
+//                                             of fd(e_1), measured from e_2, as
+//                                             that noise can cancel the
+//                                             truncation it is compared with);
 //   |fd(e_k) - fd(e_k+1)| / r                 its noise, measured from the
 //                                             smaller step's (noise ~ 1/e).
 // The smallest step serves only to measure its neighbour's noise (with a

@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <random>
 
+#include "diffpd/box_mesh.h"
 #include "diffpd/error.h"
 #include "diffpd/state_forces.h"
 #include "diffpd/simulator.h"
@@ -172,6 +174,58 @@ INSTANTIATE_TEST_SUITE_P(AllMethods, TangentReverseModeTest,
                                            Case{Method::kPdLbfgs, false}, Case{Method::kNewtonCholesky, true},
                                            Case{Method::kPd, true}),
                          CaseName);
+
+// Stiff, nearly incompressible material (E = 1e10 Pa, nu = 0.499: lambda =
+// 1.7e12 Pa) on a free cell released squashed: after one step of 0.1 s the
+// volumetric strain left is about stress / lambda ~ 1e-11, near the rounding
+// of F (~1e-16), so the pd-volume stress sigma - d is known to only ~1e-5
+// relative and the Poisson's ratio derivative, which is nearly all lambda
+// term (dlambda/dnu = 1.7e15 Pa), inherits that. Reverse and forward mode
+// must read the same unit-Lame stresses to stay exact transposes of one
+// linearisation: with Newton-Cholesky both solve with one factor, so they
+// agree to ~1e-7 (the factor's rounding at a condition number of ~1e10);
+// evaluated each its own way they differed by up to 9e-5 on these inputs.
+TEST(TangentRolloutTest, MaterialTangentsTransposeReverseModeForStiffNearlyIncompressibleMaterial) {
+  Scene scene;
+  scene.mesh = MakeBoxHexMesh(Eigen::Vector3i(1, 1, 1), Vec3(0.1, 0.1, 0.1));
+  scene.material.youngs_modulus = 1e10;
+  scene.material.poissons_ratio = 0.499;
+  scene.material.density = 1e3;
+  scene.gravity = Vec3(0, 0, -9.81);
+  SolverOptions options;
+  options.method = Method::kNewtonCholesky;
+  options.time_step = 0.1;
+  options.rel_tolerance = 1e-12;
+  options.abs_tolerance = 1e-14;
+  options.num_threads = 1;
+  for (std::uint64_t seed : {1, 2, 3}) {
+    Simulator sim(scene, options);
+    const int n = sim.num_dofs();
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> normal;
+    VectorXd cx(n), cv(n), force(n);
+    const double node_weight = 0.125 * 9.81;  // N: a corner's share of the 1 kg cell
+    for (int i = 0; i < n; ++i) {
+      cx(i) = normal(rng);
+      cv(i) = normal(rng);
+      force(i) = 0.1 * node_weight * normal(rng);
+    }
+    State start = sim.RestState();
+    for (int i = 0; i < n / 3; ++i) start.x(3 * i + 2) *= 0.9;
+    std::vector<StepInput> inputs(1);
+    inputs[0].external_force = force;
+    const Rollout rollout = sim.Simulate(start, inputs);
+    LossGradient loss(1);
+    loss.dx[1] = cx;
+    loss.dv[1] = cv;
+    const RolloutGradient g = sim.Backward(rollout, loss);
+    const TangentRollout t = sim.Tangents(rollout, {InputDirection::PoissonsRatio(), InputDirection::YoungsModulus()});
+    const double nu_forward = cx.dot(t.dx[1].col(0)) + cv.dot(t.dv[1].col(0));
+    const double e_forward = cx.dot(t.dx[1].col(1)) + cv.dot(t.dv[1].col(1));
+    EXPECT_NEAR(g.poissons_ratio, nu_forward, 1e-6 * std::abs(nu_forward)) << "seed " << seed;
+    EXPECT_NEAR(g.youngs_modulus, e_forward, 1e-6 * std::abs(e_forward)) << "seed " << seed;
+  }
+}
 
 TEST(TangentRolloutTest, PdReusesTheForwardFactorForEveryColumn) {
   // CG (the default PD backward) and L-BFGS converge without a direct

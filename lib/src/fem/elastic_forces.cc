@@ -208,12 +208,12 @@ void ElasticForces::SampleDecompositions(const VectorXd& x, int e0, int count, M
 }
 
 template <int K, class Body>
-void ElasticForces::VisitDecomposedBatch(const VectorXd& x, int e0, int count, Body&& body) {
+void ElasticForces::VisitDecomposedBatch(const VectorXd& x, int e0, int count, Body&& body, bool warm_start) {
   const int q_per = fem_.samples_per_element();
   Mat3 F[kSvdBatch];
   Svd3 svd[kSvdBatch];
   VolumeProjection volume[kSvdBatch];
-  SampleDecompositions<K>(x, e0, count, F, svd, volume);
+  SampleDecompositions<K>(x, e0, count, F, svd, volume, warm_start);
   for (int j = 0; j < count; ++j) {
     const int i = j * q_per;
     body(e0 + j, F + i, svd + i, needs_volume_ ? volume + i : nullptr);
@@ -221,9 +221,9 @@ void ElasticForces::VisitDecomposedBatch(const VectorXd& x, int e0, int count, B
 }
 
 template <int K, class Body>
-void ElasticForces::ForEachDecomposedElement(const VectorXd& x, int threads, Body&& body) {
+void ElasticForces::ForEachDecomposedElement(const VectorXd& x, int threads, Body&& body, bool warm_start) {
   ParallelForSampleBatches(fem_.num_elements(), fem_.samples_per_element(), threads,
-                           [&](int e0, int count) { VisitDecomposedBatch<K>(x, e0, count, body); });
+                           [&](int e0, int count) { VisitDecomposedBatch<K>(x, e0, count, body, warm_start); });
 }
 
 template <int K>
@@ -283,28 +283,38 @@ double ElasticForces::EnergyAndGradient(const VectorXd& x, const LameField& lame
                                        : EnergyAndGradientImpl<8>(x, lame, grad, threads);
 }
 
+template <int K, class Body>
+void ElasticForces::ForEachUnitLameElement(const VectorXd& x, int threads, Body&& body) {
+  if (!x.allFinite()) throw SolverError(SolverStatus::kNonFinite, "positions are not finite");
+  const int q_per = fem_.samples_per_element();
+  ForEachDecomposedElement<K>(
+      x, threads,
+      [&](int e, const Mat3* F, const Svd3* svd, const VolumeProjection* volume) {
+        Eigen::Matrix<double, 3, K> f_mu = Eigen::Matrix<double, 3, K>::Zero(), f_lambda = f_mu;
+        for (int q = 0; q < q_per; ++q) {
+          const int s = e * q_per + q;
+          const double* g = fem_.grad(s);
+          Mat3 p_mu, p_lambda;  // one SVD and projection serve both unit-parameter stresses
+          const VolumeProjection* vq = volume ? &volume[q] : nullptr;
+          EvaluateDensity(energies_, F[q], svd[q], 1.0, 0.0, &p_mu, nullptr, vq);
+          EvaluateDensity(energies_, F[q], svd[q], 0.0, 1.0, &p_lambda, nullptr, vq);
+          const auto gt = Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
+          const double vol = fem_.sample_volume(s);
+          f_mu.noalias() += (vol * p_mu) * gt;
+          f_lambda.noalias() += (vol * p_lambda) * gt;
+        }
+        body(e, f_mu, f_lambda);
+      },
+      /*warm_start=*/false);
+}
+
 template <int K>
 void ElasticForces::PartLameDotsImpl(const VectorXd& x, const VectorXd& z, const std::vector<int>& part_of_element,
                                      int num_parts, VectorXd* dmu, VectorXd* dlambda, int threads) {
-  if (!x.allFinite()) throw SolverError(SolverStatus::kNonFinite, "positions are not finite");
   const Mesh& mesh = fem_.mesh();
-  const int q_per = fem_.samples_per_element();
   element_dot_.resize(fem_.num_elements());
-  ForEachDecomposedElement<K>(x, threads, [&](int e, const Mat3* F, const Svd3* svd, const VolumeProjection* volume) {
+  ForEachUnitLameElement<K>(x, threads, [&](int e, const auto& f_mu, const auto& f_lambda) {
     const Eigen::Matrix<double, 3, K> ze = GatherElement<K>(mesh, z, e);
-    Eigen::Matrix<double, 3, K> f_mu = Eigen::Matrix<double, 3, K>::Zero(), f_lambda = f_mu;
-    for (int q = 0; q < q_per; ++q) {
-      const int s = e * q_per + q;
-      const double* g = fem_.grad(s);
-      Mat3 p_mu, p_lambda;  // one SVD and projection serve both unit-parameter stresses
-      const VolumeProjection* vq = volume ? &volume[q] : nullptr;
-      EvaluateDensity(energies_, F[q], svd[q], 1.0, 0.0, &p_mu, nullptr, vq);
-      EvaluateDensity(energies_, F[q], svd[q], 0.0, 1.0, &p_lambda, nullptr, vq);
-      const auto gt = Eigen::Map<const Eigen::Matrix<double, K, 3>>(g).transpose();
-      const double vol = fem_.sample_volume(s);
-      f_mu.noalias() += (vol * p_mu) * gt;
-      f_lambda.noalias() += (vol * p_lambda) * gt;
-    }
     element_energy_[e] = ze.cwiseProduct(f_mu).sum();
     element_dot_[e] = ze.cwiseProduct(f_lambda).sum();
   });
@@ -317,6 +327,25 @@ void ElasticForces::PartLameDotsImpl(const VectorXd& x, const VectorXd& z, const
   }
   if (!dmu->allFinite() || !dlambda->allFinite())
     throw SolverError(SolverStatus::kNonFinite, "the elastic Lame-parameter derivatives are not finite");
+}
+
+template <int K>
+void ElasticForces::LameDirectionGradientImpl(const VectorXd& x, const LameField& direction, VectorXd* grad,
+                                              int threads) {
+  ForEachUnitLameElement<K>(x, threads, [&](int e, const auto& f_mu, const auto& f_lambda) {
+    Eigen::Map<Eigen::Matrix<double, 3, K>>(element_buffer_.data() + static_cast<size_t>(e) * 3 * K) =
+        direction.mu_of(e) * f_mu + direction.lambda_of(e) * f_lambda;
+  });
+  GatherElementBuffer(grad, threads);
+  if (!grad->allFinite())
+    throw SolverError(SolverStatus::kNonFinite, "the elastic gradient along the Lame direction is not finite");
+}
+
+void ElasticForces::LameDirectionGradient(const VectorXd& x, const LameField& direction, VectorXd* grad, int threads) {
+  if (fem_.nodes_per_element() == 4)
+    LameDirectionGradientImpl<4>(x, direction, grad, threads);
+  else
+    LameDirectionGradientImpl<8>(x, direction, grad, threads);
 }
 
 void ElasticForces::PartLameDots(const VectorXd& x, const VectorXd& z, const std::vector<int>& part_of_element,

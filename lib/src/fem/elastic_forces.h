@@ -55,6 +55,18 @@ class ElasticForces {
   // Per-element values are summed in element order: deterministic.
   void PartLameDots(const VectorXd& x, const VectorXd& z, const std::vector<int>& part_of_element, int num_parts,
                     VectorXd* dmu, VectorXd* dlambda, int threads);
+  // *grad = d(grad E)/d(mu, lambda) along a field of Lame directions
+  // (dmu_e, dlambda_e) = (direction.mu_of(e), direction.lambda_of(e)) at x:
+  //   sum_e dmu_e d(grad_e E)/d mu_e + dlambda_e d(grad_e E)/d lambda_e (3n, N/Pa).
+  // PartLameDots and this evaluate the same unit-parameter element forces
+  // bit for bit (cold-started SVDs: a function of x alone), so a reverse pass
+  // built on the one and a forward-mode pass built on the other transpose
+  // each other exactly. Where a volumetric strain sits near the rounding of
+  // F (stiff, nearly incompressible material: strain ~ stress / lambda), two
+  // evaluations of the pd-volume stress that round differently differ far
+  // above machine precision (see docs/benchmarks.md, "Gradient checks with a
+  // verdict"), which is why neither pass may evaluate it its own way.
+  void LameDirectionGradient(const VectorXd& x, const LameField& direction, VectorXd* grad, int threads);
 
   // Per-sample exact stress differentials dP/dF (summed over energies) at x.
   void StressDifferentials(const VectorXd& x, const LameField& lame, std::vector<Mat9>* d, int threads);
@@ -92,6 +104,13 @@ class ElasticForces {
  private:
   template <int K>
   double EnergyAndGradientImpl(const VectorXd& x, const LameField& lame, VectorXd* grad, int threads);
+  // Runs body(e, f_mu, f_lambda) for every element e (in parallel over SVD
+  // batches): f_mu and f_lambda are e's 3 x K gradients d(grad_e E)/d mu_e
+  // and d(grad_e E)/d lambda_e at x, from cold-started SVDs.
+  template <int K, class Body>
+  void ForEachUnitLameElement(const VectorXd& x, int threads, Body&& body);
+  template <int K>
+  void LameDirectionGradientImpl(const VectorXd& x, const LameField& direction, VectorXd* grad, int threads);
   template <int K>
   void PartLameDotsImpl(const VectorXd& x, const VectorXd& z, const std::vector<int>& part_of_element, int num_parts,
                         VectorXd* dmu, VectorXd* dlambda, int threads);
@@ -126,14 +145,14 @@ class ElasticForces {
   void SampleDecompositions(const VectorXd& x, int e0, int count, Mat3* F, Svd3* svd, VolumeProjection* volume,
                             bool warm_start = true);
   // Runs body(e, F, svd, volume) for elements e0 .. e0+count-1 of one SVD
-  // batch (SampleDecompositions, warm started): F, svd and volume point at
-  // e's samples_per_element() entries (volume is nullptr unless pd-volume is
-  // declared).
+  // batch (SampleDecompositions, warm started unless warm_start is false):
+  // F, svd and volume point at e's samples_per_element() entries (volume is
+  // nullptr unless pd-volume is declared).
   template <int K, class Body>
-  void VisitDecomposedBatch(const VectorXd& x, int e0, int count, Body&& body);
+  void VisitDecomposedBatch(const VectorXd& x, int e0, int count, Body&& body, bool warm_start = true);
   // VisitDecomposedBatch over every element, in parallel over batches.
   template <int K, class Body>
-  void ForEachDecomposedElement(const VectorXd& x, int threads, Body&& body);
+  void ForEachDecomposedElement(const VectorXd& x, int threads, Body&& body, bool warm_start = true);
   // Sums the per-element 3 x K buffer into a 3n vector, in parallel over nodes.
   void GatherElementBuffer(VectorXd* out, int threads) const;
 

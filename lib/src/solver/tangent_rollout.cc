@@ -278,12 +278,13 @@ TangentRollout TangentPass(SimulatorImpl& sim, const std::vector<StepInput>& inp
     return parts > 1 ? internal::LameField::PerElement(field_mu[p].data(), field_lambda[p].data())
                      : internal::LameField::Uniform(dmu(0, p), dlambda(0, p));
   };
-  // *b.col(p) -= grad E(x; direction p's Lame field) for every direction with one.
+  // *b.col(p) -= grad E(x; direction p's Lame field) for every direction with one,
+  // from the same element forces as the reverse pass's (ElasticForces::PartLameDots).
   VectorXd grad_dir;
   auto subtract_lame_terms = [&](const VectorXd& x, MatrixXd* b) {
     for (int p = 0; p < num_dirs; ++p) {
       if (!lame_dir[p]) continue;
-      sim.elastic.EnergyAndGradient(x, lame_field(p), &grad_dir, sim.threads());
+      sim.elastic.LameDirectionGradient(x, lame_field(p), &grad_dir, sim.threads());
       b->col(p) -= grad_dir;
     }
   };

@@ -101,6 +101,19 @@ TEST(DerivativeVerdictTest, AKinkWithinTheLargerStepsMovesTheChoiceToSmallerOnes
   EXPECT_LE(j.step, 1e-3);
 }
 
+// Measured (the one-cell bouncing ball, Newton-Cholesky, E = 1e10 Pa, nu = 0,
+// h = 1e-5 s, Poisson's ratio, relative to the derivative): the largest step
+// is off by its truncation, -5.5e-4, and the next one's noise (about 5e-4,
+// as its neighbours show) happens to land next to it. The truncation is not
+// resolved: unresolved, not a failure.
+TEST(DerivativeVerdictTest, TruncationHiddenByTheNextStepsNoiseIsNotAFailure) {
+  const std::vector<FiniteDifference> d = {{3e-1, 1 - 5.5e-4, 0}, {3e-2, 1 - 4.6e-4, 0}, {1e-2, 1 - 9.6e-4, 0},
+                                           {1e-3, 1 + 1.1e-2, 0}, {1e-4, 1 + 0.15, 0},   {1e-5, 1 + 0.31, 0}};
+  const DerivativeJudgement j = JudgeDerivative(1.0, d, 1e-4);
+  EXPECT_EQ(j.verdict, CheckVerdict::kUnresolved) << j.reason;
+  EXPECT_GT(j.floor, j.error / 3);
+}
+
 TEST(DerivativeVerdictTest, VerdictsOrderAndNames) {
   EXPECT_EQ(Worse(CheckVerdict::kPass, CheckVerdict::kUnresolved), CheckVerdict::kUnresolved);
   EXPECT_EQ(Worse(CheckVerdict::kFail, CheckVerdict::kUnresolved), CheckVerdict::kFail);
