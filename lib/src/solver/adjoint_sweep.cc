@@ -58,8 +58,11 @@ void AdjointSweep::Step(int i, const State& s0, const State& s1, const StepInput
     StepLinearization lin(sim, s1.x);
     lin.set_recycling(&recycling_);
     lin.set_rel_tolerance(AdjointRelTolerance(sim.options, forward_rel_tolerance_, report));
+    // The Lame-parameter dots below reuse the SVDs of H's element pass,
+    // started from the warm-start cache as ElasticForces::PartLameDots does.
+    lin.KeepLameGradients(/*warm_svd=*/true);
     VectorXd z = lin.Solve(b, &out_.report);  // zero at fixed DoFs
-    sim.elastic.PartLameDots(s1.x, z, sim.part_of_element, parts, &part_mu, &part_lambda, sim.threads());
+    lin.PartLameDots(z, &part_mu, &part_lambda);
     dmu_ -= part_mu;
     dlambda_ -= part_lambda;
     // grad g depends on M through M (x_{i+1} - x_i - h v_i) / h^2 - M g.
