@@ -58,9 +58,11 @@ void AdjointSweep::Step(int i, const State& s0, const State& s1, const StepInput
     StepLinearization lin(sim, s1.x);
     lin.set_recycling(&recycling_);
     lin.set_rel_tolerance(AdjointRelTolerance(sim.options, forward_rel_tolerance_, report));
-    // The Lame-parameter dots below reuse the SVDs of H's element pass,
-    // started from the warm-start cache as ElasticForces::PartLameDots does.
-    lin.KeepLameGradients(/*warm_svd=*/true);
+    // The Lame-parameter dots below reuse the SVDs of H's element pass. They
+    // start cold: H then depends on x alone, as the tangent pass's H does
+    // (warm-started SVDs moved an ill-conditioned scene's gradient off its
+    // tangents by 1.4e-4 relative).
+    lin.KeepLameGradients(/*warm_svd=*/false);
     VectorXd z = lin.Solve(b, &out_.report);  // zero at fixed DoFs
     lin.PartLameDots(z, &part_mu, &part_lambda);
     dmu_ -= part_mu;
