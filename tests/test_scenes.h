@@ -76,8 +76,8 @@ inline SolverOptions TightOptions(Method method) {
   options.backward_rel_tolerance = 1e-13;
   options.max_iterations = 20000;
   options.num_threads = 1;
-  // Deterministic: the automatic adjoint choice follows measured times, so
-  // two simulators of one scene could differ in the last bits.
+  // The iteration throughout: the tests compare its gradients (the automatic
+  // choice may factorise on some steps).
   options.adjoint_solver = AdjointSolver::kIterative;
   return options;
 }

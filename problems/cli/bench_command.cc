@@ -26,7 +26,7 @@ Simulate / Backward on a fresh simulator (forward includes PD's factorisation,
 factorization_s: the one-off cost per mesh, h and weights), median of --repeat runs. The adjoint tolerance is the
 library's default (derived per step from the accuracy the forward reached)
 unless --backward-rtol is given; the PD methods' adjoint solver is
---adjoint-solver (auto: per step by measured cost). iter/dir: backward steps
+--adjoint-solver (auto: per step by estimated cost). iter/dir: backward steps
 solved iteratively / by a factorisation of the step Hessian.
 speedup_vs_newton_cholesky = (forward+backward of newton-cholesky in this
 run) / (this method's); speedup_vs_best_newton the same against the faster
@@ -176,7 +176,7 @@ Subcommand AddBenchCommand(CLI::App* parent) {
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--adjoint-solver", args->adjoint_solver,
-                  "PD methods' adjoint solver: auto (per step by measured cost), iterative or direct")
+                  "PD methods' adjoint solver: auto (per step by estimated cost), iterative or direct")
       ->capture_default_str();
   cmd->add_option("--threads", args->options.threads, "threads for element loops (0: OpenMP default)")
       ->check(ThreadCount("--threads"));

@@ -175,7 +175,7 @@ int TrainStarfish(const Arguments& args) {
   SolverOptions options = StarfishControl().BaseOptions(args.small);
   options.method = ParseMethod(args.method);
   options.num_threads = args.threads;
-  // Explicit (kAuto chooses by measured time, which would make the results depend on the run).
+  // Explicit (kAuto's choices depend on what each rank's simulator solved before, which the layout changes).
   options.adjoint_solver = ParseAdjointSolver(args.adjoint_solver.empty() ? "iterative" : args.adjoint_solver);
   SwimmerStartsOptions starts;
   starts.count = args.starts;
@@ -259,7 +259,7 @@ int CalibrateStarfish(const Arguments& args) {
   StarfishCalibration problem;
   problem.set_substeps(args.substeps);
   SolverOptions options = problem.Options(ParseMethod(args.method), args.threads);
-  // Explicit (kAuto chooses by measured time); the Jacobians' 5 tangents share a factorisation.
+  // Explicit (kAuto's choices depend on each rank's earlier solves); the Jacobians' 5 tangents share a factorisation.
   const std::string adjoint_solver = args.adjoint_solver.empty() ? "direct" : args.adjoint_solver;
   options.adjoint_solver = ParseAdjointSolver(adjoint_solver);
   StarfishRecordingsOptions recordings;

@@ -64,8 +64,8 @@ struct TradeoffOptions {
   int threads = 0;
   // Timed runs of each setting (>= 1); a row keeps its fastest run (on a
   // shared machine the least-disturbed one). Repeated runs' forward errors
-  // agree up to the rounding of threaded sums, their gradients up to the
-  // adjoint's tolerance (adjoint_solver auto picks by measured time).
+  // agree up to the rounding of threaded sums, and so do their gradients
+  // (adjoint_solver auto's choice is deterministic).
   int repeats = 1;
   TradeoffClock clock = TradeoffClock::kWall;
   int max_iterations = -1;    // of each step's solve; -1: the problem's (references: at least 1000)

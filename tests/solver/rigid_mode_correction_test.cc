@@ -178,7 +178,7 @@ SolverOptions LbfgsOptions(bool rigid) {
   options.rel_tolerance = 1e-10;
   options.abs_tolerance = 1e-12;
   options.backward_rel_tolerance = 1e-9;
-  // The iterative adjoint (not chosen per step by measured time) is what the
+  // The iterative adjoint (not chosen per step by estimated cost) is what the
   // correction preconditions; its iteration counts are compared.
   options.adjoint_solver = AdjointSolver::kIterative;
   options.num_threads = 1;

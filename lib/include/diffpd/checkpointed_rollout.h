@@ -10,8 +10,9 @@
 // step's SVDs start cold, SolverOptions::svd_warm_start = false), so the
 // gradients are those of a stored rollout (Simulator::Simulate) made with
 // svd_warm_start = false bit for bit wherever the backward itself is
-// deterministic (a fixed SolverOptions::adjoint_solver; kAuto picks solvers
-// by measured times), and those of the default (warm) stored rollout to
+// deterministic (a fixed SolverOptions::adjoint_solver, or kAuto on
+// simulators with the same earlier passes: its estimates remember them),
+// and those of the default (warm) stored rollout to
 // rounding.
 #pragma once
 

@@ -51,12 +51,20 @@ enum class PdBackwardMethod {
 // pd-lbfgs) solve with the step Hessian H. Newton methods always use their
 // own linear solver (a factorisation of H, or PCG for newton-pcg).
 enum class AdjointSolver {
-  // Per step, whichever of the two below is cheaper on this problem, by
-  // their measured times: each is timed on a step as it runs, the cheaper
-  // one serves the following steps, and the other is timed again after
-  // max(8, (r - 1) / 0.05) of them (r: the ratio of the times; <= 5% extra). The
-  // measurements persist across Backward/Tangents calls of one simulator
-  // (SetOptions resets them). Which steps used which is reported
+  // Per step, whichever of the two below is estimated cheaper on this
+  // problem (the factorisation only when more than 10% cheaper). The estimates are deterministic, from counts and
+  // sizes, never
+  // from clocks: the iteration's from the Hessian products, factor solves
+  // and iterations its latest step made, the factorisation's from its
+  // factor's entries and flop count (estimated from A's before its first
+  // symbolic analysis, whose one-off cost is spread over the pass's
+  // remaining steps), with per-operation costs of one reference core. The
+  // first step iterates; no factorisation is made only to be measured; while
+  // the factorisation leads, the iteration is counted again after max(8,
+  // (r - 1) / 0.05) direct steps (r: the ratio of the estimates; <= 5%
+  // extra). The iteration's estimate persists across Backward/Tangents calls
+  // of one simulator (SetOptions resets it). The same problem makes the same
+  // choices on every run. Which steps used which is reported
   // (BackwardReport); the gradients agree with either to the adjoint's
   // tolerance.
   kAuto,
@@ -161,8 +169,7 @@ struct SolverOptions {
   // step must meet.
   bool rigid_mode_correction = true;
 
-  // PD methods' backward and tangent solves: iterative, direct or chosen per step by measured cost (AdjointSolver;
-  // kAuto follows timings, so two runs may differ in the last bits: set it to compare runs bit for bit).
+  // PD methods' backward and tangent solves: iterative, direct or chosen per step by estimated cost (AdjointSolver).
   AdjointSolver adjoint_solver = AdjointSolver::kAuto;
   PdBackwardMethod pd_backward = PdBackwardMethod::kConjugateGradient;
   // Iterative backward (adjoint) and tangent solves stop at the relative

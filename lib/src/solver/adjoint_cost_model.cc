@@ -6,43 +6,32 @@
 
 namespace diffpd::internal {
 
-AdjointCostModel::Solver AdjointCostModel::Leader() const {
-  return estimate_[Index(Solver::kDirect)] < estimate_[Index(Solver::kIterative)] ? Solver::kDirect
-                                                                                  : Solver::kIterative;
-}
-
 int AdjointCostModel::RecheckInterval() const {
-  const double leader = estimate_[Index(Leader())];
-  const double other = estimate_[1 - Index(Leader())];
-  if (!(leader > 0)) return kMinRecheck;
-  const double steps = std::ceil((other / leader - 1) / kRecheckShare);
+  if (!(direct_estimate_ > 0)) return kMinRecheck;
+  const double steps = std::ceil((iteration_estimate_ / direct_estimate_ - 1) / kRecheckShare);
   if (!(steps < std::numeric_limits<int>::max())) return std::numeric_limits<int>::max();
   return std::max(kMinRecheck, static_cast<int>(steps));
 }
 
+bool AdjointCostModel::DirectLeads() const {
+  return measured_iteration_ && direct_estimate_ > 0 && direct_estimate_ * (1 + kDirectMargin) < iteration_estimate_;
+}
+
 AdjointCostModel::Solver AdjointCostModel::Next() const {
-  if (!measured(Solver::kIterative)) return Solver::kIterative;
-  if (!measured(Solver::kDirect)) return Solver::kDirect;
-  const Solver leader = Leader();
-  if (leader_steps_ < RecheckInterval()) return leader;
-  return leader == Solver::kDirect ? Solver::kIterative : Solver::kDirect;
+  if (!DirectLeads()) return Solver::kIterative;
+  return direct_steps_ < RecheckInterval() ? Solver::kDirect : Solver::kIterative;
 }
 
 void AdjointCostModel::Record(Solver solver, double seconds) {
-  const bool both = measured(Solver::kIterative) && measured(Solver::kDirect);
-  const Solver leader_before = both ? Leader() : solver;
-  double& estimate = estimate_[Index(solver)];
-  const bool consecutive = have_last_ && last_ == solver && measured(solver);
-  estimate = consecutive ? 0.5 * (estimate + seconds) : seconds;
-  measured_[Index(solver)] = true;
-  have_last_ = true;
-  last_ = solver;
-  // The leader's steps count towards the next recheck; the other solver's
-  // first measurement or recheck starts the count again.
-  if (both && solver == leader_before)
-    ++leader_steps_;
-  else
-    leader_steps_ = 0;
+  if (solver == Solver::kDirect) {
+    ++direct_steps_;
+    last_iterative_ = false;
+    return;
+  }
+  iteration_estimate_ = last_iterative_ && measured_iteration_ ? 0.5 * (iteration_estimate_ + seconds) : seconds;
+  measured_iteration_ = true;
+  last_iterative_ = true;
+  direct_steps_ = 0;
 }
 
 }  // namespace diffpd::internal

@@ -57,6 +57,7 @@ void AdjointSweep::Step(int i, const State& s0, const State& s1, const StepInput
     if (contact) pins.emplace(sim, report->contact_nodes, s1.x);
     StepLinearization lin(sim, s1.x);
     lin.set_recycling(&recycling_);
+    lin.set_steps_left(i + 1);  // steps i, i - 1, ..., 0
     lin.set_rel_tolerance(AdjointRelTolerance(sim.options, forward_rel_tolerance_, report));
     // The Lame-parameter dots below reuse the SVDs of H's element pass. They
     // start cold: H then depends on x alone, as the tangent pass's H does

@@ -130,6 +130,10 @@ double CholmodSolver::factor_nonzeros() const {
   return impl_->With(layout_, [](auto& llt) { return llt.cholmod().lnz; });
 }
 
+double CholmodSolver::factor_flops() const {
+  return impl_->With(layout_, [](auto& llt) { return llt.cholmod().fl; });
+}
+
 MatrixXd CholmodSolver::Solve(const MatrixXd& b) const {
   DIFFPD_CHECK(factorized_, "CholmodSolver::Solve before a successful Factorize");
   if (copy_) {

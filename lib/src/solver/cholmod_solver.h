@@ -75,6 +75,9 @@ class CholmodSolver {
   double analysis_seconds() const { return analysis_seconds_; }
   // Entries of the factor L after the latest analysis (CHOLMOD's lnz).
   double factor_nonzeros() const;
+  // Floating-point operations of one numeric factorisation by the latest
+  // analysis (CHOLMOD's fl).
+  double factor_flops() const;
   int num_factorizations() const { return num_factorizations_; }
   bool factorized() const { return factorized_; }
 

@@ -21,6 +21,14 @@ HessianFactorization::HessianFactorization(HessianFactorizationKind kind) : kind
 
 int HessianFactorization::num_analyses() const { return cholmod_ ? cholmod_->num_analyses() : num_ldlt_analyses_; }
 
+double HessianFactorization::factor_nonzeros() const {
+  return cholmod_ && cholmod_->num_analyses() > 0 ? cholmod_->factor_nonzeros() : 0.0;
+}
+
+double HessianFactorization::factor_flops() const {
+  return cholmod_ && cholmod_->num_analyses() > 0 ? cholmod_->factor_flops() : 0.0;
+}
+
 bool HessianFactorization::Factorize(const SparseMatrix& h) {
   DIFFPD_CHECK(h.rows() == h.cols(), "HessianFactorization needs a square matrix");
   const auto start = Clock::now();

@@ -50,6 +50,10 @@ class HessianFactorization {
   // Symbolic analyses so far (kCholmodSupernodal: one per pattern;
   // kSimplicialLdlt: one per factorisation).
   int num_analyses() const;
+  // kCholmodSupernodal after an analysis: the factor's entries and the flops
+  // of one numeric factorisation (CholmodSolver); 0 otherwise.
+  double factor_nonzeros() const;
+  double factor_flops() const;
   // Wall seconds of the latest Factorize, and the part of them spent on the
   // ordering and symbolic analysis (0 when it reused an earlier analysis).
   double factorize_seconds() const { return factorize_seconds_; }

@@ -181,6 +181,29 @@ double PdSystem::factor_nonzeros() const {
   return entries;
 }
 
+double PdSystem::factor_flops() const {
+  double flops = 0;
+  for (const Group& g : groups_)
+    if (g.solver->num_analyses() > 0) flops = std::max(flops, g.solver->factor_flops());
+  return flops;
+}
+
+double PdSystem::SolveEntries() const {
+  const double n = fem_.num_nodes();
+  const double erased = static_cast<double>(active_nodes_.size());
+  double entries = 0;
+  for (size_t gi = 0; gi < groups_.size(); ++gi) {
+    const Group& g = groups_[gi];
+    if (g.solver->num_analyses() == 0) continue;
+    const double factor = g.solver->factor_nonzeros();
+    double correction = 0;
+    if (gi < erasures_.size() && !erasures_[gi].empty())
+      correction = erased <= ActiveSetErasure::kDenseCorrectionMax ? std::min(n * erased, factor) : factor;
+    entries += static_cast<double>(g.axes.size()) * (factor + correction);
+  }
+  return entries;
+}
+
 void PdSystem::SetAuxiliaryMatrix(const SparseMatrix& auxiliary) {
   auxiliary_ = auxiliary;
   h_ = -1;

@@ -60,6 +60,14 @@ class PdSystem {
   // Entries of the largest factor (CholmodSolver::factor_nonzeros; 0 before
   // the first Update).
   double factor_nonzeros() const;
+  // Flops of the largest factor's numeric factorisation (CholmodSolver::
+  // factor_flops; 0 before the first Update).
+  double factor_flops() const;
+  // Factor entries one Solve of a single 3n vector passes over, per
+  // triangular sweep: every group's factor once per axis it solves, plus the
+  // contact active set's correction (ActiveSetErasure: O(n s) for s erased
+  // nodes, at most a second solve). A deterministic measure of Solve's cost.
+  double SolveEntries() const;
   // y = A x over the free DoFs (fixed rows and columns erased).
   VectorXd Apply(const VectorXd& x) const;
 

@@ -19,6 +19,7 @@
 #include "fem/mass_model.h"
 #include "forces/state_forces.h"
 #include "solver/adjoint_cost_model.h"
+#include "solver/adjoint_work.h"
 #include "solver/adjoint_recycling.h"
 #include "solver/hessian_assembler.h"
 #include "solver/hessian_factorization.h"
@@ -99,7 +100,7 @@ class SimulatorImpl {
   // adjoint or tangent solve (simplicial LDL^T for newton-ldlt, else
   // CHOLMOD's supernodal Cholesky, its analysis kept across steps).
   HessianFactorization& hessian_factorization();
-  // The measured costs behind AdjointSolver::kAuto: one model for the
+  // The cost estimates behind AdjointSolver::kAuto: one model for the
   // backward pass (one right-hand side per step) and one per number of
   // tangent directions. Reset by ResetAdjointCostModels (SetOptions).
   AdjointCostModel& backward_cost_model() { return backward_cost_; }
@@ -217,7 +218,7 @@ class StepObjective {
 // (step_linearization.cc): a direct factorisation for newton-cholesky and
 // newton-ldlt, PCG for newton-pcg; for PD and PD-LBFGS the PD-preconditioned
 // iteration (with a direct fallback), a direct factorisation, or either per
-// step by measured cost (SolverOptions::adjoint_solver).
+// step by estimated cost (SolverOptions::adjoint_solver).
 class StepLinearization {
  public:
   StepLinearization(SimulatorImpl& sim, const VectorXd& x, bool static_problem = false);
@@ -241,6 +242,9 @@ class StepLinearization {
   // from the gradients kept by H's element pass when KeepLameGradients was
   // called before it ran, else evaluated afresh.
   void PartLameDots(const VectorXd& z, VectorXd* dmu, VectorXd* dlambda);
+  // Steps of the pass still to solve, this one included (>= 1; default 1):
+  // AdjointSolver::kAuto spreads the one-off analysis of H over them.
+  void set_steps_left(int steps) { steps_left_ = steps < 1 ? 1 : steps; }
   // Solves H z = b (3n; fixed entries of b ignored, of z zero): one adjoint
   // step (the simulator's backward cost model, AdjointSolver::kAuto). Throws
   // SolverError(kNonFinite) for a b with a non-finite entry or a solution
@@ -283,6 +287,9 @@ class StepLinearization {
   // b in lockstep; ok[c] tells which converged.
   void IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, std::vector<char>* ok, int* iterations);
   bool PcgSolve(const VectorXd& b, VectorXd* z, int* iterations);
+  // AdjointSolver::kAuto's sizes (adjoint_work.h) for a step solving `dofs`
+  // unknowns.
+  AdjointWorkSizes WorkSizes();
 
   SimulatorImpl& sim_;
   VectorXd x_;
@@ -301,9 +308,11 @@ class StepLinearization {
   SparseMatrix matrix_;  // assembled exact H (lazily)
   bool have_matrix_ = false;
   bool factored_ = false;
-  int factor_id_ = -1;           // HessianFactorization::num_factorizations() after ours
-  double analysis_seconds_ = 0;  // symbolic analyses our factorisations made
+  int factor_id_ = -1;  // HessianFactorization::num_factorizations() after ours
   AdjointRecycling* recycling_ = nullptr;
+  int steps_left_ = 1;
+  int hessian_products_ = 0;  // products with H so far (Apply, ApplyUnmasked)
+  int pd_solves_ = 0;         // single-vector solves with A's factors so far
   std::unique_ptr<Eigen::SparseLU<SparseMatrix>> lu_;
 };
 

@@ -7,11 +7,10 @@
 // either apply H element by element and iterate with the forward factor of A
 // as preconditioner (preconditioned_iteration.h: CG, the DiffPD fixed point
 // or L-BFGS), or factorise the assembled H like Newton, or choose between
-// the two per step by their measured costs (adjoint_cost_model.h).
+// the two per step by their estimated costs (adjoint_cost_model.h).
 // Residual growth, stagnation or negative curvature of the iteration
 // triggers a reported fallback to the direct solve (sparse LU when H is
 // indefinite).
-#include <chrono>
 #include <cstdio>
 #include <optional>
 #include <sstream>
@@ -28,8 +27,6 @@
 
 namespace diffpd::internal {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 bool IsPdMethod(Method m) { return m == Method::kPd || m == Method::kPdLbfgs; }
 
@@ -100,6 +97,7 @@ void StepLinearization::PartLameDots(const VectorXd& z, VectorXd* dmu, VectorXd*
 }
 
 VectorXd StepLinearization::ApplyUnmasked(const VectorXd& z) {
+  ++hessian_products_;
   VectorXd zf = z;
   sim_.ZeroFixed(&zf);
   VectorXd out;
@@ -115,7 +113,6 @@ bool StepLinearization::DirectSolve(const MatrixXd& b, MatrixXd* z) {
     AssembleMatrix();
     factored_ = factor.Factorize(matrix_);
     factor_id_ = factor.num_factorizations();
-    analysis_seconds_ += factor.analysis_seconds();
     if (!factored_) {  // indefinite H (e.g. strongly compressed elements): sparse LU
       lu_ = std::make_unique<Eigen::SparseLU<SparseMatrix>>();
       lu_->compute(matrix_);
@@ -175,7 +172,8 @@ void StepLinearization::IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, st
   }
   SolvePreconditioned(
       iteration, guessed ? residual : rhs, apply_h,
-      [&pd, &rigid](const MatrixXd& r) {
+      [this, &pd, &rigid](const MatrixXd& r) {
+        pd_solves_ += static_cast<int>(r.cols());
         MatrixXd out = pd.Solve(r);
         if (rigid) rigid->Add(r, &out);
         return out;
@@ -210,6 +208,25 @@ bool StepLinearization::DirectAdjointFits() {
          DirectAdjointBytes() <= sim_.options.adjoint_direct_max_bytes;
 }
 
+AdjointWorkSizes StepLinearization::WorkSizes() {
+  AdjointWorkSizes sizes;
+  sizes.dofs = static_cast<double>(sim_.num_dofs());
+  sizes.packed_entries = static_cast<double>(PackedBlocks().size());
+  const PdSystem& pd = sim_.pd_system();
+  sizes.pd_solve_entries = pd.SolveEntries();
+  const HessianFactorization& factor = sim_.hessian_factorization();
+  sizes.hessian_analysed = factor.factor_nonzeros() > 0;
+  if (sizes.hessian_analysed) {
+    sizes.hessian_factor_entries = factor.factor_nonzeros();
+    sizes.hessian_factor_flops = factor.factor_flops();
+  } else {
+    // H is A's pattern with 3 x 3 blocks: 9 times the entries, 27 times the flops.
+    sizes.hessian_factor_entries = kHessianFactorEntriesPerPdEntry * pd.factor_nonzeros();
+    sizes.hessian_factor_flops = 27 * pd.factor_flops();
+  }
+  return sizes;
+}
+
 VectorXd StepLinearization::Solve(const VectorXd& b, BackwardReport* report) {
   return SolveSystem(b, &sim_.backward_cost_model(), /*tangent=*/false, report).col(0);
 }
@@ -220,8 +237,6 @@ MatrixXd StepLinearization::SolveColumns(const MatrixXd& b, BackwardReport* repo
 
 MatrixXd StepLinearization::SolveSystem(const MatrixXd& b, AdjointCostModel* model, bool tangent,
                                         BackwardReport* report) {
-  const auto start = Clock::now();
-  analysis_seconds_ = 0;
   const Method m = sim_.options.method;
   const char* pass = tangent ? "tangent" : "backward";
   if (!b.allFinite())
@@ -244,6 +259,9 @@ MatrixXd StepLinearization::SolveSystem(const MatrixXd& b, AdjointCostModel* mod
         break;
       case AdjointSolver::kAuto:
         if (DirectAdjointFits()) {
+          const AdjointWorkSizes sizes = WorkSizes();
+          model->SetDirectEstimate(DirectSeconds(sizes, cols) +
+                                   (sizes.hessian_analysed ? 0.0 : AnalysisSeconds(sizes) / steps_left_));
           iterative = model->Next() == AdjointCostModel::Solver::kIterative;
           chosen = true;
         } else {
@@ -252,6 +270,7 @@ MatrixXd StepLinearization::SolveSystem(const MatrixXd& b, AdjointCostModel* mod
         break;
     }
   }
+  const int products_before = hessian_products_, pd_solves_before = pd_solves_;
   if (iterative && IsPdMethod(m)) {
     IterativeSolveColumns(b, &z, &ok, &iterations);
   } else if (iterative) {
@@ -305,10 +324,18 @@ MatrixXd StepLinearization::SolveSystem(const MatrixXd& b, AdjointCostModel* mod
   if (report) ++(iterative ? report->iterative_steps : report->direct_steps);
   if (recycling_) recycling_->Push(z);
   if (chosen) {
-    // The one-off symbolic analysis is not a per-step cost.
-    const double seconds = std::chrono::duration<double>(Clock::now() - start).count() - analysis_seconds_;
-    model->Record(iterative ? AdjointCostModel::Solver::kIterative : AdjointCostModel::Solver::kDirect,
-                  std::max(seconds, 0.0));
+    if (iterative) {
+      IterativeWork work;
+      work.hessian_products = hessian_products_ - products_before;
+      work.pd_solves = pd_solves_ - pd_solves_before;
+      work.iterations = iterations;
+      double seconds = IterativeSeconds(WorkSizes(), work);
+      // A fallback's factorisation was part of this step's cost.
+      if (!rest.empty()) seconds += DirectSeconds(WorkSizes(), static_cast<int>(rest.size()));
+      model->Record(AdjointCostModel::Solver::kIterative, seconds);
+    } else {
+      model->Record(AdjointCostModel::Solver::kDirect, 0.0);
+    }
   }
   return z;
 }

@@ -372,6 +372,7 @@ TangentRollout TangentPass(SimulatorImpl& sim, const std::vector<StepInput>& inp
       if (!pinned.empty()) pins.emplace(sim, pinned, s1.x);
       internal::StepLinearization lin(sim, s1.x);
       lin.set_recycling(&recycling);
+      lin.set_steps_left(steps - i);
       lin.set_rel_tolerance(internal::AdjointRelTolerance(sim.options, forward.rel_tolerance, at.report));
       dx1 = lin.SolveColumns(b, &out.report) + dpin;  // zero at fixed DoFs but the pins
     } else {

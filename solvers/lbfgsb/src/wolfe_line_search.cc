@@ -2,37 +2,109 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace diffpd::solvers::lbfgsb_internal {
 namespace {
 
-struct Trial {
+// A step with its value and slope g(x + a d)^T d (of f or of psi).
+struct Point {
   double step = 0, f = 0, slope = 0;
-  bool failed = false;  // the evaluation failed: no value, only an upper end
-  VectorXd x, gradient;
+  bool has_value = true;  // false: its evaluation failed (an upper end only)
 };
 
-// The minimiser of the cubic through (a, fa, da) and (b, fb, db); the
-// quadratic's through (a, fa, da) and (a, fb) when the cubic has none; NaN
-// when neither has.
-double Interpolate(const Trial& a, const Trial& b) {
-  const double h = b.step - a.step;
-  if (!b.failed) {
-    const double d1 = a.slope + b.slope - 3 * (a.f - b.f) / (a.step - b.step);
-    const double disc = d1 * d1 - a.slope * b.slope;
-    if (disc >= 0) {
-      const double d2 = std::copysign(std::sqrt(disc), h);
-      const double denom = b.slope - a.slope + 2 * d2;
-      if (denom != 0) {
-        const double t = b.step - h * (b.slope + d2 - d1) / denom;
-        if (std::isfinite(t)) return t;
-      }
+// The minimiser of the cubic interpolating (a, fa, da) and (b, fb, db),
+// written as in More and Thuente with gamma's sign taken towards `toward`
+// (the scaling by s guards against overflow); the cubic may have no
+// minimiser, then the root is clamped at 0 (clamp_root) or the formula gives
+// the one of the quadratic limit.
+struct CubicTerms {
+  double theta, gamma;
+};
+CubicTerms Cubic(const Point& a, const Point& b, bool clamp_root) {
+  const double theta = 3 * (a.f - b.f) / (b.step - a.step) + a.slope + b.slope;
+  const double s = std::max({std::abs(theta), std::abs(a.slope), std::abs(b.slope)});
+  double radicand = (theta / s) * (theta / s) - (a.slope / s) * (b.slope / s);
+  if (clamp_root || radicand < 0) radicand = std::max(radicand, 0.0);
+  return {theta, s * std::sqrt(radicand)};
+}
+
+// More and Thuente's safeguarded step from the best step x, the other end y
+// and the trial t, within [step_min, step_max] while nothing is bracketed;
+// updates x and y (the interval of uncertainty) and bracketed.
+double SafeguardedStep(Point* x, Point* y, const Point& t, bool* bracketed, double step_min, double step_max) {
+  const double sign = x->slope < 0 ? -t.slope : t.slope;  // < 0: the slopes differ in sign
+  double next;
+  if (t.f > x->f) {
+    // Case 1, a higher value: the minimiser is bracketed. The cubic step if
+    // it is the nearer to x, else halfway between it and the quadratic's.
+    CubicTerms c = Cubic(*x, t, false);
+    if (t.step < x->step) c.gamma = -c.gamma;
+    const double p = (c.gamma - x->slope) + c.theta;
+    const double q = ((c.gamma - x->slope) + c.gamma) + t.slope;
+    const double cubic = x->step + (p / q) * (t.step - x->step);
+    const double quadratic =
+        x->step + ((x->slope / ((x->f - t.f) / (t.step - x->step) + x->slope)) / 2) * (t.step - x->step);
+    next = std::abs(cubic - x->step) < std::abs(quadratic - x->step) ? cubic : cubic + (quadratic - cubic) / 2;
+    *bracketed = true;
+  } else if (sign < 0) {
+    // Case 2, a lower value and the slope's sign changed: bracketed. The
+    // cubic step if it is the farther from t, else the secant step.
+    CubicTerms c = Cubic(*x, t, false);
+    if (t.step > x->step) c.gamma = -c.gamma;
+    const double p = (c.gamma - t.slope) + c.theta;
+    const double q = ((c.gamma - t.slope) + c.gamma) + x->slope;
+    const double cubic = t.step + (p / q) * (x->step - t.step);
+    const double secant = t.step + (t.slope / (t.slope - x->slope)) * (x->step - t.step);
+    next = std::abs(cubic - t.step) > std::abs(secant - t.step) ? cubic : secant;
+    *bracketed = true;
+  } else if (std::abs(t.slope) < std::abs(x->slope)) {
+    // Case 3, a lower value, the same sign and a smaller slope: the cubic
+    // step only if the cubic tends to infinity in the step's direction (and
+    // its minimum is beyond t), else the interval's end.
+    CubicTerms c = Cubic(*x, t, true);
+    if (t.step > x->step) c.gamma = -c.gamma;
+    const double p = (c.gamma - t.slope) + c.theta;
+    const double q = (c.gamma + (x->slope - t.slope)) + c.gamma;
+    const double r = p / q;
+    double cubic;
+    if (r < 0 && c.gamma != 0)
+      cubic = t.step + r * (x->step - t.step);
+    else
+      cubic = t.step > x->step ? step_max : step_min;
+    const double secant = t.step + (t.slope / (t.slope - x->slope)) * (x->step - t.step);
+    if (*bracketed) {
+      // The nearer of the two, at most 0.66 of the way to y.
+      next = std::abs(cubic - t.step) < std::abs(secant - t.step) ? cubic : secant;
+      const double limit = t.step + 0.66 * (y->step - t.step);
+      next = t.step > x->step ? std::min(limit, next) : std::max(limit, next);
+    } else {
+      next = std::abs(cubic - t.step) > std::abs(secant - t.step) ? cubic : secant;
+      next = std::clamp(next, step_min, step_max);
     }
-    const double curvature = b.f - a.f - a.slope * h;
-    if (curvature > 0) return a.step - a.slope * h * h / (2 * curvature);
+  } else {
+    // Case 4, a lower value, the same sign and no smaller slope: the cubic
+    // through t and y if bracketed (halfway to y if y has no value), else
+    // the interval's end.
+    if (*bracketed && y->has_value) {
+      CubicTerms c = Cubic(t, *y, false);
+      if (t.step > y->step) c.gamma = -c.gamma;
+      const double p = (c.gamma - t.slope) + c.theta;
+      const double q = ((c.gamma - t.slope) + c.gamma) + y->slope;
+      next = t.step + (p / q) * (y->step - t.step);
+    } else if (*bracketed) {
+      next = t.step + 0.5 * (y->step - t.step);
+    } else {
+      next = t.step > x->step ? step_max : step_min;
+    }
   }
-  return std::nan("");
+  // The interval of uncertainty.
+  if (t.f > x->f) {
+    *y = t;
+  } else {
+    if (sign < 0) *y = *x;
+    *x = t;
+  }
+  return next;
 }
 
 }  // namespace
@@ -44,63 +116,96 @@ LineSearchResult StrongWolfeLineSearch(const Evaluator& evaluate, const VectorXd
   const VectorXd d = xbar - x;
   const double slope0 = g0.dot(d);
   if (!(slope0 < 0) || !(step_max > 0)) return out;
-  Trial lo;  // the best point with sufficient decrease so far (the start at first)
-  lo.step = 0;
-  lo.f = f0;
-  lo.slope = slope0;
-  Trial hi;  // the other end once bracketed
-  bool bracketed = false;
+  constexpr double kExtrapolateMin = 1.1, kExtrapolateMax = 4;
+  const double decrease_slope = settings.c1 * slope0;  // psi(a) = f(a) - f0 - a decrease_slope
+
+  Point best{0, f0, slope0}, other{0, f0, slope0};  // stx and sty
+  VectorXd best_x = x, best_gradient = g0;
+  bool bracketed = false, first_stage = true;
   double step = std::min(step0, step_max);
-  const auto accept = [&](const Trial& t, bool wolfe) {
+  double width = step_max, previous_width = 2 * width;
+  double low = 0, high = step + kExtrapolateMax * step;  // where the next step may fall
+  const auto finish = [&](const Point& p, const VectorXd& px, const VectorXd& pg, bool wolfe) {
     out.accepted = true;
     out.strong_wolfe = wolfe;
-    out.step = t.step;
-    out.x = t.x;
-    out.gradient = t.gradient;
-    out.f = t.f;
+    out.step = p.step;
+    out.x = px;
+    out.gradient = pg;
+    out.f = p.f;
+    return out;
+  };
+  // Ends without the Wolfe conditions: at the best step if it lowered f.
+  const auto give_up = [&]() {
+    if (best.step > 0 && best.f < f0) return finish(best, best_x, best_gradient, false);
+    return out;
   };
   for (int k = 0; k < settings.max_steps; ++k) {
-    Trial t;
+    Point t;
     t.step = step;
-    t.x = step == 1 ? xbar : VectorXd((x + step * d).cwiseMax(lower).cwiseMin(upper));
+    const VectorXd xt = step == 1 ? xbar : VectorXd((x + step * d).cwiseMax(lower).cwiseMin(upper));
+    VectorXd gt;
     ++out.trials;
-    t.failed = !evaluate(t.x, &t.f, &t.gradient);
-    if (!t.failed) t.slope = t.gradient.dot(d);
-    if (t.failed || t.f > f0 + settings.c1 * step * slope0 || t.f >= lo.f) {
-      hi = t;  // too long (or no value): the minimiser lies before it
+    t.has_value = evaluate(xt, &t.f, &gt);
+    double next;
+    if (!t.has_value) {
+      // Too long (or no value): halfway back to the best step.
+      other = t;
       bracketed = true;
+      next = best.step + 0.5 * (step - best.step);
     } else {
-      if (std::abs(t.slope) <= -settings.c2 * slope0) {
-        accept(t, true);
-        return out;
+      t.slope = gt.dot(d);
+      const double sufficient = f0 + step * decrease_slope;
+      if (first_stage && t.f <= sufficient && t.slope >= 0) first_stage = false;
+      if (t.f <= sufficient && std::abs(t.slope) <= -settings.c2 * slope0) return finish(t, xt, gt, true);
+      if (step == step_max && t.f <= sufficient && t.slope <= decrease_slope)
+        return finish(t, xt, gt, false);  // at the box's edge, still going down
+      const Point old_best = best;
+      if (first_stage && t.f <= best.f && t.f > sufficient) {
+        // On psi, whose minimisers have sufficient decrease.
+        const auto modified = [&](Point p) {
+          if (p.has_value) {
+            p.f -= p.step * decrease_slope;
+            p.slope -= decrease_slope;
+          }
+          return p;
+        };
+        const auto restored = [&](Point p) {
+          if (p.has_value) {
+            p.f += p.step * decrease_slope;
+            p.slope += decrease_slope;
+          }
+          return p;
+        };
+        Point mb = modified(best), mo = modified(other);
+        next = SafeguardedStep(&mb, &mo, modified(t), &bracketed, low, high);
+        best = restored(mb);
+        other = restored(mo);
+      } else {
+        next = SafeguardedStep(&best, &other, t, &bracketed, low, high);
       }
-      if (bracketed ? t.slope * (hi.step - lo.step) >= 0 : t.slope >= 0) {
-        hi = lo;
-        bracketed = true;
-      }
-      lo = t;
-      if (!bracketed && step >= step_max) {
-        accept(lo, false);  // at the box's edge, still going down
-        return out;
+      if (best.step != old_best.step) {
+        best_x = xt;
+        best_gradient = gt;
       }
     }
-    // The next trial step.
     if (bracketed) {
-      const double a = std::min(lo.step, hi.step), b = std::max(lo.step, hi.step);
-      const double width = b - a;
-      if (width <= std::numeric_limits<double>::epsilon() * std::max(1.0, b)) break;
-      double next = hi.failed ? std::nan("") : Interpolate(lo, hi);
-      if (!std::isfinite(next) || next < a + 0.1 * width || next > b - 0.1 * width) {
-        // Safeguard: bisect (a failed end is approached from the good side).
-        next = hi.failed ? lo.step + 0.5 * (hi.step - lo.step) : 0.5 * (a + b);
-      }
-      step = next;
+      // Bisect when two steps have not shrunk the interval to 2/3.
+      if (std::abs(other.step - best.step) >= 0.66 * previous_width) next = best.step + 0.5 * (other.step - best.step);
+      previous_width = width;
+      width = std::abs(other.step - best.step);
+      low = std::min(best.step, other.step);
+      high = std::max(best.step, other.step);
     } else {
-      step = std::min(step_max, 4 * step);
+      low = next + kExtrapolateMin * (next - best.step);
+      high = next + kExtrapolateMax * (next - best.step);
     }
+    step = std::clamp(next, 0.0, step_max);
+    // No further progress: the step would leave the bracket (rounding) or
+    // the bracket is narrow relative to its scale.
+    if (bracketed && (step <= low || step >= high || high - low <= settings.xtol * high)) return give_up();
+    if (!std::isfinite(step)) return give_up();
   }
-  if (lo.step > 0) accept(lo, false);
-  return out;
+  return give_up();
 }
 
 }  // namespace diffpd::solvers::lbfgsb_internal

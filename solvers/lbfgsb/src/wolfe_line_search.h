@@ -1,17 +1,29 @@
-// A line search for a step a in (0, a_max] along a descent direction
-// d = xbar - x that meets the strong Wolfe conditions
+// The line search of L-BFGS-B: a step a in (0, a_max] along a descent
+// direction d = xbar - x that meets the strong Wolfe conditions
 //
 //   f(x + a d) <= f(x) + c1 a g^T d,   |g(x + a d)^T d| <= c2 |g^T d|,
 //
-// by bracketing and zooming with safeguarded cubic interpolation (Nocedal
-// and Wright, Numerical Optimization, algorithms 3.5 and 3.6). Every trial
-// point is projected onto the box (a_max keeps it inside but for rounding);
-// the trial at a = 1 is xbar itself, so variables that xbar puts on a bound
-// land on it exactly.
-// A failed trial evaluation shortens the step towards the last good point
-// (bisection). At a_max with the slope still negative the search stops there
-// (the bound); out of trials it returns the best point with sufficient
-// decrease, if any.
+// by the safeguarded cubic and quadratic interpolation of More and Thuente
+// ("Line search algorithms with guaranteed sufficient decrease", ACM TOMS
+// 20(3), 1994), the search of the original code (and so of scipy): while no
+// step has shown both sufficient decrease and a non-negative slope it works
+// on psi(a) = f(x + a d) - f(x) - c1 a g^T d; the interval of uncertainty
+// [stx, sty] (stx the best step so far) is bisected when two trials have not
+// shrunk it to 2/3; before a bracket the next step lies 1.1 to 4 times the
+// last step's distance from stx beyond it. It ends
+//   - with the strong Wolfe conditions met (strong_wolfe),
+//   - at a_max with sufficient decrease and the slope still below c1 g^T d
+//     (the box's edge),
+//   - once the bracket is narrower than xtol times its upper end, or when
+//     rounding leaves no step strictly inside it, or after max_steps trials:
+//     at the best step stx if it lowered f, else without a step (the
+//     original code evaluates stx again; this search keeps its value and
+//     gradient).
+// Every trial point is projected onto the box (a_max keeps it inside but for
+// rounding); the trial at a = 1 is xbar itself, so variables that xbar puts
+// on a bound land on it exactly. A failed trial evaluation shortens the step
+// to halfway back to the best step (an upper end of the bracket without a
+// value).
 #pragma once
 
 #include <functional>
@@ -26,6 +38,8 @@ using Evaluator = std::function<bool(const VectorXd& x, double* f, VectorXd* gra
 
 struct LineSearchSettings {
   double c1 = 1e-3, c2 = 0.9;
+  // Relative width of the bracket that ends the search (the original's xtol).
+  double xtol = 0.1;
   int max_steps = 20;
 };
 

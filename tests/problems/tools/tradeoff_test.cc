@@ -140,9 +140,8 @@ TEST(TradeoffTest, RepeatsKeepTheErrorsAndTheCpuClockCountsCpuSeconds) {
   for (size_t i = 0; i < once.rows.size(); ++i) {
     const TradeoffRow &a = once.rows[i], &b = thrice.rows[i];
     ASSERT_TRUE(a.ok() && b.ok()) << a.failure << b.failure;
-    // One thread: the repeated forward passes are the same computation; the
-    // adjoint agrees to its tolerance (adjoint_solver auto picks the solve
-    // per step by measured time).
+    // One thread: the repeated forward passes are the same computation, and
+    // the adjoint agrees (at least to its tolerance).
     EXPECT_EQ(a.state_rel_error, b.state_rel_error);
     EXPECT_EQ(a.iters_per_step, b.iters_per_step);
     EXPECT_NEAR(a.grad_rel_error, b.grad_rel_error, 1e-2 * a.grad_rel_error);

@@ -105,6 +105,157 @@ TEST(LbfgsbTest, BoundedQuadraticFindsItsKktPointAndItsActiveSet) {
   EXPECT_LE((t.x - x_star).lpNorm<Eigen::Infinity>(), 1e-5);
 }
 
+// sum 100 (x_i - 1)^4 + (x_i - 1)^2: the first step (to the box's corner)
+// raises f 57-fold, so the line search must interpolate far back.
+bool Steep(const VectorXd& x, double* f, VectorXd* g) {
+  const VectorXd r = x.array() - 1;
+  *f = (100 * r.array().pow(4) + r.array().square()).sum();
+  *g = (400 * r.array().cube() + 2 * r.array()).matrix();
+  return true;
+}
+
+// sum exp(a_i x_i) - b_i x_i, a from 1 to 3, b from 2 to 5 (n >= 2).
+bool Exponentials(const VectorXd& x, double* f, VectorXd* g) {
+  const int n = static_cast<int>(x.size());
+  *f = 0;
+  *g = VectorXd(n);
+  for (int i = 0; i < n; ++i) {
+    const double a = 1 + 2.0 * i / (n - 1), b = 2 + 3.0 * i / (n - 1), e = std::exp(a * x(i));
+    *f += e - b * x(i);
+    (*g)(i) = a * e - b;
+  }
+  return true;
+}
+
+// The Rosenbrock function with its gradient's entries off by a relative 1e-4
+// (a deterministic function of x, as a simulation solved to a tolerance).
+bool RosenbrockNoisyGradient(const VectorXd& x, double* f, VectorXd* g) {
+  Rosenbrock(x, f, g);
+  double s = 0;
+  for (int i = 0; i < x.size(); ++i) s += x(i) * (i + 1);
+  for (int i = 0; i < x.size(); ++i) (*g)(i) *= 1 + 1e-4 * std::sin(1e6 * s + 7.0 * i);
+  return true;
+}
+
+TEST(LbfgsbTest, TakesScipysIterationsAndEvaluationsOnBoundedProblems) {
+  // The same algorithm as scipy's (1.10.1, minimize(method='L-BFGS-B'),
+  // maxcor 10, the same ftol and gtol): evaluations after each iteration,
+  // recorded from scipy's callback:
+  //   Steep, 5 variables in [-10, 10] from 5:            3 6 7 8 9 10 11 12 13 14 15 16
+  //   Exponentials, 6 variables in [-5, 5] from 3:       2 9 12 14 15 17 18 19 ... 29
+  //   Rosenbrock, 2 variables in [-2, 0.5] x [-1, 2]:    3 4 5 7 8 12 14 15 16 17 19 21 22 23 25 ... 30
+  //   Rosenbrock, 10 variables, no bounds, from -1.2 (first step 1 / |d|): 2 3 ... 13 15 16 18 19 20 21 23 25 ...
+  //     84 evaluations in 69 iterations
+  //   Rosenbrock with a noisy gradient, 10 variables in [-2, 0.6] from -1.2: 27 iterations, 30 evaluations,
+  //     x = (0.6, 0.37496961002, 0.15222888399, ...)
+  // The line searches of the first iterations interpolate (More and
+  // Thuente's safeguarded steps): those counts must match exactly, the
+  // totals within one.
+  struct Case {
+    const char* name;
+    LbfgsbObjective f;
+    VectorXd x0, lower, upper;
+    double ftol, pgtol;
+    std::vector<long> evaluations;  // after the first iterations
+    int iterations;
+    long total;
+    VectorXd solution;  // its first entries
+  };
+  const std::vector<Case> cases = {
+      {"steep",
+       Steep,
+       VectorXd::Constant(5, 5),
+       VectorXd::Constant(5, -10),
+       VectorXd::Constant(5, 10),
+       1e-12,
+       1e-8,
+       {3, 6, 7},
+       12,
+       16,
+       VectorXd::Ones(5)},
+      {"exponentials",
+       Exponentials,
+       VectorXd::Constant(6, 3),
+       VectorXd::Constant(6, -5),
+       VectorXd::Constant(6, 5),
+       1e-12,
+       1e-8,
+       {2, 9, 12, 14, 15},
+       18,
+       29,
+       (VectorXd(3) << std::log(2.0), std::log(2.6 / 1.4) / 1.4, std::log(3.2 / 1.8) / 1.8).finished()},
+      {"bounded Rosenbrock",
+       Rosenbrock,
+       (VectorXd(2) << -1.2, 1).finished(),
+       (VectorXd(2) << -2, -1).finished(),
+       (VectorXd(2) << 0.5, 2).finished(),
+       0,
+       1e-9,
+       {3, 4, 5, 7, 8, 12},
+       20,
+       30,
+       (VectorXd(2) << 0.5, 0.25).finished()},
+      {"unbounded Rosenbrock",
+       Rosenbrock,
+       VectorXd::Constant(10, -1.2),
+       VectorXd::Constant(10, -kInf),
+       VectorXd::Constant(10, kInf),
+       1e-12,
+       1e-8,
+       {2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 15, 16, 18, 19, 20, 21, 23, 25},
+       69,
+       84,
+       VectorXd::Ones(10)},
+      {"noisy gradient",
+       RosenbrockNoisyGradient,
+       VectorXd::Constant(10, -1.2),
+       VectorXd::Constant(10, -2),
+       VectorXd::Constant(10, 0.6),
+       1e-12,
+       1e-8,
+       {},
+       27,
+       30,
+       (VectorXd(3) << 0.6, 0.37496961002, 0.15222888399).finished()},
+  };
+  for (const Case& c : cases) {
+    LbfgsbOptions o;
+    o.ftol = c.ftol;
+    o.pgtol = c.pgtol;
+    const LbfgsbResult r = MinimizeLbfgsb(c.f, c.x0, c.lower, c.upper, o);
+    ASSERT_GT(r.history.size(), c.evaluations.size()) << c.name;
+    for (size_t k = 0; k < c.evaluations.size(); ++k)
+      EXPECT_EQ(r.history[k + 1].evaluations, c.evaluations[k]) << c.name << ", iteration " << k + 1;
+    EXPECT_NEAR(r.iterations, c.iterations, 1) << c.name;
+    EXPECT_NEAR(r.evaluations, c.total, 1) << c.name;
+    EXPECT_LE((r.x.head(c.solution.size()) - c.solution).lpNorm<Eigen::Infinity>(), 1e-6) << c.name;
+    EXPECT_EQ(r.memory_resets, 0) << c.name;
+  }
+}
+
+TEST(LbfgsbTest, AFarTooLongFirstStepIsCutBackByInterpolationAsScipyDoes) {
+  // Steep from 5 in [-10, 10]^5: the first trial (the box's corner, f =
+  // 7321105 against 128080) brackets the step; More and Thuente's case of a
+  // higher value takes the cubic minimiser or, when the quadratic's is nearer
+  // the best step, halfway between the two. scipy's second trial has f =
+  // 4.2891567875311809 and is accepted; a bisecting search needs more trials.
+  std::vector<double> values;
+  const auto steep = [&](const VectorXd& x, double* f, VectorXd* g) {
+    Steep(x, f, g);
+    values.push_back(*f);
+    return true;
+  };
+  LbfgsbOptions o;
+  o.max_iterations = 1;
+  const LbfgsbResult r =
+      MinimizeLbfgsb(steep, VectorXd::Constant(5, 5), VectorXd::Constant(5, -10), VectorXd::Constant(5, 10), o);
+  ASSERT_EQ(values.size(), 3u);
+  EXPECT_DOUBLE_EQ(values[0], 128080);
+  EXPECT_DOUBLE_EQ(values[1], 7321105);
+  EXPECT_NEAR(values[2], 4.2891567875311809, 1e-12 * 4.29);
+  EXPECT_EQ(r.f, values[2]);
+}
+
 // H g by the two-loop recursion over the pairs (oldest first), H0 = s^T y / y^T y.
 VectorXd TwoLoop(const std::deque<VectorXd>& s, const std::deque<VectorXd>& y, const VectorXd& g) {
   const int k = static_cast<int>(s.size());

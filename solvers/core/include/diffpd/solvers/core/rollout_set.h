@@ -17,7 +17,8 @@
 // EvaluateRolloutTerm / RolloutTermGradient and combine the terms in the
 // same order, so their results agree bit for bit when the terms'
 // simulations are deterministic (fixed thread counts and a fixed
-// SolverOptions::adjoint_solver: kAuto chooses by measured time).
+// SolverOptions::adjoint_solver: kAuto's choices depend on what each
+// simulator solved before).
 //
 // Failures: Evaluate and Gradient never throw; false, with the reason in
 // last_error() ("term 2: rollout failed (...)").

@@ -12,7 +12,15 @@
 // method; its step projected onto the box as in the code's version 3.0
 // (Morales and Nocedal 2011), truncated to the box where that is no descent
 // direction); a line search along d = xbar - x for a step meeting the
-// strong Wolfe conditions inside the box (every trial point is projected).
+// strong Wolfe conditions inside the box: More and Thuente's, as the
+// original code's (scipy's), with its constants (xtol 0.1), its largest step
+// (to the box; 1 on the first iteration of a bounded problem) and its first
+// trial (1, or 1 / |d| on the first iteration of a problem not boxed). Where
+// the original ends a search by evaluating its best step again, this one
+// keeps that step's value; out of trials it takes its best step if that
+// lowered f (the original restarts from x). A search that finds no lower f
+// restarts from steepest descent with the memory cleared, once; then the run
+// stops (kLineSearchFailed).
 //
 //   LbfgsbResult r = MinimizeLbfgsb(
 //       [](const VectorXd& x, double* f, VectorXd* g) { *f = x.squaredNorm(); *g = 2 * x; return true; },
