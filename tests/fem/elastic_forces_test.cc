@@ -354,5 +354,89 @@ TEST(ElasticForcesTest, PackedProductMatchesTheDenseBlocksForPartialGroups) {
   }
 }
 
+// The product of several columns in one pass over the packed matrices
+// equals the single-vector product of each column bit for bit (the same
+// kernel and sums per column), for tetrahedra and hexahedra with a partly
+// empty last group, on 1 and 2 threads, and the single-vector product is
+// unchanged by a column product made in between.
+TEST(ElasticForcesTest, PackedProductOfColumnsEqualsTheProductOfEachColumn) {
+  for (const bool tets : {false, true}) {
+    PartialGroupBeam beam(tets, testing::SmallBeamScene(tets).energies);
+    ElasticForces& forces = beam.forces;
+    std::mt19937 rng(16);
+    const int rows = static_cast<int>(beam.x.size()), cols = 5;
+    MatrixXd z(rows, cols);
+    for (int c = 0; c < cols; ++c) z.col(c) = NormalVector(rows, &rng);
+    for (const int threads : {1, 2}) {
+      MatrixXd product;
+      forces.ApplyElementMatricesToColumns(beam.packed, z, &product, threads);
+      ASSERT_EQ(product.rows(), rows);
+      ASSERT_EQ(product.cols(), cols);
+      for (int c = 0; c < cols; ++c) {
+        VectorXd single;
+        forces.ApplyElementMatrices(beam.packed, z.col(c), &single, threads);
+        EXPECT_EQ((product.col(c) - single).cwiseAbs().maxCoeff(), 0.0)
+            << (tets ? "tets" : "hexes") << ", column " << c << ", " << threads << " threads";
+        EXPECT_GT(single.norm(), 0.0);
+      }
+    }
+  }
+}
+
+// The unit-parameter gradients kept by the packed Hessian pass give
+// PartLameDots' per-part dots (to rounding, from the same warm-start cache),
+// for coefficient-form energy sets (lane-by-lane pass) and a set with a
+// non-SVD energy (element-by-element pass); the warm-started pass's
+// Hessians equal the cold ones to rounding.
+TEST(ElasticForcesTest, UnitGradientsOfThePackedPassGiveThePartLameDots) {
+  using E = ElasticEnergy;
+  const std::vector<std::vector<E>> sets = {
+      {E::kPdCorotated, E::kPdVolume}, {E::kNeoHookean}, {E::kCorotated, E::kLinear}};
+  for (const bool tets : {false, true}) {
+    for (const auto& energies : sets) {
+      PartialGroupBeam beam(tets, energies);
+      const int m = beam.fem.num_elements();
+      std::vector<int> part(m);
+      for (int e = 0; e < m; ++e) part[e] = e % 2;
+      std::mt19937 rng(17);
+      const VectorXd z = NormalVector(static_cast<int>(beam.x.size()), &rng);
+      const LameField lame = LameField::Uniform(PartialGroupBeam::kMu, PartialGroupBeam::kLambda);
+      const std::string what =
+          std::string(tets ? "tets" : "hexes") + ", first energy " + std::to_string(static_cast<int>(energies[0]));
+      // Both from the same cache: a fresh object each (identity guesses),
+      // and again after both were moved by another state.
+      ElasticForces fused(beam.fem, energies), separate(beam.fem, energies);
+      for (int round = 0; round < 2; ++round) {
+        if (round == 1) {
+          const VectorXd other = DeformedPositions(beam.scene.mesh, 2e-3, 18);
+          fused.EnergyAndGradient(other, lame, nullptr, 1);
+          separate.EnergyAndGradient(other, lame, nullptr, 1);
+        }
+        std::vector<double> packed, gradients;
+        fused.PackedElementHessians(beam.x, lame, &packed, 1, &gradients, /*warm_start=*/true);
+        ASSERT_EQ(gradients.size(), static_cast<size_t>(6 * beam.fem.nodes_per_element()) * m) << what;
+        VectorXd dmu, dlambda, dmu_ref, dlambda_ref;
+        fused.LameDotsFromUnitGradients(gradients, z, part, 2, &dmu, &dlambda);
+        separate.PartLameDots(beam.x, z, part, 2, &dmu_ref, &dlambda_ref, 1);
+        VectorXd g_mu, g_lambda;
+        separate.EnergyAndGradient(beam.x, LameField::Uniform(1.0, 0.0), &g_mu, 1);
+        separate.EnergyAndGradient(beam.x, LameField::Uniform(0.0, 1.0), &g_lambda, 1);
+        for (int p = 0; p < 2; ++p) {
+          EXPECT_NEAR(dmu(p), dmu_ref(p), 1e-12 * z.norm() * g_mu.norm()) << what << ", round " << round;
+          EXPECT_NEAR(dlambda(p), dlambda_ref(p), 1e-12 * z.norm() * g_lambda.norm()) << what << ", round " << round;
+        }
+        EXPECT_NEAR(dmu.sum(), z.dot(g_mu), 1e-12 * z.norm() * g_mu.norm()) << what;
+        EXPECT_NE(dmu(0), 0.0) << what;
+        double largest = 0, worst = 0;
+        for (size_t i = 0; i < packed.size(); ++i) {
+          largest = std::max(largest, std::abs(beam.packed[i]));
+          worst = std::max(worst, std::abs(packed[i] - beam.packed[i]));
+        }
+        EXPECT_LE(worst, 1e-13 * largest) << what << ", round " << round;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace diffpd

@@ -79,6 +79,21 @@ inline void AddSampleStiffness(const double* g, double vol, const Mat9& dP,
                                         G(a, 2) * t.template middleRows<3>(6);
 }
 
+// Per part p, the sums over its elements (in element order) of the
+// per-element dots; throws SolverError(kNonFinite) for a non-finite sum.
+void SumPartDots(const std::vector<double>& element_mu, const std::vector<double>& element_lambda,
+                 const std::vector<int>& part_of_element, int num_parts, VectorXd* dmu, VectorXd* dlambda) {
+  *dmu = VectorXd::Zero(num_parts);
+  *dlambda = VectorXd::Zero(num_parts);
+  for (size_t e = 0; e < element_mu.size(); ++e) {
+    const int p = part_of_element.empty() ? 0 : part_of_element[e];
+    (*dmu)(p) += element_mu[e];
+    (*dlambda)(p) += element_lambda[e];
+  }
+  if (!dmu->allFinite() || !dlambda->allFinite())
+    throw SolverError(SolverStatus::kNonFinite, "the elastic Lame-parameter derivatives are not finite");
+}
+
 }  // namespace
 
 bool AnyNeedsSvd(const std::vector<ElasticEnergy>& energies) {
@@ -166,17 +181,20 @@ double ElasticForces::PdWeight(double mu, double lambda) const {
 }
 
 void ElasticForces::GatherElementBuffer(VectorXd* out, int threads) const {
+  out->resize(3 * fem_.num_nodes());
+  GatherBuffer(element_buffer_.data(), out->data(), threads);
+}
+
+void ElasticForces::GatherBuffer(const double* buffer, double* out, int threads) const {
   const int n = fem_.num_nodes();
-  out->resize(3 * n);
   const auto& off = fem_.node_offsets();
   const auto& inc = fem_.node_incidences();
   const int nt = threads > 0 ? threads : 0;
 #pragma omp parallel for schedule(static) num_threads(nt) if (nt != 1 && n >= 4 * kMinParallelElements)
   for (int i = 0; i < n; ++i) {
     Vec3 sum = Vec3::Zero();
-    for (int j = off[i]; j < off[i + 1]; ++j)
-      sum += Eigen::Map<const Vec3>(element_buffer_.data() + 3 * static_cast<size_t>(inc[j]));
-    out->segment<3>(3 * i) = sum;
+    for (int j = off[i]; j < off[i + 1]; ++j) sum += Eigen::Map<const Vec3>(buffer + 3 * static_cast<size_t>(inc[j]));
+    Eigen::Map<Vec3>(out + 3 * static_cast<size_t>(i)) = sum;
   }
 }
 
@@ -318,15 +336,60 @@ void ElasticForces::PartLameDotsImpl(const VectorXd& x, const VectorXd& z, const
     element_energy_[e] = ze.cwiseProduct(f_mu).sum();
     element_dot_[e] = ze.cwiseProduct(f_lambda).sum();
   });
-  *dmu = VectorXd::Zero(num_parts);
-  *dlambda = VectorXd::Zero(num_parts);
-  for (int e = 0; e < fem_.num_elements(); ++e) {
-    const int p = part_of_element.empty() ? 0 : part_of_element[e];
-    (*dmu)(p) += element_energy_[e];
-    (*dlambda)(p) += element_dot_[e];
+  SumPartDots(element_energy_, element_dot_, part_of_element, num_parts, dmu, dlambda);
+}
+
+template <int K>
+void ElasticForces::AddSampleUnitGradients(int s, const Mat3& F, const Svd3& svd, const VolumeProjection* volume,
+                                           double* g) const {
+  // One SVD and projection serve both unit-parameter stresses; pd-corotated
+  // (2 mu) has none at (0, 1), pd-volume (lambda) none at (1, 0).
+  Mat3 p_mu = Mat3::Zero(), p_lambda = Mat3::Zero(), p;
+  for (const ElasticEnergy energy : energies_) {
+    if (energy != ElasticEnergy::kPdVolume) {
+      EnergyAndStress(energy, F, svd, 1.0, 0.0, &p, volume);
+      p_mu += p;
+    }
+    if (energy != ElasticEnergy::kPdCorotated) {
+      EnergyAndStress(energy, F, svd, 0.0, 1.0, &p, volume);
+      p_lambda += p;
+    }
   }
-  if (!dmu->allFinite() || !dlambda->allFinite())
-    throw SolverError(SolverStatus::kNonFinite, "the elastic Lame-parameter derivatives are not finite");
+  const auto gt = Eigen::Map<const Eigen::Matrix<double, K, 3>>(fem_.grad(s)).transpose();
+  const double vol = fem_.sample_volume(s);
+  Eigen::Map<Eigen::Matrix<double, 3, K>>(g).noalias() += (vol * p_mu) * gt;
+  Eigen::Map<Eigen::Matrix<double, 3, K>>(g + 3 * K).noalias() += (vol * p_lambda) * gt;
+}
+
+void ElasticForces::LameDotsFromUnitGradients(const std::vector<double>& unit_gradients, const VectorXd& z,
+                                              const std::vector<int>& part_of_element, int num_parts, VectorXd* dmu,
+                                              VectorXd* dlambda) const {
+  const int m = fem_.num_elements();
+  DIFFPD_CHECK(unit_gradients.size() == static_cast<size_t>(6 * fem_.nodes_per_element()) * m,
+               "LameDotsFromUnitGradients: " << unit_gradients.size() << " entries for " << m << " elements");
+  DIFFPD_CHECK(part_of_element.empty() || static_cast<int>(part_of_element.size()) == m,
+               "part_of_element has " << part_of_element.size() << " entries");
+  std::vector<double> dots_mu(m), dots_lambda(m);
+  if (fem_.nodes_per_element() == 4)
+    UnitGradientDots<4>(unit_gradients, z, &dots_mu, &dots_lambda);
+  else
+    UnitGradientDots<8>(unit_gradients, z, &dots_mu, &dots_lambda);
+  SumPartDots(dots_mu, dots_lambda, part_of_element, num_parts, dmu, dlambda);
+}
+
+template <int K>
+void ElasticForces::UnitGradientDots(const std::vector<double>& unit_gradients, const VectorXd& z,
+                                     std::vector<double>* dots_mu, std::vector<double>* dots_lambda) const {
+  const Mesh& mesh = fem_.mesh();
+  using Block = Eigen::Matrix<double, 3, K>;
+  for (int e = 0; e < fem_.num_elements(); ++e) {
+    const double* g = unit_gradients.data() + static_cast<size_t>(6 * K) * e;
+    // PartLameDots' expressions, so that equal gradients give equal dots.
+    const Block ze = GatherElement<K>(mesh, z, e);
+    const Block f_mu = Eigen::Map<const Block>(g), f_lambda = Eigen::Map<const Block>(g + 3 * K);
+    (*dots_mu)[e] = ze.cwiseProduct(f_mu).sum();
+    (*dots_lambda)[e] = ze.cwiseProduct(f_lambda).sum();
+  }
 }
 
 template <int K>
@@ -435,11 +498,23 @@ void ElasticForces::PackElementMatrices(const std::vector<double>& blocks, std::
 
 template <int K>
 void ElasticForces::PackedElementHessiansImpl(const VectorXd& x, const LameField& lame, std::vector<double>* packed,
-                                              int threads) {
+                                              int threads, std::vector<double>* unit_gradients, bool warm_start) {
   constexpr int N = 3 * K;
   const int q_per = fem_.samples_per_element(), m = fem_.num_elements();
   const int groups = (m + kElementLanes - 1) / kElementLanes;
-  packed->assign(static_cast<size_t>(groups) * PackedEntries(K) * kElementLanes, 0.0);
+  const size_t group_entries = static_cast<size_t>(PackedEntries(K)) * kElementLanes;
+  // Cleared here, or group by group in the lane-by-lane pass (while in cache).
+  if (coefficient_form_)
+    packed->resize(groups * group_entries);
+  else
+    packed->assign(groups * group_entries, 0.0);
+  if (unit_gradients) unit_gradients->assign(static_cast<size_t>(6 * K) * m, 0.0);
+  // Element e's unit-parameter gradients from its samples (i: e's first).
+  const auto add_unit_gradients = [&](int e, const Mat3* F, const Svd3* svd, const VolumeProjection* volume) {
+    double* g = unit_gradients->data() + static_cast<size_t>(6 * K) * e;
+    for (int q = 0; q < q_per; ++q)
+      AddSampleUnitGradients<K>(e * q_per + q, F[q], svd[q], needs_volume_ ? &volume[q] : nullptr, g);
+  };
   if (coefficient_form_) {
     DIFFPD_CHECK(q_per <= kMaxSamplesPerElement, "PackedElementHessians: " << q_per << " samples per element");
     // Lane by lane over each group's elements, one sample index at a time:
@@ -455,9 +530,13 @@ void ElasticForces::PackedElementHessiansImpl(const VectorXd& x, const LameField
           VolumeProjection volume[kElementLanes * kMaxSamplesPerElement];
           for (int j = 0; j < count; j += per_batch)
             SampleDecompositions<K>(x, e0 + j, std::min(per_batch, count - j), F + j * q_per, svd + j * q_per,
-                                    volume + j * q_per, /*warm_start=*/false);
+                                    volume + j * q_per, warm_start);
+          if (unit_gradients)
+            for (int j = 0; j < count; ++j)
+              add_unit_gradients(e0 + j, F + j * q_per, svd + j * q_per, volume + j * q_per);
           PackedSampleLanes lanes{};  // lanes without an element stay zero
-          double* out = packed->data() + static_cast<size_t>(g) * PackedEntries(K) * kElementLanes;
+          double* out = packed->data() + g * group_entries;
+          std::fill(out, out + group_entries, 0.0);
           for (int q = 0; q < q_per; ++q) {
             for (int j = 0; j < count; ++j) {
               const int e = e0 + j, i = j * q_per + q, sample = e * q_per + q;
@@ -488,61 +567,88 @@ void ElasticForces::PackedElementHessiansImpl(const VectorXd& x, const LameField
     Mat3 F[kSvdBatch];
     Svd3 svd[kSvdBatch];
     VolumeProjection volume[kSvdBatch];
-    SampleDecompositions<K>(x, e0, count, F, svd, volume, /*warm_start=*/false);
+    SampleDecompositions<K>(x, e0, count, F, svd, volume, warm_start);
     Eigen::Matrix<double, N, N> ke;
     for (int j = 0; j < count; ++j) {
       ElementStiffness<K, /*kUpper=*/true>(e0 + j, F + j * q_per, svd + j * q_per, volume + j * q_per, lame, ke.data());
       PackElement(K, e0 + j, ke.data(), packed->data());
+      if (unit_gradients) add_unit_gradients(e0 + j, F + j * q_per, svd + j * q_per, volume + j * q_per);
     }
   });
 }
 
 void ElasticForces::PackedElementHessians(const VectorXd& x, const LameField& lame, std::vector<double>* packed,
-                                          int threads) {
+                                          int threads, std::vector<double>* unit_gradients, bool warm_start) {
+  if (!x.allFinite()) throw SolverError(SolverStatus::kNonFinite, "positions are not finite");
   if (fem_.nodes_per_element() == 4)
-    PackedElementHessiansImpl<4>(x, lame, packed, threads);
+    PackedElementHessiansImpl<4>(x, lame, packed, threads, unit_gradients, warm_start);
   else
-    PackedElementHessiansImpl<8>(x, lame, packed, threads);
+    PackedElementHessiansImpl<8>(x, lame, packed, threads, unit_gradients, warm_start);
 }
 
 template <int K>
-void ElasticForces::ApplyElementMatricesImpl(const std::vector<double>& packed, const VectorXd& z, VectorXd* out,
-                                             int threads) {
+void ElasticForces::ApplyElementMatricesImpl(const std::vector<double>& packed, const Eigen::Ref<const MatrixXd>& z,
+                                             double* out, int threads) {
   const size_t entries = PackedEntries(K);
   const Mesh& mesh = fem_.mesh();
-  const int m = fem_.num_elements();
+  const int m = fem_.num_elements(), cols = static_cast<int>(z.cols());
   const int groups = (m + kElementLanes - 1) / kElementLanes;
   DIFFPD_CHECK(packed.size() == static_cast<size_t>(groups) * entries * kElementLanes,
                "ApplyElementMatrices: " << packed.size() << " packed entries for " << m << " elements");
+  // One element buffer per column (the single-column product uses
+  // element_buffer_ itself).
+  const size_t buffer_size = static_cast<size_t>(m) * 3 * K;
+  double* buffer = element_buffer_.data();
+  if (cols > 1) {
+    if (column_buffer_.size() < buffer_size * cols) column_buffer_.resize(buffer_size * cols);
+    buffer = column_buffer_.data();
+  }
   ParallelForElements(
       groups, threads,
       [&](int g) {
         alignas(64) double zl[3 * K][kElementLanes];
         alignas(64) double yl[3 * K][kElementLanes];
         const int count = std::min(kElementLanes, m - g * kElementLanes);
-        for (int j = 0; j < kElementLanes; ++j) {
-          const int e = g * kElementLanes + j;
-          for (int a = 0; a < K; ++a) {
-            const int node = j < count ? mesh.elements(a, e) : 0;
-            for (int i = 0; i < 3; ++i) zl[3 * a + i][j] = j < count ? z(3 * node + i) : 0.0;
+        const double* group = packed.data() + static_cast<size_t>(g) * entries * kElementLanes;
+        for (int c = 0; c < cols; ++c) {
+          for (int j = 0; j < kElementLanes; ++j) {
+            const int e = g * kElementLanes + j;
+            for (int a = 0; a < K; ++a) {
+              const int node = j < count ? mesh.elements(a, e) : 0;
+              for (int i = 0; i < 3; ++i) zl[3 * a + i][j] = j < count ? z(3 * node + i, c) : 0.0;
+            }
           }
-        }
-        ApplyPackedGroup(K, packed.data() + static_cast<size_t>(g) * entries * kElementLanes, zl, yl);
-        for (int j = 0; j < count; ++j) {
-          double* ye = element_buffer_.data() + static_cast<size_t>(g * kElementLanes + j) * 3 * K;
-          for (int r = 0; r < 3 * K; ++r) ye[r] = yl[r][j];
+          ApplyPackedGroup(K, group, zl, yl);
+          for (int j = 0; j < count; ++j) {
+            double* ye = buffer + buffer_size * c + static_cast<size_t>(g * kElementLanes + j) * 3 * K;
+            for (int r = 0; r < 3 * K; ++r) ye[r] = yl[r][j];
+          }
         }
       },
       std::max(1, kMinParallelElements / kElementLanes));
-  GatherElementBuffer(out, threads);
+  for (int c = 0; c < cols; ++c)
+    GatherBuffer(buffer + buffer_size * c, out + static_cast<size_t>(z.rows()) * c, threads);
 }
 
 void ElasticForces::ApplyElementMatrices(const std::vector<double>& packed, const VectorXd& z, VectorXd* out,
                                          int threads) {
+  out->resize(z.size());
   if (fem_.nodes_per_element() == 4)
-    ApplyElementMatricesImpl<4>(packed, z, out, threads);
+    ApplyElementMatricesImpl<4>(packed, z, out->data(), threads);
   else
-    ApplyElementMatricesImpl<8>(packed, z, out, threads);
+    ApplyElementMatricesImpl<8>(packed, z, out->data(), threads);
+}
+
+void ElasticForces::ApplyElementMatricesToColumns(const std::vector<double>& packed, const MatrixXd& z, MatrixXd* out,
+                                                  int threads) {
+  DIFFPD_CHECK(z.rows() == 3 * fem_.num_nodes(),
+               "ApplyElementMatricesToColumns: " << z.rows() << " rows for " << fem_.num_nodes() << " nodes");
+  out->resize(z.rows(), z.cols());
+  if (z.cols() == 0) return;
+  if (fem_.nodes_per_element() == 4)
+    ApplyElementMatricesImpl<4>(packed, z, out->data(), threads);
+  else
+    ApplyElementMatricesImpl<8>(packed, z, out->data(), threads);
 }
 
 template <int K, bool kUpper>

@@ -93,13 +93,35 @@ class ElasticForces {
   // then PackElementMatrices, equal to rounding), in parallel, without the
   // full blocks: 8 elements per vector operation when every energy is
   // SVD-coefficient based (AddPackedSampleStiffness), else element by
-  // element (bit for bit).
-  void PackedElementHessians(const VectorXd& x, const LameField& lame, std::vector<double>* packed, int threads);
+  // element (bit for bit). With `unit_gradients` != nullptr the same pass
+  // (the same SVDs) also fills it with every element's unit-parameter
+  // gradients, the input of LameDotsFromUnitGradients: per element e,
+  // 6K doubles, d(grad_e E)/d mu_e (3 x K, column-major) then
+  // d(grad_e E)/d lambda_e. With warm_start the SVDs start from, and update,
+  // the warm-start cache as EnergyAndGradient's and PartLameDots' do (equal
+  // to rounding; after ResetWarmStart exactly the cold ones); without it
+  // they start cold and the result depends on x alone.
+  void PackedElementHessians(const VectorXd& x, const LameField& lame, std::vector<double>* packed, int threads,
+                             std::vector<double>* unit_gradients = nullptr, bool warm_start = false);
+  // PartLameDots(x, z, ...) from the unit gradients at x that
+  // PackedElementHessians made (num_elements * 6K entries): the same dots,
+  // summed in the same order, without evaluating the material again (bit
+  // for bit PartLameDots' when both decomposed x from the same warm-start
+  // cache). Throws SolverError(kNonFinite) like PartLameDots.
+  void LameDotsFromUnitGradients(const std::vector<double>& unit_gradients, const VectorXd& z,
+                                 const std::vector<int>& part_of_element, int num_parts, VectorXd* dmu,
+                                 VectorXd* dlambda) const;
   // out = sum_e K_e z_e with packed element Hessians: the Hessian product for
   // many products at one x ((3K)^2 multiply-adds per element and product,
   // against about 3 (3K)^2 through StressDifferentials for hexahedra, and
   // half the memory traffic of full blocks).
   void ApplyElementMatrices(const std::vector<double>& packed, const VectorXd& z, VectorXd* out, int threads);
+  // The same product for every column of z (3n x P) in one pass over the
+  // packed matrices, each group of elements applied to all P columns while
+  // its matrices are in cache: column c of *out is
+  // ApplyElementMatrices(packed, z.col(c)) bit for bit, for the cost of
+  // reading the matrices once.
+  void ApplyElementMatricesToColumns(const std::vector<double>& packed, const MatrixXd& z, MatrixXd* out, int threads);
 
  private:
   template <int K>
@@ -119,7 +141,8 @@ class ElasticForces {
   template <int K>
   void ApplyHessianImpl(const std::vector<Mat9>& d, const VectorXd& z, VectorXd* out, int threads);
   template <int K>
-  void ApplyElementMatricesImpl(const std::vector<double>& packed, const VectorXd& z, VectorXd* out, int threads);
+  void ApplyElementMatricesImpl(const std::vector<double>& packed, const Eigen::Ref<const MatrixXd>& z, double* out,
+                                int threads);
   // Element e's Hessian (3K x 3K, column-major) from its samples' F, SVD
   // and volume projection (e's samples_per_element() entries each); with
   // kUpper only its upper node blocks (the rest left zero).
@@ -130,7 +153,15 @@ class ElasticForces {
   void AddElementHessianProductsImpl(const VectorXd& x, const LameField& lame, const std::vector<int>& elements,
                                      const MatrixXd& z, MatrixXd* out);
   template <int K>
-  void PackedElementHessiansImpl(const VectorXd& x, const LameField& lame, std::vector<double>* packed, int threads);
+  void PackedElementHessiansImpl(const VectorXd& x, const LameField& lame, std::vector<double>* packed, int threads,
+                                 std::vector<double>* unit_gradients, bool warm_start);
+  // Adds sample s's unit-parameter gradients (vol G^T-weighted stresses at
+  // (mu, lambda) = (1, 0) and (0, 1)) to g (6K doubles: mu then lambda).
+  template <int K>
+  void UnitGradientDots(const std::vector<double>& unit_gradients, const VectorXd& z, std::vector<double>* dots_mu,
+                        std::vector<double>* dots_lambda) const;
+  template <int K>
+  void AddSampleUnitGradients(int s, const Mat3& F, const Svd3& svd, const VolumeProjection* volume, double* g) const;
   template <int K>
   void ElementHessiansImpl(const VectorXd& x, const LameField& lame, bool project_spd, std::vector<double>* blocks,
                            int threads);
@@ -155,6 +186,9 @@ class ElasticForces {
   void ForEachDecomposedElement(const VectorXd& x, int threads, Body&& body, bool warm_start = true);
   // Sums the per-element 3 x K buffer into a 3n vector, in parallel over nodes.
   void GatherElementBuffer(VectorXd* out, int threads) const;
+  // The same for a buffer laid out like element_buffer_ (3K per element),
+  // into out (3n doubles).
+  void GatherBuffer(const double* buffer, double* out, int threads) const;
 
   const FemModel& fem_;
   std::vector<ElasticEnergy> energies_;
@@ -165,6 +199,7 @@ class ElasticForces {
   // (NeedsSvd): PackedElementHessians runs lane by lane (AddPackedSampleStiffness).
   bool coefficient_form_ = false;
   std::vector<double> element_buffer_;  // 3 * K per element
+  std::vector<double> column_buffer_;   // P element buffers (ApplyElementMatricesToColumns)
   std::vector<double> element_energy_;  // per element
   std::vector<double> element_dot_;     // per element (PartLameDots' lambda dots)
   // Per-sample V of the last SVD: warm start of the next one (see svd3.h).

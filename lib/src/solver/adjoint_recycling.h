@@ -12,8 +12,9 @@
 // definite on it (E's eigenvalues below a relative floor, or not positive,
 // are dropped). The iteration then solves H_i dz = b - H_i z0 to the same
 // absolute residual as from zero (the tolerance stays relative to ||b||).
-// Costs m products with H_i per step. A column whose guess does not reduce
-// the residual starts from zero.
+// Costs m products with H_i per step, made in one pass over the element
+// Hessians. A column whose guess does not reduce the residual starts from
+// zero.
 #pragma once
 
 #include <deque>
@@ -33,8 +34,9 @@ class AdjointRecycling {
   int size() const { return static_cast<int>(columns_.size()); }
 
   // For the columns of b: z0 (the guesses) and r0 = b - H z0, with
-  // apply_h(v) = H v. Without stored columns z0 = 0 and r0 = b.
-  void Guess(const MatrixXd& b, const std::function<VectorXd(const VectorXd&)>& apply_h, MatrixXd* z0,
+  // apply_h(V) = H V for the columns of V (3n x m). Without stored columns
+  // z0 = 0 and r0 = b.
+  void Guess(const MatrixXd& b, const std::function<MatrixXd(const MatrixXd&)>& apply_h, MatrixXd* z0,
              MatrixXd* r0) const;
 
  private:

@@ -59,8 +59,13 @@ void AdjointSweep::Step(int i, const State& s0, const State& s1, const StepInput
     lin.set_recycling(&recycling_);
     lin.set_steps_left(i + 1);  // steps i, i - 1, ..., 0
     lin.set_rel_tolerance(AdjointRelTolerance(sim.options, forward_rel_tolerance_, report));
+    // The Lame-parameter dots below reuse the SVDs of H's element pass. They
+    // start cold: H then depends on x alone, as the tangent pass's H does
+    // (warm-started SVDs moved an ill-conditioned scene's gradient off its
+    // tangents by 1.4e-4 relative).
+    lin.KeepLameGradients(/*warm_svd=*/false);
     VectorXd z = lin.Solve(b, &out_.report);  // zero at fixed DoFs
-    sim.elastic.PartLameDots(s1.x, z, sim.part_of_element, parts, &part_mu, &part_lambda, sim.threads());
+    lin.PartLameDots(z, &part_mu, &part_lambda);
     dmu_ -= part_mu;
     dlambda_ -= part_lambda;
     // grad g depends on M through M (x_{i+1} - x_i - h v_i) / h^2 - M g.

@@ -106,6 +106,10 @@ class SimulatorImpl {
   AdjointCostModel& backward_cost_model() { return backward_cost_; }
   AdjointCostModel& tangent_cost_model(int directions) { return tangent_cost_[directions]; }
   void ResetAdjointCostModels();
+  // The storage of the step Hessian's packed element matrices, lent to one
+  // StepLinearization at a time (kept between steps: a backward pass
+  // allocates and clears it once, not once per step).
+  std::vector<double> packed_hessian_storage;
   int pd_factorizations() const { return pd_ ? pd_->num_factorizations() : 0; }
   double pd_factorization_seconds() const { return pd_ ? pd_->factorization_seconds() : 0.0; }
   std::size_t pd_factor_copy_bytes() const { return pd_ ? pd_->copy_bytes() : 0; }
@@ -225,6 +229,19 @@ class StepLinearization {
   // The previous steps' solutions (not owned; nullptr: none): the iteration
   // starts from their Galerkin guess, and the solution is added to them.
   void set_recycling(AdjointRecycling* recycling) { recycling_ = recycling; }
+  // Before the first solve: H's element pass also keeps the elastic
+  // unit-parameter gradients at x for PartLameDots (one pass over the
+  // elements, one SVD per sample, instead of two), its SVDs started from the
+  // elastic forces' warm-start cache when warm_svd (as ElasticForces::
+  // PartLameDots starts them), else cold.
+  void KeepLameGradients(bool warm_svd) {
+    keep_lame_gradients_ = true;
+    warm_svd_ = warm_svd;
+  }
+  // The elastic forces' PartLameDots(x, z, ...) over the simulator's parts:
+  // from the gradients kept by H's element pass when KeepLameGradients was
+  // called before it ran, else evaluated afresh.
+  void PartLameDots(const VectorXd& z, VectorXd* dmu, VectorXd* dlambda);
   // Steps of the pass still to solve, this one included (>= 1; default 1):
   // AdjointSolver::kAuto spreads the one-off analysis of H over them.
   void set_steps_left(int steps) { steps_left_ = steps < 1 ? 1 : steps; }
@@ -242,6 +259,9 @@ class StepLinearization {
   MatrixXd SolveColumns(const MatrixXd& b, BackwardReport* report);
   // H z (3n, free rows only).
   VectorXd Apply(const VectorXd& z);
+  // H Z for the columns of Z (3n x P) in one pass over the element
+  // Hessians; column c equals Apply(Z.col(c)) bit for bit.
+  MatrixXd ApplyColumns(const MatrixXd& z);
   // H z with the fixed entries of z zeroed but every row kept: the fixed rows
   // carry the coupling to the free DoFs (frictional contact's pin gradient).
   VectorXd ApplyUnmasked(const VectorXd& z);
@@ -279,7 +299,12 @@ class StepLinearization {
   // Element Hessians at x_ of the elastic and the auxiliary energies, not
   // projected, packed (ElasticForces::PackedElementHessians' layout): every
   // product with H and the assembled H use them.
-  std::vector<double> packed_blocks_;
+  std::vector<double> packed_blocks_;  // SimulatorImpl::packed_hessian_storage while lent
+  bool have_blocks_ = false;
+  bool keep_lame_gradients_ = false, warm_svd_ = false;
+  // The elastic unit-parameter gradients at x_ (ElasticForces::
+  // PackedElementHessians), when kept; empty otherwise.
+  std::vector<double> lame_gradients_;
   SparseMatrix matrix_;  // assembled exact H (lazily)
   bool have_matrix_ = false;
   bool factored_ = false;

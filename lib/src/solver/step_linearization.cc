@@ -35,13 +35,18 @@ bool IsPdMethod(Method m) { return m == Method::kPd || m == Method::kPdLbfgs; }
 StepLinearization::StepLinearization(SimulatorImpl& sim, const VectorXd& x, bool static_problem)
     : sim_(sim), x_(x), static_(static_problem), rel_tolerance_(sim.options.backward_rel_tolerance) {
   inertia_ = static_problem ? VectorXd::Zero(sim.num_dofs()) : VectorXd(sim.Mass() / (sim.h() * sim.h()));
+  packed_blocks_.swap(sim.packed_hessian_storage);  // empty if another linearization holds it
 }
 
-StepLinearization::~StepLinearization() = default;
+StepLinearization::~StepLinearization() {
+  if (sim_.packed_hessian_storage.capacity() < packed_blocks_.capacity())
+    sim_.packed_hessian_storage.swap(packed_blocks_);
+}
 
 const std::vector<double>& StepLinearization::PackedBlocks() {
-  if (!packed_blocks_.empty()) return packed_blocks_;
-  sim_.elastic.PackedElementHessians(x_, sim_.lame(), &packed_blocks_, sim_.threads());
+  if (have_blocks_) return packed_blocks_;
+  sim_.elastic.PackedElementHessians(x_, sim_.lame(), &packed_blocks_, sim_.threads(),
+                                     keep_lame_gradients_ ? &lame_gradients_ : nullptr, warm_svd_);
   if (!sim_.aux.empty()) {
     // The auxiliary energies' element Hessians (muscles, penalty contact)
     // join the packed elastic ones: one packed product per application of
@@ -55,6 +60,7 @@ const std::vector<double>& StepLinearization::PackedBlocks() {
     Eigen::Map<VectorXd>(packed_blocks_.data(), packed_blocks_.size()) +=
         Eigen::Map<const VectorXd>(packed_aux.data(), packed_aux.size());
   }
+  have_blocks_ = true;
   return packed_blocks_;
 }
 
@@ -68,6 +74,26 @@ VectorXd StepLinearization::Apply(const VectorXd& z) {
   VectorXd out = ApplyUnmasked(z);
   sim_.ZeroFixed(&out);
   return out;
+}
+
+MatrixXd StepLinearization::ApplyColumns(const MatrixXd& z) {
+  MatrixXd zf = z;
+  for (int d = 0; d < zf.rows(); ++d)
+    if (sim_.fixed[d]) zf.row(d).setZero();
+  MatrixXd out;
+  sim_.elastic.ApplyElementMatricesToColumns(PackedBlocks(), zf, &out, sim_.threads());  // elastic and auxiliary
+  for (Eigen::Index c = 0; c < out.cols(); ++c) out.col(c).array() += inertia_.array() * zf.col(c).array();
+  for (int d = 0; d < out.rows(); ++d)
+    if (sim_.fixed[d]) out.row(d).setZero();
+  return out;
+}
+
+void StepLinearization::PartLameDots(const VectorXd& z, VectorXd* dmu, VectorXd* dlambda) {
+  if (lame_gradients_.empty()) {
+    sim_.elastic.PartLameDots(x_, z, sim_.part_of_element, sim_.num_parts(), dmu, dlambda, sim_.threads());
+    return;
+  }
+  sim_.elastic.LameDotsFromUnitGradients(lame_gradients_, z, sim_.part_of_element, sim_.num_parts(), dmu, dlambda);
 }
 
 VectorXd StepLinearization::ApplyUnmasked(const VectorXd& z) {
@@ -125,18 +151,19 @@ void StepLinearization::IterativeSolveColumns(const MatrixXd& b, MatrixXd* z, st
   std::optional<RigidModeCorrection> rigid;
   if (sim_.UseRigidModeCorrection(static_) && opt.pd_backward != PdBackwardMethod::kFixedPoint) {
     rigid.emplace(x_, sim_.fixed);
-    MatrixXd hz(rhs.rows(), RigidModeCorrection::kModes);
-    for (int k = 0; k < RigidModeCorrection::kModes; ++k) hz.col(k) = Apply(rigid->modes().col(k));
-    rigid->SetHessianProducts(hz);
+    rigid->SetHessianProducts(ApplyColumns(rigid->modes()));
   }
   const std::function<VectorXd(const VectorXd&)> apply_h = [this](const VectorXd& v) { return Apply(v); };
+  const std::function<MatrixXd(const MatrixXd&)> apply_h_columns = [this](const MatrixXd& v) {
+    return ApplyColumns(v);
+  };
   // From the Galerkin guess on the previous steps' solutions when there are
   // any: the iteration solves for the correction, to the tolerance relative
   // to the right-hand side itself.
   MatrixXd guess, residual;
   const bool guessed = recycling_ && recycling_->size() > 0;
   if (guessed) {
-    recycling_->Guess(rhs, apply_h, &guess, &residual);
+    recycling_->Guess(rhs, apply_h_columns, &guess, &residual);
     // Earlier steps may have other fixed DoFs (contact pins): H W was formed
     // with them zeroed (Apply), so zeroing them in the guess keeps r0 exact.
     for (int d = 0; d < guess.rows(); ++d)
