@@ -98,16 +98,15 @@ class ElasticForces {
   // gradients, the input of LameDotsFromUnitGradients: per element e,
   // 6K doubles, d(grad_e E)/d mu_e (3 x K, column-major) then
   // d(grad_e E)/d lambda_e. With warm_start the SVDs start from, and update,
-  // the warm-start cache as EnergyAndGradient's and PartLameDots' do (equal
-  // to rounding; after ResetWarmStart exactly the cold ones); without it
-  // they start cold and the result depends on x alone.
+  // the warm-start cache as EnergyAndGradient's do (equal to rounding; after
+  // ResetWarmStart exactly the cold ones); without it (the backward pass)
+  // they start cold, as PartLameDots' do, and the result depends on x alone.
   void PackedElementHessians(const VectorXd& x, const LameField& lame, std::vector<double>* packed, int threads,
                              std::vector<double>* unit_gradients = nullptr, bool warm_start = false);
   // PartLameDots(x, z, ...) from the unit gradients at x that
   // PackedElementHessians made (num_elements * 6K entries): the same dots,
   // summed in the same order, without evaluating the material again (bit
-  // for bit PartLameDots' when both decomposed x from the same warm-start
-  // cache). Throws SolverError(kNonFinite) like PartLameDots.
+  // for bit PartLameDots' when the gradients came from cold SVDs). Throws SolverError(kNonFinite) like PartLameDots.
   void LameDotsFromUnitGradients(const std::vector<double>& unit_gradients, const VectorXd& z,
                                  const std::vector<int>& part_of_element, int num_parts, VectorXd* dmu,
                                  VectorXd* dlambda) const;

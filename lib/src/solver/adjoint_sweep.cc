@@ -63,7 +63,7 @@ void AdjointSweep::Step(int i, const State& s0, const State& s1, const StepInput
     // start cold: H then depends on x alone, as the tangent pass's H does
     // (warm-started SVDs moved an ill-conditioned scene's gradient off its
     // tangents by 1.4e-4 relative).
-    lin.KeepLameGradients(/*warm_svd=*/false);
+    lin.KeepLameGradients();
     VectorXd z = lin.Solve(b, &out_.report);  // zero at fixed DoFs
     lin.PartLameDots(z, &part_mu, &part_lambda);
     dmu_ -= part_mu;

@@ -231,13 +231,9 @@ class StepLinearization {
   void set_recycling(AdjointRecycling* recycling) { recycling_ = recycling; }
   // Before the first solve: H's element pass also keeps the elastic
   // unit-parameter gradients at x for PartLameDots (one pass over the
-  // elements, one SVD per sample, instead of two), its SVDs started from the
-  // elastic forces' warm-start cache when warm_svd (as ElasticForces::
-  // PartLameDots starts them), else cold.
-  void KeepLameGradients(bool warm_svd) {
-    keep_lame_gradients_ = true;
-    warm_svd_ = warm_svd;
-  }
+  // elements, one SVD per sample, instead of two). Its SVDs start cold, as
+  // ElasticForces::PartLameDots' do, so the dots depend on x alone.
+  void KeepLameGradients() { keep_lame_gradients_ = true; }
   // The elastic forces' PartLameDots(x, z, ...) over the simulator's parts:
   // from the gradients kept by H's element pass when KeepLameGradients was
   // called before it ran, else evaluated afresh.
@@ -301,7 +297,7 @@ class StepLinearization {
   // product with H and the assembled H use them.
   std::vector<double> packed_blocks_;  // SimulatorImpl::packed_hessian_storage while lent
   bool have_blocks_ = false;
-  bool keep_lame_gradients_ = false, warm_svd_ = false;
+  bool keep_lame_gradients_ = false;
   // The elastic unit-parameter gradients at x_ (ElasticForces::
   // PackedElementHessians), when kept; empty otherwise.
   std::vector<double> lame_gradients_;

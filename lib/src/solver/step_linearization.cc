@@ -46,7 +46,7 @@ StepLinearization::~StepLinearization() {
 const std::vector<double>& StepLinearization::PackedBlocks() {
   if (have_blocks_) return packed_blocks_;
   sim_.elastic.PackedElementHessians(x_, sim_.lame(), &packed_blocks_, sim_.threads(),
-                                     keep_lame_gradients_ ? &lame_gradients_ : nullptr, warm_svd_);
+                                     keep_lame_gradients_ ? &lame_gradients_ : nullptr);
   if (!sim_.aux.empty()) {
     // The auxiliary energies' element Hessians (muscles, penalty contact)
     // join the packed elastic ones: one packed product per application of
