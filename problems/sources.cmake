@@ -84,6 +84,7 @@ set(DIFFPD_PROBLEMS_CALIBRATION_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_trace.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_plot.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_fit.cc
+  ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_fit_starts.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/starfish_covariance_check.cc
   ${CMAKE_CURRENT_LIST_DIR}/calibration/calibrate_starfish.cc
   # calibration over several recordings (a rollout set)

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "calibration/starfish_fit_starts.h"
 #include "calibration/starfish_plot.h"
 #include "calibration/starfish_trace.h"
 #include "cli/commands.h"
@@ -27,6 +28,7 @@ constexpr double kFitStart = 1.0;     // s: the tendon first moves at 1.18 s in 
 constexpr double kFitSeconds = 5.0;   // s
 constexpr double kDefaultSeconds = 10;
 constexpr int kDefaultIterations = 10;
+constexpr int kDefaultStarts = 1;
 constexpr int kVtkStride = 6;  // camera frames per VTK frame: 10 per second
 
 std::string Num(double v) {
@@ -184,19 +186,23 @@ std::unique_ptr<solvers::RolloutFunction> StarfishCalibration::MakeModel(
 
 StarfishFit StarfishCalibration::Fit(const StarfishRecording& rec, const StarfishWindow& w,
                                      const SolverOptions& options, const MaterialParameters& guess,
-                                     const StarfishActuation& actuation_guess, int max_iterations, FILE* log) const {
+                                     const StarfishActuation& actuation_guess, int max_iterations, FILE* log,
+                                     const StarfishWater& water_guess) const {
   const bool arms = regions_ == StarfishRegions::kBodyArms;
   if (arms && fit_method_ == StarfishFitMethod::kLevenbergMarquardt)
     throw InvalidInputError("the lm fit has no tied arms' nu: fit body-arms regions with --fit lbfgs");
   StarfishActuation start = actuation_guess;
-  if (release_in_model() && !start.release_lag) start.release_lag = start.lag;
-  const StarfishWater water = water_in_model() ? WaterGuess() : StarfishWater();
+  if (!release_in_model())
+    start.release_lag.reset();
+  else if (!start.release_lag)
+    start.release_lag = start.lag;
+  if (water_in_model()) CheckStarfishWaterStart(water_guess);
+  const StarfishWater water = water_in_model() ? water_guess : StarfishWater();
   std::unique_ptr<solvers::RolloutFunction> model = MakeModel(rec, w, options, guess, start, water);
   if (fit_method_ == StarfishFitMethod::kLevenbergMarquardt)
     return FitStarfishLeastSquares(model.get(), 0, guess, start, water_in_model() ? &water : nullptr, max_iterations,
                                    log);
-  return FitStarfishLoss(model.get(), regions_ == StarfishRegions::kBodyArms, guess, actuation_guess, max_iterations,
-                         log);
+  return FitStarfishLoss(model.get(), regions_ == StarfishRegions::kBodyArms, guess, start, max_iterations, log);
 }
 
 StarfishCalibration::Prediction StarfishCalibration::Predict(const StarfishRecording& rec, const StarfishWindow& w,
@@ -322,8 +328,34 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                  "from the body's %zu; nu and density shared\n",
                  scene.material_regions[0].elements.size(),
                  scene.mesh.num_elements() - scene.material_regions[0].elements.size());
-  const StarfishFit fit = Fit(calibration, fit_window, options, guess, actuation_guess,
-                              args.max_iterations >= 0 ? args.max_iterations : kDefaultIterations, log);
+  const int max_iterations = args.max_iterations >= 0 ? args.max_iterations : kDefaultIterations;
+  StarfishStart first{guess, actuation_guess, WaterGuess()};
+  if (release_in_model()) first.actuation.release_lag = first.actuation.lag;
+  const std::vector<StarfishStart> starts = StarfishStarts(args.starts >= 0 ? args.starts : kDefaultStarts, first);
+  std::vector<StarfishFit> start_fits;
+  for (size_t k = 0; k < starts.size(); ++k) {
+    const StarfishStart& s = starts[k];
+    if (starts.size() > 1) {
+      std::string more;
+      if (release_in_model()) more += ", release lag = " + Num(*s.actuation.release_lag) + " s";
+      if (water_in_model())
+        more +=
+            ", water " + Num(s.water.drag_tangential) + " / " + Num(s.water.drag_normal) + " / " + Num(s.water.thrust);
+      std::fprintf(log,
+                   "# start %zu of %zu: E = %.6g Pa, nu = %.6g, slack = %.3f mm, lag = %.4f s, length = %.2f mm%s\n",
+                   k + 1, starts.size(), s.material.youngs_modulus, s.material.poissons_ratio, s.actuation.slack / kMm,
+                   s.actuation.lag, s.actuation.length / kMm, more.c_str());
+    }
+    start_fits.push_back(Fit(calibration, fit_window, options, s.material, s.actuation, max_iterations, log, s.water));
+    if (starts.size() > 1)
+      std::fprintf(log, "# start %zu: cost %.6e -> %.6e (%s)\n", k + 1, start_fits.back().initial_cost,
+                   start_fits.back().final_cost, start_fits.back().usable ? "usable" : "not usable");
+  }
+  const int best = BestStarfishFit(start_fits);
+  const int chosen = best >= 0 ? best : 0;  // none usable: the first start's, reported as not usable
+  if (starts.size() > 1)
+    std::fprintf(log, "# starts: start %d has the lowest final cost on the calibration window\n", chosen + 1);
+  const StarfishFit& fit = start_fits[chosen];
   const MaterialParameters& fitted = fit.material;
   const StarfishActuation& actuation = fit.actuation;
   const solvers::RolloutStatistics& stats = fit.statistics;
@@ -418,6 +450,8 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_clock).count();
   std::fprintf(log, "# total %.1f s\n", total);
   if (args.json) {
+    nlohmann::json start_costs = nlohmann::json::array();
+    for (const StarfishFit& f : start_fits) start_costs.push_back(f.final_cost);
     nlohmann::json out = {{"problem", name()},
                           {"youngs_modulus", fitted.youngs_modulus},
                           {"poissons_ratio", fitted.poissons_ratio},
@@ -429,15 +463,18 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                            actuation.release_lag ? nlohmann::json(*actuation.release_lag) : nlohmann::json(nullptr)},
                           {"truth", nlohmann::json::object()},
                           {"initial_guess",
-                           {{"youngs_modulus", guess.youngs_modulus},
-                            {"poissons_ratio", guess.poissons_ratio},
-                            {"tendon_slack_mm", actuation_guess.slack / kMm},
-                            {"tendon_lag_s", actuation_guess.lag},
-                            {"tendon_length_mm", actuation_guess.length / kMm}}},
+                           {{"youngs_modulus", starts[chosen].material.youngs_modulus},
+                            {"poissons_ratio", starts[chosen].material.poissons_ratio},
+                            {"tendon_slack_mm", starts[chosen].actuation.slack / kMm},
+                            {"tendon_lag_s", starts[chosen].actuation.lag},
+                            {"tendon_length_mm", starts[chosen].actuation.length / kMm}}},
                           {"method", ToString(method)},
                           {"initial_cost", fit.initial_cost},
                           {"final_cost", fit.final_cost},
                           {"iterations", fit.iterations},
+                          {"starts", starts.size()},
+                          {"chosen_start", chosen},
+                          {"start_final_costs", start_costs},
                           {"evaluations", stats.rollouts},
                           {"gradient_evaluations", stats.gradients},
                           {"failed_evaluations", stats.failures},

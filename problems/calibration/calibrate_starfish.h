@@ -133,18 +133,19 @@ class StarfishCalibration : public Problem {
                                                       const CapturedMotion* motion = nullptr) const;
 
   // Fits E, nu, slack, lag and length (with kBodyArms also the arms' E;
-  // when water_in_model() also the water's coefficients from WaterGuess()) on
-  // a window (when release_in_model() also the release lag, starting at the
-  // guess's lag): FitStarfishLeastSquares or FitStarfishLoss (fit_method()) on
-  // MakeModel's functional, starting from `guess` (both regions) and
-  // `actuation_guess`, at most `max_iterations` iterations; the iteration
-  // table goes to `log` (nullptr: silent). Throws what MakeModel and
-  // StarfishFitStart throw, and InvalidInputError for kBodyArms with
-  // kLevenbergMarquardt ("the lm fit has no tied arms' nu: fit body-arms
-  // regions with --fit lbfgs").
+  // when water_in_model() also the water's coefficients from `water_guess`)
+  // on a window (when release_in_model() also the release lag, starting at
+  // actuation_guess's release lag, or its lag when it has none; otherwise a
+  // release lag of actuation_guess is ignored): FitStarfishLeastSquares or
+  // FitStarfishLoss (fit_method()) on MakeModel's functional, starting from
+  // `guess` (both regions) and `actuation_guess`, at most `max_iterations`
+  // iterations; the iteration table goes to `log` (nullptr: silent). Throws
+  // what MakeModel, StarfishFitStart and CheckStarfishWaterStart throw, and
+  // InvalidInputError for kBodyArms with kLevenbergMarquardt ("the lm fit
+  // has no tied arms' nu: fit body-arms regions with --fit lbfgs").
   StarfishFit Fit(const StarfishRecording& recording, const StarfishWindow& window, const SolverOptions& options,
                   const MaterialParameters& guess, const StarfishActuation& actuation_guess, int max_iterations,
-                  FILE* log) const;
+                  FILE* log, const StarfishWater& water_guess = WaterGuess()) const;
 
   // A window simulated with fitted parameters and compared with its
   // recording (Predict).

@@ -94,6 +94,10 @@ int RunCommandLine(const std::vector<std::string>& argv) {
       "calibrate-starfish: 'asymmetric' fits a release lag apart from the pull's (lm fit, default), or 'symmetric'");
   run->add_option("--fit-seconds", run_args.fit_seconds, "calibrate-starfish: length of the fit window (s, default 5)")
       ->check(Positive("--fit-seconds", "s"));
+  run->add_option("--starts", run_args.starts,
+                  "calibrate-starfish: fit from this many starting points (1 to 4, default 1), keep the fit with the "
+                  "lowest cost on the calibration window")
+      ->check(IntegerIn("--starts", 1, 4));
 
   CLI::App* grad = app.add_subcommand("gradcheck", "compare rollout gradients with central finite differences");
   AddCommonOptions(grad, &grad_args, &grad_method);

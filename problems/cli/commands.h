@@ -65,6 +65,7 @@ struct CommandArgs {
   double fit_seconds = -1;
   std::string water;  // calibrate-starfish: "": the problem's; "fitted", "fixed"
   std::string servo;  // calibrate-starfish: "": the problem's; "symmetric", "asymmetric"
+  int starts = -1;    // calibrate-starfish: fits from this many starting points (-1: the problem's)
 };
 
 int ListCommand(bool json);

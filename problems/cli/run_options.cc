@@ -79,6 +79,7 @@ void RefuseUnusedRunOptions(const CommandArgs& args, const Problem& problem) {
       {"--fit-seconds", args.fit_seconds != defaults.fit_seconds, kStarfish, "calibrate-starfish"},
       {"--water", !args.water.empty(), kStarfish, "calibrate-starfish"},
       {"--servo", !args.servo.empty(), kStarfish, "calibrate-starfish"},
+      {"--starts", args.starts != defaults.starts, kStarfish, "calibrate-starfish"},
   };
   const int kind = KindOf(problem);
   for (const RunOption& o : options)

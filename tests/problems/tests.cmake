@@ -19,6 +19,7 @@ if(TARGET diffpd_ceres)
                   LIBS diffpd_problems)
   diffpd_add_test(starfish_recordings_fit_test ${_dir}/calibration/starfish_recordings_fit_test.cc
                   LIBS diffpd_problems)
+  diffpd_add_test(starfish_fit_starts_test ${_dir}/calibration/starfish_fit_starts_test.cc LIBS diffpd_problems)
 endif()
 if(TARGET diffpd_ipopt)
   diffpd_add_test(bunny_test ${_dir}/control/bunny_test.cc LIBS diffpd_problems)

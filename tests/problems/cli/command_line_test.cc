@@ -125,6 +125,12 @@ TEST(CommandLineTest, RefusesOutOfRangeValuesOfTheSimulatingCommands) {
       {{"run", "calibrate-starfish", "--seconds", "0"},
        2,
        Invalid("--seconds = 0 is invalid: must be finite and > 0 (s)")},
+      {{"run", "calibrate-starfish", "--starts", "0"},
+       2,
+       Invalid("--starts = 0 is invalid: must be an integer in [1, 4]")},
+      {{"run", "calibrate-starfish", "--starts", "5"},
+       2,
+       Invalid("--starts = 5 is invalid: must be an integer in [1, 4]")},
   });
 }
 
@@ -156,6 +162,9 @@ TEST(CommandLineTest, RefusesOptionsTheProblemWouldIgnore) {
       {{"run", "calibrate-plant", "--seconds", "3"},
        2,
        Invalid("--seconds is not used by the calibration problem 'calibrate-plant' (only calibrate-starfish read it)")},
+      {{"run", "calibrate-plant", "--starts", "2"},
+       2,
+       Invalid("--starts is not used by the calibration problem 'calibrate-plant' (only calibrate-starfish read it)")},
       {{"run", "calibrate-starfish", "--small"},
        2,
        Invalid("--small is not used by the starfish calibration 'calibrate-starfish' (only the optimisation and "
