@@ -140,7 +140,7 @@ StarfishErrors StarfishCalibration::WindowErrors(const Mesh& mesh, const std::ve
 std::unique_ptr<solvers::RolloutFunction> StarfishCalibration::MakeModel(
     const StarfishRecording& rec, const StarfishWindow& w, const SolverOptions& options,
     const MaterialParameters& material, const StarfishActuation& actuation, const StarfishWater& water,
-    const CapturedMotion* motion) const {
+    const CapturedMotion* motion, double linear_damping) const {
   using solvers::MaterialField;
   Scene scene = MakeScene();
   scene.material = material;
@@ -148,6 +148,7 @@ std::unique_ptr<solvers::RolloutFunction> StarfishCalibration::MakeModel(
   scene.hydrodynamics->drag_normal = water.drag_normal;
   scene.hydrodynamics->thrust = water.thrust;
   for (MaterialRegion& region : scene.material_regions) region.material = material;
+  if (damping_in_model()) scene.linear_damping = linear_damping;
   SolverOptions solver = options;
   solver.time_step = StarfishTimeStep(rec, w, substeps_);
   std::vector<StepInput> inputs = WindowInputs(rec, w, actuation);
@@ -161,6 +162,7 @@ std::unique_ptr<solvers::RolloutFunction> StarfishCalibration::MakeModel(
   model->SetInitialState(initial);
   model->SetInputs(std::move(inputs));
   std::vector<solvers::MaterialBlock::Entry> fitted = {MaterialField::kYoungsModulus, MaterialField::kPoissonsRatio};
+  if (density_in_model()) fitted.push_back(MaterialField::kDensity);
   if (regions_ == StarfishRegions::kBodyArms) {
     fitted.push_back({MaterialField::kYoungsModulus, 0});
     fitted.push_back({MaterialField::kPoissonsRatio, 0});
@@ -175,6 +177,9 @@ std::unique_ptr<solvers::RolloutFunction> StarfishCalibration::MakeModel(
                                                      StateForceField::kThrust},
         scene));
   }
+  if (damping_in_model())
+    model->AddBlock(std::make_unique<solvers::StateForceBlock>(
+        std::vector<solvers::StateForceBlock::Entry>{solvers::StateForceField::kLinearDamping}, scene));
   auto residuals = std::make_unique<solvers::MarkerResiduals>(
       motion ? *motion : WindowMotion(scene.mesh, initial, rec, w), scene.mesh, solver.time_step, steps);
   if (fit_method_ == StarfishFitMethod::kLbfgs)
@@ -198,10 +203,14 @@ StarfishFit StarfishCalibration::Fit(const StarfishRecording& rec, const Starfis
     start.release_lag = start.lag;
   if (water_in_model()) CheckStarfishWaterStart(water_guess);
   const StarfishWater water = water_in_model() ? water_guess : StarfishWater();
+  StarfishMassDamping mass_damping;
+  mass_damping.fit_density = density_in_model();
+  if (damping_in_model()) mass_damping.linear_damping_guess = DampingGuess();
+  CheckStarfishMassDampingStart(guess.density, mass_damping);
   std::unique_ptr<solvers::RolloutFunction> model = MakeModel(rec, w, options, guess, start, water);
   if (fit_method_ == StarfishFitMethod::kLevenbergMarquardt)
     return FitStarfishLeastSquares(model.get(), 0, guess, start, water_in_model() ? &water : nullptr, max_iterations,
-                                   log);
+                                   log, mass_damping);
   return FitStarfishLoss(model.get(), regions_ == StarfishRegions::kBodyArms, guess, start, max_iterations, log);
 }
 
@@ -214,6 +223,7 @@ StarfishCalibration::Prediction StarfishCalibration::Predict(const StarfishRecor
   s.hydrodynamics->drag_tangential = fit.water.drag_tangential;
   s.hydrodynamics->drag_normal = fit.water.drag_normal;
   s.hydrodynamics->thrust = fit.water.thrust;
+  if (fit.linear_damping) s.linear_damping = *fit.linear_damping;
   SolverOptions o = options;
   o.time_step = StarfishTimeStep(rec, w, substeps_);
   Simulator sim(s, o);
@@ -231,7 +241,8 @@ StarfishCalibration::Prediction StarfishCalibration::Predict(const StarfishRecor
 
 int StarfishCalibration::Run(const CommandArgs& args) const {
   RefuseSimulatorTuning(args, name());
-  if (!args.regions.empty() || !args.fit.empty() || !args.water.empty() || !args.servo.empty()) {
+  if (!args.regions.empty() || !args.fit.empty() || !args.water.empty() || !args.servo.empty() ||
+      !args.density.empty() || !args.damping.empty()) {
     StarfishCalibration with = *this;
     if (!args.regions.empty()) with.set_regions(ParseStarfishRegions(args.regions));
     if (!args.fit.empty()) with.set_fit_method(ParseStarfishFitMethod(args.fit));
@@ -247,11 +258,25 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                                 "' is invalid: calibrate-starfish knows 'symmetric' or 'asymmetric'");
       with.set_fit_release_lag(args.servo == "asymmetric");
     }
+    if (!args.density.empty()) {
+      if (args.density != "fitted" && args.density != "fixed")
+        throw InvalidInputError("--density = '" + args.density +
+                                "' is invalid: calibrate-starfish knows 'fitted' or 'fixed'");
+      with.set_fit_density(args.density == "fitted");
+    }
+    if (!args.damping.empty()) {
+      if (args.damping != "fitted" && args.damping != "fixed")
+        throw InvalidInputError("--damping = '" + args.damping +
+                                "' is invalid: calibrate-starfish knows 'fitted' or 'fixed'");
+      with.set_fit_damping(args.damping == "fitted");
+    }
     CommandArgs rest = args;
     rest.regions.clear();
     rest.fit.clear();
     rest.water.clear();
     rest.servo.clear();
+    rest.density.clear();
+    rest.damping.clear();
     return with.Run(rest);
   }
   if (args.steps > 0 || args.dt > 0)
@@ -321,7 +346,12 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
           : "Ceres Levenberg-Marquardt on per-frame marker residuals with forward-mode Jacobians",
       regions_ == StarfishRegions::kBodyArms ? ", E_arms like E" : "",
       release_in_model() ? ", servo release lag in (1, 500) ms" : "",
-      water_in_model() ? ", water drag_tangential in (0.005, 5), drag_normal in (0.2, 20), thrust in (0.001, 10)" : "");
+      (std::string(water_in_model()
+                       ? ", water drag_tangential in (0.005, 5), drag_normal in (0.2, 20), thrust in (0.001, 10)"
+                       : "") +
+       (density_in_model() ? ", density in (50, 5000) kg/m^3" : "") +
+       (damping_in_model() ? ", linear_damping in (0.01, 100) 1/s" : ""))
+          .c_str());
   if (regions_ == StarfishRegions::kBodyArms)
     std::fprintf(log,
                  "# regions: body-arms: E of the %zu arm elements (centroid beyond |y|, |z| < 18 mm) fitted apart "
@@ -374,7 +404,10 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                  fit.water.drag_tangential, fit.water.drag_normal, fit.water.thrust);
   if (actuation.release_lag)
     std::fprintf(log, "# fit: asymmetric servo: release lag = %.4f s\n", *actuation.release_lag);
-  const std::vector<std::string> fit_names = StarfishFitNames(actuation.release_lag.has_value(), fit.water_fitted);
+  if (fit.density_fitted) std::fprintf(log, "# fit: density = %.5g kg/m^3\n", fitted.density);
+  if (fit.linear_damping) std::fprintf(log, "# fit: linear_damping = %.5g 1/s\n", *fit.linear_damping);
+  const std::vector<std::string> fit_names = StarfishFitNames(actuation.release_lag.has_value(), fit.water_fitted,
+                                                              fit.density_fitted, fit.linear_damping.has_value());
   const std::vector<double> fit_values = StarfishFitValues(fit);
   const int n = static_cast<int>(fit.standard_deviation.size());
   if (n > 0) {
@@ -501,6 +534,8 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                     {"drag_normal", fit.water.drag_normal},
                     {"thrust", fit.water.thrust}};
     out["fit"] = ToString(fit_method_);
+    out["density_fitted"] = fit.density_fitted;
+    out["linear_damping"] = fit.linear_damping ? nlohmann::json(*fit.linear_damping) : nlohmann::json(nullptr);
     if (!fit.standard_deviation.empty()) {
       nlohmann::json sd, bound;
       for (int i = 0; i < n; ++i) {

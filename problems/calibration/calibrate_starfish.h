@@ -69,6 +69,17 @@ class StarfishCalibration : public Problem {
   // Whether the water joins a model (fit_water() and the lm fit).
   bool water_in_model() const { return fit_water_ && fit_method_ == StarfishFitMethod::kLevenbergMarquardt; }
 
+  // Whether the lm fit fits the body's density (the mass it moves with the
+  // water it carries; default false: the scene's 400 kg/m^3) and a linear
+  // damping (Scene::linear_damping, from DampingGuess(); default false: none).
+  bool fit_density() const { return fit_density_; }
+  void set_fit_density(bool fit) { fit_density_ = fit; }
+  bool fit_damping() const { return fit_damping_; }
+  void set_fit_damping(bool fit) { fit_damping_ = fit; }
+  // Whether the density and the damping join a model (chosen and the lm fit).
+  bool density_in_model() const { return fit_density_ && fit_method_ == StarfishFitMethod::kLevenbergMarquardt; }
+  bool damping_in_model() const { return fit_damping_ && fit_method_ == StarfishFitMethod::kLevenbergMarquardt; }
+
   // How Fit minimises (default kLevenbergMarquardt).
   StarfishFitMethod fit_method() const { return fit_method_; }
   void set_fit_method(StarfishFitMethod method) { fit_method_ = method; }
@@ -116,7 +127,10 @@ class StarfishCalibration : public Problem {
   // tendon actuation model, which writes every step's activations; with
   // `actuation`'s release_lag set {slack, lag, length, release_lag}) and,
   // when water_in_model(), {drag_tangential, drag_normal, thrust} (a
-  // StateForceBlock; otherwise the scene has `water`'s values), and functional
+  // StateForceBlock; otherwise the scene has `water`'s values), with
+  // density_in_model() the material block {E, nu, density}, with
+  // damping_in_model() a last block {linear_damping} (a StateForceBlock
+  // starting at `linear_damping`, 1/s), and functional
   // 0: with fit_method() kLbfgs one row, the scalar loss 1/2 |r|^2 of the
   // marker residuals (LeastSquaresLoss; its gradient is one adjoint), with
   // kLevenbergMarquardt the marker residuals r themselves (MarkerResiduals,
@@ -130,7 +144,8 @@ class StarfishCalibration : public Problem {
                                                       const SolverOptions& options, const MaterialParameters& material,
                                                       const StarfishActuation& actuation,
                                                       const StarfishWater& water = StarfishWater(),
-                                                      const CapturedMotion* motion = nullptr) const;
+                                                      const CapturedMotion* motion = nullptr,
+                                                      double linear_damping = DampingGuess()) const;
 
   // Fits E, nu, slack, lag and length (with kBodyArms also the arms' E;
   // when water_in_model() also the water's coefficients from `water_guess`)
@@ -142,7 +157,9 @@ class StarfishCalibration : public Problem {
   // iterations; the iteration table goes to `log` (nullptr: silent). Throws
   // what MakeModel, StarfishFitStart and CheckStarfishWaterStart throw, and
   // InvalidInputError for kBodyArms with kLevenbergMarquardt ("the lm fit
-  // has no tied arms' nu: fit body-arms regions with --fit lbfgs").
+  // has no tied arms' nu: fit body-arms regions with --fit lbfgs"). With
+  // density_in_model() the density is fitted from guess.density, with
+  // damping_in_model() the linear damping from DampingGuess().
   StarfishFit Fit(const StarfishRecording& recording, const StarfishWindow& window, const SolverOptions& options,
                   const MaterialParameters& guess, const StarfishActuation& actuation_guess, int max_iterations,
                   FILE* log, const StarfishWater& water_guess = WaterGuess()) const;
@@ -164,13 +181,16 @@ class StarfishCalibration : public Problem {
   // The fit's starting water when fitted: the scene's drag, thrust 0.1 (the
   // fit keeps the thrust positive, StarfishWaterCoordinates).
   static StarfishWater WaterGuess() { return StarfishWater{0.05, 2.05, 0.1}; }
+  // The fit's starting linear damping when fitted: 1 /s.
+  static constexpr double DampingGuess() { return 1.0; }
   // The fit's starting actuation: slack 3 mm, lag 50 ms, length 65 mm.
   static StarfishActuation ActuationGuess() { return StarfishActuation{0.003, 0.05, kTendonRest}; }
 
   // `diffpd run calibrate-starfish [--calibrate FILE] [--predict FILE ...]
   // [--seconds S] [--json] [--threads T] [--max-iterations N] [--out DIR]
   // [--regions body-arms] [--fit lm|lbfgs] [--fit-start S] [--fit-seconds S]
-  // [--water fitted|fixed] [--servo symmetric|asymmetric]`:
+  // [--water fitted|fixed] [--servo symmetric|asymmetric] [--starts N]
+  // [--density fitted|fixed] [--damping fitted|fixed]`:
   // fits E, nu, tendon slack, lag and length (and with the lm fit, unless
   // --servo symmetric, the servo's release lag, and unless --water fixed,
   // the water's drag and thrust coefficients) on the calibration file's
@@ -183,7 +203,10 @@ class StarfishCalibration : public Problem {
   // (default 10) of every --predict file (any recording in the fact sheet's
   // format; default: the calibration file and, when no --calibrate is given,
   // cyclic2 too) with the fitted parameters and reports per file the errors
-  // and the zero-motion and mean-displacement baselines.
+  // and the zero-motion and mean-displacement baselines. --starts N (1 to
+  // 4, default 1) fits from the first N of StarfishStarts and keeps the fit
+  // with the lowest cost on the calibration window; --density fitted and
+  // --damping fitted add the density and a linear damping to the lm fit.
   // --out DIR writes per predicted file DIR/<file stem>_trace.csv
   // (WriteStarfishTrace), its plot <stem>_trace.png (WriteStarfishTracePlot;
   // skipped with a note without gnuplot) and the simulated body with the
@@ -201,6 +224,8 @@ class StarfishCalibration : public Problem {
   StarfishFitMethod fit_method_ = StarfishFitMethod::kLevenbergMarquardt;
   bool fit_water_ = true;
   bool fit_release_lag_ = true;
+  bool fit_density_ = false;
+  bool fit_damping_ = false;
 };
 
 }  // namespace diffpd::problems

@@ -27,6 +27,8 @@ constexpr double kMinLength = 0.03, kMaxLength = 0.13;  // m
 constexpr double kMinDragTangential = 0.005, kMaxDragTangential = 5;
 constexpr double kMinDragNormal = 0.2, kMaxDragNormal = 20;
 constexpr double kMinThrust = 1e-3, kMaxThrust = 10;
+constexpr double kMinDensity = 50, kMaxDensity = 5000;   // kg/m^3
+constexpr double kMinDamping = 0.01, kMaxDamping = 100;  // 1/s
 
 std::string Num(double v) {
   std::ostringstream s;
@@ -103,20 +105,32 @@ class FitTable : public ceres::IterationCallback {
 // `water` nullptr when the water is not fitted).
 class LeastSquaresTable : public ceres::IterationCallback {
  public:
-  LeastSquaresTable(FILE* log, const double* material, const double* actuation, bool release, const double* water)
-      : log_(log), material_(material), actuation_(actuation), release_(release), water_(water) {}
+  LeastSquaresTable(FILE* log, const double* material, const double* actuation, bool release, const double* water,
+                    bool density, const double* damping)
+      : log_(log),
+        material_(material),
+        actuation_(actuation),
+        release_(release),
+        water_(water),
+        density_(density),
+        damping_(damping) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     if (s.iteration == 0) {
       std::fprintf(log_, "%4s %13s %11s %11s %9s %14s %14s %9s %9s %9s", "iter", "cost", "cost_change", "|gradient|",
                    "total_t", "youngs_modulus", "poissons_ratio", "slack_mm", "lag_s", "length_mm");
       if (release_) std::fprintf(log_, " %9s", "release_s");
-      std::fprintf(log_, water_ ? " %9s %9s %9s\n" : "\n", "drag_t", "drag_n", "thrust");
+      if (water_) std::fprintf(log_, " %9s %9s %9s", "drag_t", "drag_n", "thrust");
+      if (density_) std::fprintf(log_, " %9s", "density");
+      if (damping_) std::fprintf(log_, " %9s", "damping");
+      std::fprintf(log_, "\n");
     }
     std::fprintf(log_, "%4d %13.6e %11.3e %11.3e %9.2f %14.6g %14.6g %9.4f %9.4f %9.3f", s.iteration, s.cost,
                  s.cost_change, s.gradient_max_norm, s.cumulative_time_in_seconds, material_[0], material_[1],
                  actuation_[0] / kMm, actuation_[1], actuation_[2] / kMm);
     if (release_) std::fprintf(log_, " %9.4f", actuation_[3]);
     if (water_) std::fprintf(log_, " %9.4f %9.4f %9.4f", water_[0], water_[1], water_[2]);
+    if (density_) std::fprintf(log_, " %9.2f", material_[2]);
+    if (damping_) std::fprintf(log_, " %9.4f", damping_[0]);
     std::fprintf(log_, "\n");
     std::fflush(log_);
     return ceres::SOLVER_CONTINUE;
@@ -128,6 +142,8 @@ class LeastSquaresTable : public ceres::IterationCallback {
   const double* actuation_;
   bool release_;
   const double* water_;
+  bool density_;
+  const double* damping_;
 };
 
 // The tangent coordinate of x under `map` (0 for linear and log maps).
@@ -187,6 +203,15 @@ void CheckStarfishWaterStart(const StarfishWater& w) {
                             Num(kMaxThrust) + ")");
 }
 
+void CheckStarfishMassDampingStart(double density, const StarfishMassDamping& md) {
+  if (md.fit_density && !(density > kMinDensity && density < kMaxDensity))
+    throw InvalidInputError("density = " + Num(density) + " is outside the fit's interval (" + Num(kMinDensity) + ", " +
+                            Num(kMaxDensity) + ") kg/m^3");
+  if (md.linear_damping_guess && !(*md.linear_damping_guess > kMinDamping && *md.linear_damping_guess < kMaxDamping))
+    throw InvalidInputError("linear_damping = " + Num(*md.linear_damping_guess) + " is outside the fit's interval (" +
+                            Num(kMinDamping) + ", " + Num(kMaxDamping) + ") 1/s");
+}
+
 std::vector<double> StarfishFitStart(const MaterialParameters& m, const StarfishActuation& a, bool arms) {
   if (!(m.youngs_modulus > kMinE && m.youngs_modulus < kMaxE))
     throw InvalidInputError("youngs_modulus = " + Num(m.youngs_modulus) +
@@ -237,39 +262,53 @@ StarfishFit FitStarfishLoss(solvers::RolloutFunction* model, bool arms, const Ma
   return fit;
 }
 
-std::vector<std::string> StarfishFitNames(bool release, bool water) {
-  std::vector<std::string> names = {"youngs_modulus", "poissons_ratio", "tendon_slack", "tendon_lag", "tendon_length"};
+std::vector<std::string> StarfishFitNames(bool release, bool water, bool density, bool damping) {
+  std::vector<std::string> names = {"youngs_modulus", "poissons_ratio"};
+  if (density) names.push_back("density");
+  for (const char* n : {"tendon_slack", "tendon_lag", "tendon_length"}) names.push_back(n);
   if (release) names.push_back("tendon_release_lag");
   if (water)
     for (const char* n : {"drag_tangential", "drag_normal", "thrust"}) names.push_back(n);
+  if (damping) names.push_back("linear_damping");
   return names;
 }
 
 std::vector<double> StarfishFitValues(const StarfishFit& fit) {
-  std::vector<double> v = {fit.material.youngs_modulus, fit.material.poissons_ratio, fit.actuation.slack,
-                           fit.actuation.lag, fit.actuation.length};
+  std::vector<double> v = {fit.material.youngs_modulus, fit.material.poissons_ratio};
+  if (fit.density_fitted) v.push_back(fit.material.density);
+  for (double a : {fit.actuation.slack, fit.actuation.lag, fit.actuation.length}) v.push_back(a);
   if (fit.actuation.release_lag) v.push_back(*fit.actuation.release_lag);
   if (fit.water_fitted)
     for (double w : {fit.water.drag_tangential, fit.water.drag_normal, fit.water.thrust}) v.push_back(w);
+  if (fit.linear_damping) v.push_back(*fit.linear_damping);
   return v;
 }
 
 StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residual_functional,
                                     const MaterialParameters& guess, const StarfishActuation& actuation_guess,
-                                    const StarfishWater* water_guess, int max_iterations, FILE* log) {
+                                    const StarfishWater* water_guess, int max_iterations, FILE* log,
+                                    const StarfishMassDamping& mass_damping) {
   const std::vector<double> start = StarfishFitStart(guess, actuation_guess, false);
   if (water_guess) CheckStarfishWaterStart(*water_guess);
+  CheckStarfishMassDampingStart(guess.density, mass_damping);
+  const bool density = mass_damping.fit_density;
+  const bool damping = mass_damping.linear_damping_guess.has_value();
   const bool release = actuation_guess.release_lag.has_value();
   if (release && !(*actuation_guess.release_lag > kMinLag && *actuation_guess.release_lag < kMaxLag))
     throw InvalidInputError("tendon release_lag = " + Num(*actuation_guess.release_lag) +
                             " is outside the fit's interval (0.001, 0.5) s");
-  std::vector<solvers::CoordinateMap> maps = StarfishFitCoordinates(false);
+  // The maps in the blocks' order (material, actuation, water, damping).
+  const std::vector<solvers::CoordinateMap> fit_maps = StarfishFitCoordinates(false);
+  std::vector<solvers::CoordinateMap> maps = {fit_maps[0], fit_maps[1]};
+  if (density) maps.push_back(solvers::CoordinateMap::LogLogit(kMinDensity, kMaxDensity));
+  for (int i = 2; i < 5; ++i) maps.push_back(fit_maps[i]);
   if (release) maps.push_back(solvers::CoordinateMap::LogLogit(kMinLag, kMaxLag));
-  double material[2] = {start[0], start[1]};
+  double material[3] = {start[0], start[1], guess.density};
   double actuation[4] = {start[2], start[3], start[4], release ? *actuation_guess.release_lag : 0};
   double water[3] = {0, 0, 0};
+  double damping_value[1] = {damping ? *mass_damping.linear_damping_guess : 0};
   std::vector<double*> blocks = {material, actuation};
-  std::vector<int> sizes = {2, release ? 4 : 3};
+  std::vector<int> sizes = {density ? 3 : 2, release ? 4 : 3};
   if (water_guess) {
     water[0] = water_guess->drag_tangential;
     water[1] = water_guess->drag_normal;
@@ -277,6 +316,11 @@ StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residua
     blocks.push_back(water);
     sizes.push_back(3);
     for (const solvers::CoordinateMap& m : StarfishWaterCoordinates()) maps.push_back(m);
+  }
+  if (damping) {
+    blocks.push_back(damping_value);
+    sizes.push_back(1);
+    maps.push_back(solvers::CoordinateMap::LogLogit(kMinDamping, kMaxDamping));
   }
   const int n = static_cast<int>(maps.size());
   solvers::RolloutEvaluationCallback callback(model, blocks);
@@ -299,19 +343,22 @@ StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residua
   options.gradient_tolerance = 1e-12;
   options.update_state_every_iteration = true;
   options.logging_type = ceres::SILENT;
-  LeastSquaresTable table(log, material, actuation, release, water_guess ? water : nullptr);
+  LeastSquaresTable table(log, material, actuation, release, water_guess ? water : nullptr, density,
+                          damping ? damping_value : nullptr);
   if (log) options.callbacks.push_back(&table);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
 
   StarfishFit fit;
-  fit.material = MaterialParameters{material[0], material[1], guess.density};
+  fit.material = MaterialParameters{material[0], material[1], density ? material[2] : guess.density};
+  fit.density_fitted = density;
   fit.actuation = StarfishActuation{actuation[0], actuation[1], actuation[2]};
   if (release) fit.actuation.release_lag = actuation[3];
   if (water_guess) {
     fit.water = StarfishWater{water[0], water[1], water[2]};
     fit.water_fitted = true;
   }
+  if (damping) fit.linear_damping = damping_value[0];
   fit.initial_cost = summary.initial_cost;
   fit.final_cost = summary.final_cost;
   fit.iterations = static_cast<int>(summary.iterations.size()) - 1;

@@ -17,9 +17,13 @@
 // and, in the least-squares fit when the water is fitted (StarfishWater),
 // three more, log-logit (positive: each term opposes the motion):
 //   drag_tangential in (0.005, 5), drag_normal in (0.2, 20), thrust in (0.001, 10)
+// and when chosen (StarfishMassDamping), log-logit:
+//   density        in (50, 5000) kg/m^3 (the body's mass with the water it carries)
+//   linear_damping in (0.01, 100) 1/s (Scene::linear_damping)
 #pragma once
 
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +47,17 @@ std::vector<solvers::CoordinateMap> StarfishWaterCoordinates();
 //   "drag_normal = 30 is outside the fit's interval (0.2, 20)".
 void CheckStarfishWaterStart(const StarfishWater& water);
 
+// The body's density and linear damping in the least-squares fit: fitted
+// when chosen (default: neither; the scene's density and no damping).
+struct StarfishMassDamping {
+  bool fit_density = false;                    // from the material guess's density
+  std::optional<double> linear_damping_guess;  // 1/s; set: linear_damping fitted from it
+};
+// Throws InvalidInputError for a value outside its interval, e.g.
+//   "density = 9000 is outside the fit's interval (50, 5000) kg/m^3",
+//   "linear_damping = 200 is outside the fit's interval (0.01, 100) 1/s".
+void CheckStarfishMassDampingStart(double density, const StarfishMassDamping& mass_damping);
+
 // How a fit minimises the marker error.
 enum class StarfishFitMethod {
   kLbfgs,               // FitStarfishLoss: L-BFGS on the scalar loss (one adjoint per gradient)
@@ -63,15 +78,16 @@ struct StarfishFit {
   StarfishActuation actuation;  // fitted
   StarfishWater water;          // fitted when water_fitted, else the scene's
   bool water_fitted = false;
-  double initial_cost = 0;  // the model's loss at the start
+  bool density_fitted = false;           // material.density fitted
+  std::optional<double> linear_damping;  // 1/s, fitted; unset: no damping
+  double initial_cost = 0;               // the model's loss at the start
   double final_cost = 0;
   int iterations = 0;                     // Ceres iterations
   bool usable = false;                    // Ceres' solution is usable
   std::string termination;                // Ceres' message
   solvers::RolloutStatistics statistics;  // rollouts, gradients, timings
-  // FitStarfishLeastSquares only (empty otherwise): per fitted value (x0..x4,
-  // then drag_tangential, drag_normal, thrust when the water is fitted: n
-  // values) its standard deviation from ceres::Covariance (physical units;
+  // FitStarfishLeastSquares only (empty otherwise): per fitted value (in the
+  // order of StarfishFitNames: n values) its standard deviation from ceres::Covariance (physical units;
   // the residuals scaled by their fitted noise, s^2 = |r|^2 / (rows - n)),
   // the n x n correlation matrix (row-major), and whether the value lies at
   // a bound of its interval (tangent coordinate |u| > 5: within 1% of an
@@ -83,12 +99,12 @@ struct StarfishFit {
 };
 
 // The names of the least-squares fit's values in their order: youngs_modulus,
-// poissons_ratio, tendon_slack, tendon_lag, tendon_length, then with
-// `release` tendon_release_lag, then with `water` drag_tangential,
-// drag_normal, thrust.
-std::vector<std::string> StarfishFitNames(bool release, bool water);
+// poissons_ratio, with `density` density, then tendon_slack, tendon_lag,
+// tendon_length, then with `release` tendon_release_lag, then with `water`
+// drag_tangential, drag_normal, thrust, then with `damping` linear_damping.
+std::vector<std::string> StarfishFitNames(bool release, bool water, bool density = false, bool damping = false);
 // A fit's values in the order of StarfishFitNames(fit.actuation.release_lag,
-// fit.water_fitted) (physical units).
+// fit.water_fitted, fit.density_fitted, fit.linear_damping) (physical units).
 std::vector<double> StarfishFitValues(const StarfishFit& fit);
 
 // The coordinate maps of the fitted values (5, or 6 with `arms`).
@@ -109,10 +125,12 @@ std::vector<double> StarfishFitStart(const MaterialParameters& material, const S
 StarfishFit FitStarfishLoss(solvers::RolloutFunction* model, bool arms, const MaterialParameters& guess,
                             const StarfishActuation& actuation_guess, int max_iterations, FILE* log);
 
-// Fits `model` (blocks: material {E, nu}, then TendonActuationBlock (with
-// release_lag when actuation_guess has one: then it is fitted too), and
-// with `water_guess` a StateForceBlock {drag_tangential, drag_normal,
-// thrust}; functional `residual_functional`: a MarkerResiduals) by
+// Fits `model` (blocks: material {E, nu} ({E, nu, density} with
+// mass_damping.fit_density), then TendonActuationBlock (with release_lag
+// when actuation_guess has one: then it is fitted too), with `water_guess`
+// a StateForceBlock {drag_tangential, drag_normal, thrust}, and with
+// mass_damping.linear_damping_guess a StateForceBlock {linear_damping};
+// functional `residual_functional`: a MarkerResiduals) by
 // Levenberg-Marquardt (ceres::Problem, one residual block per capture frame,
 // Jacobians by the rollout function: forward-mode tangents for 5 to 9
 // parameters) on the manifolds of StarfishFitCoordinates(false) and
@@ -121,9 +139,11 @@ StarfishFit FitStarfishLoss(solvers::RolloutFunction* model, bool arms, const Ma
 // `water_guess` (nullptr: the water is not fitted), at most `max_iterations`
 // iterations, then the parameters' covariance (see StarfishFit). The
 // iteration table goes to `log` (nullptr: silent). Throws what
-// StarfishFitStart and CheckStarfishWaterStart throw.
+// StarfishFitStart, CheckStarfishWaterStart and
+// CheckStarfishMassDampingStart throw.
 StarfishFit FitStarfishLeastSquares(solvers::RolloutFunction* model, int residual_functional,
                                     const MaterialParameters& guess, const StarfishActuation& actuation_guess,
-                                    const StarfishWater* water_guess, int max_iterations, FILE* log);
+                                    const StarfishWater* water_guess, int max_iterations, FILE* log,
+                                    const StarfishMassDamping& mass_damping = StarfishMassDamping());
 
 }  // namespace diffpd::problems

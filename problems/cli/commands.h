@@ -63,9 +63,11 @@ struct CommandArgs {
   std::string fit;
   double fit_start = -1;
   double fit_seconds = -1;
-  std::string water;  // calibrate-starfish: "": the problem's; "fitted", "fixed"
-  std::string servo;  // calibrate-starfish: "": the problem's; "symmetric", "asymmetric"
-  int starts = -1;    // calibrate-starfish: fits from this many starting points (-1: the problem's)
+  std::string water;    // calibrate-starfish: "": the problem's; "fitted", "fixed"
+  std::string servo;    // calibrate-starfish: "": the problem's; "symmetric", "asymmetric"
+  int starts = -1;      // calibrate-starfish: fits from this many starting points (-1: the problem's)
+  std::string density;  // calibrate-starfish: "": the problem's; "fitted", "fixed"
+  std::string damping;  // calibrate-starfish: "": the problem's; "fitted", "fixed"
 };
 
 int ListCommand(bool json);

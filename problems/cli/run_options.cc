@@ -80,6 +80,8 @@ void RefuseUnusedRunOptions(const CommandArgs& args, const Problem& problem) {
       {"--water", !args.water.empty(), kStarfish, "calibrate-starfish"},
       {"--servo", !args.servo.empty(), kStarfish, "calibrate-starfish"},
       {"--starts", args.starts != defaults.starts, kStarfish, "calibrate-starfish"},
+      {"--density", !args.density.empty(), kStarfish, "calibrate-starfish"},
+      {"--damping", !args.damping.empty(), kStarfish, "calibrate-starfish"},
   };
   const int kind = KindOf(problem);
   for (const RunOption& o : options)

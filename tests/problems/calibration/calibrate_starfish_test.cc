@@ -606,6 +606,64 @@ TEST_F(StarfishFitTest, ResidualJacobianMatchesCentralDifferences) {
   EXPECT_LT((r8 - r5).norm(), 1e-9 * r8.norm());
 }
 
+// With the density and a linear damping fitted too: the material block is
+// {E, nu, density}, a last block {linear_damping}; their Jacobian columns
+// (forward-mode tangents through the mass matrix and the damping force)
+// against central differences of the residuals; starts outside their
+// intervals are refused.
+TEST_F(StarfishFitTest, DensityAndDampingJacobianMatchesCentralDifferences) {
+  starfish_.set_fit_density(true);
+  starfish_.set_fit_damping(true);
+  ASSERT_TRUE(starfish_.density_in_model() && starfish_.damping_in_model());
+  SolverOptions options = starfish_.Options(Method::kPdLbfgs, 1);
+  options.rel_tolerance = 1e-10;
+  options.abs_tolerance = 1e-10;
+  auto model = starfish_.MakeModel(recording_, window_, options, MaterialParameters{2e5, 0.35, 600},
+                                   StarfishActuation{0.004, 0.03, 0.05}, StarfishWater{0.1, 1.5, 0.3}, nullptr, 2.0);
+  ASSERT_EQ(model->num_blocks(), 4);
+  ASSERT_EQ(model->block(0).size(), 3);
+  ASSERT_EQ(model->block(3).size(), 1);
+  VectorXd p0(10);
+  p0 << 2e5, 0.35, 600, 0.004, 0.03, 0.05, 0.1, 1.5, 0.3, 2.0;
+  MatrixXd j;
+  ASSERT_TRUE(model->Evaluate(p0, model->AllRows(), nullptr, &j)) << model->statistics().last_error;
+  ASSERT_EQ(j.cols(), 10);
+  for (const int i : {2, 9}) {  // density, linear_damping
+    const double step = i == 2 ? 600 * 1e-4 : 1e-4;
+    VectorXd plus = p0, minus = p0, rp, rm;
+    plus(i) += step;
+    minus(i) -= step;
+    ASSERT_TRUE(model->Evaluate(plus, model->AllRows(), &rp, nullptr));
+    ASSERT_TRUE(model->Evaluate(minus, model->AllRows(), &rm, nullptr));
+    const VectorXd fd = (rp - rm) / (2 * step);
+    EXPECT_GT(fd.norm() * std::abs(p0(i)), 1e-4) << "column " << i << ": the residuals depend on it";
+    EXPECT_LT((j.col(i) - fd).norm(), 1e-4 * fd.norm()) << "column " << i;
+  }
+  EXPECT_EQ(StarfishFitNames(true, true, true, true),
+            (std::vector<std::string>{"youngs_modulus", "poissons_ratio", "density", "tendon_slack", "tendon_lag",
+                                      "tendon_length", "tendon_release_lag", "drag_tangential", "drag_normal", "thrust",
+                                      "linear_damping"}));
+  StarfishMassDamping md;
+  md.fit_density = true;
+  EXPECT_THROW_MESSAGE(CheckStarfishMassDampingStart(9000, md), InvalidInputError,
+                       "density = 9000 is outside the fit's interval (50, 5000) kg/m^3");
+  md.fit_density = false;
+  md.linear_damping_guess = 200;
+  EXPECT_THROW_MESSAGE(CheckStarfishMassDampingStart(9000, md), InvalidInputError,
+                       "linear_damping = 200 is outside the fit's interval (0.01, 100) 1/s");
+  // A one-iteration fit reports both values, the density in the material.
+  starfish_.set_fit_release_lag(false);
+  const StarfishFit fit =
+      starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
+                    StarfishCalibration::ActuationGuess(), 1, nullptr);
+  EXPECT_TRUE(fit.usable) << fit.termination;
+  EXPECT_TRUE(fit.density_fitted);
+  ASSERT_TRUE(fit.linear_damping.has_value());
+  EXPECT_EQ(StarfishFitValues(fit).size(), 10u);
+  EXPECT_EQ(fit.standard_deviation.size(), 10u);
+  EXPECT_LE(fit.final_cost, fit.initial_cost);
+}
+
 // Levenberg-Marquardt lowers the cost and gives every parameter a finite
 // standard deviation and a symmetric correlation matrix with unit diagonal.
 // (The test window has no release: the release lag is not fitted here.)

@@ -107,8 +107,8 @@ TEST(StarfishFitStartsTest, FitStartsAtTheGivenWater) {
   const StarfishWindow window = MakeStarfishWindow(recording, 1.15, 0.15);
   const SolverOptions options = starfish.Options(Method::kPdLbfgs, 1);
   const StarfishStart start = StarfishStarts(2, DefaultStart())[1];
-  const StarfishFit fit = starfish.Fit(recording, window, options, start.material, start.actuation, 1, nullptr,
-                                       start.water);
+  const StarfishFit fit =
+      starfish.Fit(recording, window, options, start.material, start.actuation, 1, nullptr, start.water);
   EXPECT_TRUE(fit.usable) << fit.termination;
   StarfishActuation symmetric = start.actuation;  // the model of a symmetric servo has no release lag
   symmetric.release_lag.reset();

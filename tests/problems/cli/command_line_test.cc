@@ -131,6 +131,12 @@ TEST(CommandLineTest, RefusesOutOfRangeValuesOfTheSimulatingCommands) {
       {{"run", "calibrate-starfish", "--starts", "5"},
        2,
        Invalid("--starts = 5 is invalid: must be an integer in [1, 4]")},
+      {{"run", "calibrate-starfish", "--density", "free"},
+       2,
+       Invalid("--density = 'free' is invalid: calibrate-starfish knows 'fitted' or 'fixed'")},
+      {{"run", "calibrate-starfish", "--damping", "yes"},
+       2,
+       Invalid("--damping = 'yes' is invalid: calibrate-starfish knows 'fitted' or 'fixed'")},
   });
 }
 
@@ -165,6 +171,9 @@ TEST(CommandLineTest, RefusesOptionsTheProblemWouldIgnore) {
       {{"run", "calibrate-plant", "--starts", "2"},
        2,
        Invalid("--starts is not used by the calibration problem 'calibrate-plant' (only calibrate-starfish read it)")},
+      {{"run", "calibrate-plant", "--damping", "fitted"},
+       2,
+       Invalid("--damping is not used by the calibration problem 'calibrate-plant' (only calibrate-starfish read it)")},
       {{"run", "calibrate-starfish", "--small"},
        2,
        Invalid("--small is not used by the starfish calibration 'calibrate-starfish' (only the optimisation and "
