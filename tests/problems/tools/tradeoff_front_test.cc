@@ -78,10 +78,11 @@ TEST(TradeoffFrontTest, ADefaultBetweenTheSweptTolerancesCountsAsItsOwnPoint) {
   TradeoffResult r = Made();
   r.default_rel_tolerance = r.rows[0].value = r.rows[0].rel_tolerance = 1e-3;  // between 1e-2 and 1e-4
   r.rows[0].grad_rel_error = 5e-3;
-  const ErrorBound& b2 = AnalyseFront(r).bounds[1];  // 1e-2: pd 1e-2 misses it (1e-1), 1e-3 and tighter meet it
+  const TradeoffFront f = AnalyseFront(r);
+  const ErrorBound& b2 = f.bounds[1];  // 1e-2: pd 1e-2 misses it (1e-1), 1e-3 and tighter meet it
   EXPECT_EQ(b2.default_method_tolerance, 1e-3);
   EXPECT_DOUBLE_EQ(b2.loosening, 1.0);
-  const ErrorBound& b3 = AnalyseFront(r).bounds[0];  // 1e-3: the default misses it, pd 1e-4 meets it
+  const ErrorBound& b3 = f.bounds[0];  // 1e-3: the default misses it, pd 1e-4 meets it
   EXPECT_EQ(b3.default_method_tolerance, 1e-4);
   EXPECT_DOUBLE_EQ(b3.loosening, 0.1);
 }

@@ -51,7 +51,7 @@ class NodeSpeedSquared : public solvers::TrajectoryFunction {
 struct ParameterBlockCase {
   std::unique_ptr<solvers::RolloutFunction> function;
   VectorXd point;    // where to check (inside every block's domain)
-  VectorXd typical;  // a typical magnitude per parameter (central-difference steps are 1e-4 of it)
+  VectorXd typical;  // a typical magnitude per parameter (central-difference steps are 1e-3 of it)
 };
 
 // Nodes with x >= max x - tol.

@@ -16,7 +16,7 @@ TEST_P(ParameterBlockDerivativeTest, PullBackAndPushForwardMatchCentralDifferenc
   ParameterBlockCase c = MakeParameterBlockCase(GetParam());
   // Forward mode covers every block (and the state-force terms of the scenes).
   EXPECT_TRUE(c.function->ForwardModeAvailable());
-  ExpectDerivativesMatchCentralDifferences(c.function.get(), c.point, 1e-4 * c.typical, 1e-6);
+  ExpectDerivativesMatchCentralDifferences(c.function.get(), c.point, 1e-3 * c.typical, 1e-6);
 }
 
 INSTANTIATE_TEST_SUITE_P(Blocks, ParameterBlockDerivativeTest, ::testing::ValuesIn(ParameterBlockCaseNames()),
