@@ -37,6 +37,16 @@ std::string Num(double v) {
   return s.str();
 }
 
+// A flag that takes one of two words: whether `value` is `chosen`;
+// InvalidInputError naming the flag and both words otherwise.
+bool ParseTwoWayOption(const std::string& flag, const std::string& value, const char* first, const char* second,
+                       const char* chosen) {
+  if (value != first && value != second)
+    throw InvalidInputError(flag + " = '" + value + "' is invalid: calibrate-starfish knows '" + first + "' or '" +
+                            second + "'");
+  return value == chosen;
+}
+
 }  // namespace
 
 std::string StarfishCalibration::description() const {
@@ -246,30 +256,13 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
     StarfishCalibration with = *this;
     if (!args.regions.empty()) with.set_regions(ParseStarfishRegions(args.regions));
     if (!args.fit.empty()) with.set_fit_method(ParseStarfishFitMethod(args.fit));
-    if (!args.water.empty()) {
-      if (args.water != "fitted" && args.water != "fixed")
-        throw InvalidInputError("--water = '" + args.water +
-                                "' is invalid: calibrate-starfish knows 'fitted' or 'fixed'");
-      with.set_fit_water(args.water == "fitted");
-    }
-    if (!args.servo.empty()) {
-      if (args.servo != "symmetric" && args.servo != "asymmetric")
-        throw InvalidInputError("--servo = '" + args.servo +
-                                "' is invalid: calibrate-starfish knows 'symmetric' or 'asymmetric'");
-      with.set_fit_release_lag(args.servo == "asymmetric");
-    }
-    if (!args.density.empty()) {
-      if (args.density != "fitted" && args.density != "fixed")
-        throw InvalidInputError("--density = '" + args.density +
-                                "' is invalid: calibrate-starfish knows 'fitted' or 'fixed'");
-      with.set_fit_density(args.density == "fitted");
-    }
-    if (!args.damping.empty()) {
-      if (args.damping != "fitted" && args.damping != "fixed")
-        throw InvalidInputError("--damping = '" + args.damping +
-                                "' is invalid: calibrate-starfish knows 'fitted' or 'fixed'");
-      with.set_fit_damping(args.damping == "fitted");
-    }
+    if (!args.water.empty()) with.set_fit_water(ParseTwoWayOption("--water", args.water, "fitted", "fixed", "fitted"));
+    if (!args.servo.empty())
+      with.set_fit_release_lag(ParseTwoWayOption("--servo", args.servo, "symmetric", "asymmetric", "asymmetric"));
+    if (!args.density.empty())
+      with.set_fit_density(ParseTwoWayOption("--density", args.density, "fitted", "fixed", "fitted"));
+    if (!args.damping.empty())
+      with.set_fit_damping(ParseTwoWayOption("--damping", args.damping, "fitted", "fixed", "fitted"));
     CommandArgs rest = args;
     rest.regions.clear();
     rest.fit.clear();
