@@ -27,7 +27,10 @@ constexpr double kLossScale = 0.002;  // m: residuals in units of 2 mm
 constexpr double kFitStart = 1.0;     // s: the tendon first moves at 1.18 s in cyclic1
 constexpr double kFitSeconds = 5.0;   // s
 constexpr double kDefaultSeconds = 10;
+// Levenberg-Marquardt iterations: 20 with the density in the fit (the
+// default), 10 without it (docs/benchmarks.md, the cross-validation).
 constexpr int kDefaultIterations = 10;
+constexpr int kDefaultIterationsWithDensity = 20;
 constexpr int kDefaultStarts = 1;
 constexpr int kVtkStride = 6;  // camera frames per VTK frame: 10 per second
 
@@ -351,7 +354,9 @@ int StarfishCalibration::Run(const CommandArgs& args) const {
                  "from the body's %zu; nu and density shared\n",
                  scene.material_regions[0].elements.size(),
                  scene.mesh.num_elements() - scene.material_regions[0].elements.size());
-  const int max_iterations = args.max_iterations >= 0 ? args.max_iterations : kDefaultIterations;
+  const int max_iterations = args.max_iterations >= 0 ? args.max_iterations
+                             : density_in_model()     ? kDefaultIterationsWithDensity
+                                                      : kDefaultIterations;
   StarfishStart first{guess, actuation_guess, WaterGuess()};
   if (release_in_model()) first.actuation.release_lag = first.actuation.lag;
   const std::vector<StarfishStart> starts = StarfishStarts(args.starts >= 0 ? args.starts : kDefaultStarts, first);

@@ -70,8 +70,10 @@ class StarfishCalibration : public Problem {
   bool water_in_model() const { return fit_water_ && fit_method_ == StarfishFitMethod::kLevenbergMarquardt; }
 
   // Whether the lm fit fits the body's density (the mass it moves with the
-  // water it carries; default false: the scene's 400 kg/m^3) and a linear
-  // damping (Scene::linear_damping, from DampingGuess(); default false: none).
+  // water it carries; default true, from the scene's 400 kg/m^3: with it
+  // both recordings predict the other at under half the zero-motion RMSE,
+  // without it only one does) and a linear damping (Scene::linear_damping,
+  // from DampingGuess(); default false: none).
   bool fit_density() const { return fit_density_; }
   void set_fit_density(bool fit) { fit_density_ = fit; }
   bool fit_damping() const { return fit_damping_; }
@@ -197,7 +199,8 @@ class StarfishCalibration : public Problem {
   // window (default [1 s, 6 s]: the tendon first moves at 1.18 s in cyclic1;
   // 5 s take in the swimming, which a 2 s window does not pin down) by
   // Levenberg-Marquardt on the marker residuals (--fit lbfgs: L-BFGS on the
-  // scalar loss; at most 10 iterations unless --max-iterations; 0: no fit,
+  // scalar loss; at most 20 iterations with the density fitted, else 10,
+  // unless --max-iterations; 0: no fit,
   // predict at the starting values), prints the parameters' standard
   // deviations and correlations (lm), then simulates the first S seconds
   // (default 10) of every --predict file (any recording in the fact sheet's
@@ -205,8 +208,9 @@ class StarfishCalibration : public Problem {
   // cyclic2 too) with the fitted parameters and reports per file the errors
   // and the zero-motion and mean-displacement baselines. --starts N (1 to
   // 4, default 1) fits from the first N of StarfishStarts and keeps the fit
-  // with the lowest cost on the calibration window; --density fitted and
-  // --damping fitted add the density and a linear damping to the lm fit.
+  // with the lowest cost on the calibration window; --density fixed keeps
+  // the scene's density (fitted by default), --damping fitted adds a linear
+  // damping to the lm fit.
   // --out DIR writes per predicted file DIR/<file stem>_trace.csv
   // (WriteStarfishTrace), its plot <stem>_trace.png (WriteStarfishTracePlot;
   // skipped with a note without gnuplot) and the simulated body with the
@@ -224,7 +228,7 @@ class StarfishCalibration : public Problem {
   StarfishFitMethod fit_method_ = StarfishFitMethod::kLevenbergMarquardt;
   bool fit_water_ = true;
   bool fit_release_lag_ = true;
-  bool fit_density_ = false;
+  bool fit_density_ = true;
   bool fit_damping_ = false;
 };
 

@@ -60,6 +60,7 @@ solvers::RolloutTerm StarfishRecordingTerm(const StarfishCalibration& problem, c
   solvers::RolloutTerm term;
   StarfishCalibration fixed_water = problem;  // the set's fit has the 5 parameters
   fixed_water.set_fit_water(false);
+  fixed_water.set_fit_density(false);
   term.function = fixed_water.MakeModel(recording, window, options, recordings.guess, recordings.actuation_guess);
   term.rows = term.function->RowsOf(0);
   return term;

@@ -98,8 +98,9 @@ int RunCommandLine(const std::vector<std::string>& argv) {
                   "calibrate-starfish: fit from this many starting points (1 to 4, default 1), keep the fit with the "
                   "lowest cost on the calibration window")
       ->check(IntegerIn("--starts", 1, 4));
-  run->add_option("--density", run_args.density,
-                  "calibrate-starfish: 'fitted' (the lm fit fits the body's density) or 'fixed' (default)");
+  run->add_option(
+      "--density", run_args.density,
+      "calibrate-starfish: 'fitted' (default: the lm fit fits the body's density) or 'fixed' (the scene's 400 kg/m^3)");
   run->add_option("--damping", run_args.damping,
                   "calibrate-starfish: 'fitted' (the lm fit fits a linear damping) or 'fixed' (default: none)");
 

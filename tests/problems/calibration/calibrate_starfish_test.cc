@@ -571,6 +571,8 @@ TEST_F(StarfishFitTest, ShortFitLowersTheLoss) {
 TEST_F(StarfishFitTest, ResidualJacobianMatchesCentralDifferences) {
   ASSERT_EQ(starfish_.fit_method(), StarfishFitMethod::kLevenbergMarquardt);
   ASSERT_TRUE(starfish_.water_in_model());
+  ASSERT_TRUE(starfish_.density_in_model());  // the default; its column is checked below, with the damping's
+  starfish_.set_fit_density(false);
   SolverOptions options = starfish_.Options(Method::kPdLbfgs, 1);
   options.rel_tolerance = 1e-10;
   options.abs_tolerance = 1e-10;
@@ -670,6 +672,7 @@ TEST_F(StarfishFitTest, DensityAndDampingJacobianMatchesCentralDifferences) {
 TEST_F(StarfishFitTest, LeastSquaresFitLowersTheCostAndHasIntervals) {
   ASSERT_TRUE(starfish_.fit_release_lag());  // the default
   starfish_.set_fit_release_lag(false);
+  starfish_.set_fit_density(false);  // 8 values: E, nu, slack, lag, length and the water's three
   const StarfishFit fit =
       starfish_.Fit(recording_, window_, starfish_.Options(Method::kPdLbfgs, 1), MaterialParameters{5e5, 0.4, 400},
                     StarfishCalibration::ActuationGuess(), 3, nullptr);

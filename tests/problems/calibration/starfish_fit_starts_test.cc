@@ -103,6 +103,7 @@ TEST(StarfishFitStartsTest, FitStartsAtTheGivenWater) {
   StarfishCalibration starfish;
   starfish.set_substeps(1);
   starfish.set_fit_release_lag(false);
+  starfish.set_fit_density(false);  // 8 values: E, nu, slack, lag, length and the water's three
   const StarfishRecording recording = ReadStarfishRecording(kStarfishDir + "data_horizontal_cyclic1.csv");
   const StarfishWindow window = MakeStarfishWindow(recording, 1.15, 0.15);
   const SolverOptions options = starfish.Options(Method::kPdLbfgs, 1);

@@ -43,8 +43,10 @@ TEST_F(StarfishRecordingsFitTest, OneRecordingFitsAsTheSingleRecordingFit) {
   solvers::LocalRolloutSet set = Set({kCyclic1});
   const StarfishRecordingsFit over_set = FitStarfishOverSet(&set, 400, 3, nullptr);
   const StarfishRecording recording = ReadStarfishRecording(kCyclic1);
-  starfish_.set_fit_water(false);  // the set fits the 5 parameters, the scene's water, a symmetric servo
+  // The set fits the 5 parameters: the scene's water and density, a symmetric servo.
+  starfish_.set_fit_water(false);
   starfish_.set_fit_release_lag(false);
+  starfish_.set_fit_density(false);
   const StarfishFit single =
       starfish_.Fit(recording, MakeStarfishWindow(recording, recordings_.start, recordings_.seconds), Options(),
                     recordings_.guess, recordings_.actuation_guess, 3, nullptr);
