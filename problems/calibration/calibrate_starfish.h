@@ -70,10 +70,10 @@ class StarfishCalibration : public Problem {
   bool water_in_model() const { return fit_water_ && fit_method_ == StarfishFitMethod::kLevenbergMarquardt; }
 
   // Whether the lm fit fits the body's density (the mass it moves with the
-  // water it carries; default true, from the scene's 400 kg/m^3: with it
-  // both recordings predict the other at under half the zero-motion RMSE,
-  // without it only one does) and a linear damping (Scene::linear_damping,
-  // from DampingGuess(); default false: none).
+  // water it carries; default true, from the scene's 400 kg/m^3, chosen by
+  // cross-validation between the recordings: docs/benchmarks.md) and a
+  // linear damping (Scene::linear_damping, from DampingGuess(); default
+  // false: none).
   bool fit_density() const { return fit_density_; }
   void set_fit_density(bool fit) { fit_density_ = fit; }
   bool fit_damping() const { return fit_damping_; }
