@@ -113,6 +113,10 @@ int RunCommandLine(const std::vector<std::string>& argv) {
   grad->add_option("--directions", grad_check.directions, "random directions per input kind")
       ->check(IntegerAtLeast("--directions", 1))
       ->capture_default_str();
+  grad->add_option("--early-stop", grad_check.early_stop_margin,
+                   "stop at three steps per direction where they pass with this margin (0: always six)")
+      ->check(ZeroOrAtLeast("--early-stop", 1))
+      ->capture_default_str();
   bool grad_reference = false, grad_no_reference = false;
   grad->add_flag("--reference", grad_reference,
                  "also compare with a tightly converged Newton-Cholesky rollout's gradient (default for pd, pd-lbfgs, "
@@ -124,7 +128,9 @@ parameters): the relative error of the gradient against central differences,
 the noise floor of the differences (from the forward's achieved residuals and
 from differences at several steps), the margin tolerance / max(error, floor)
 and a verdict: pass, fail, or unresolved (the differences cannot resolve the
-derivative to the tolerance; the reason gives the floor). Where the
+derivative to the tolerance; the reason gives the floor). Three steps per
+direction suffice where they pass with the --early-stop margin; otherwise
+six are taken (and two wider ones where still unresolved). Where the
 differences do not pass with a margin of 3, the forward-mode tangent of the
 same states (the tangent column) decides; the basis column says which did.
 For the iterative methods the gradient is also compared with a

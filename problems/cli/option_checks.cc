@@ -4,6 +4,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <functional>
 #include <sstream>
@@ -74,6 +75,15 @@ CLI::Validator NonNegative(const std::string& option) {
   return Rule(option, "finite and >= 0", [](const std::string& s) {
     double v = 0;
     return ParseDouble(s, &v) && std::isfinite(v) && v >= 0;
+  });
+}
+
+CLI::Validator ZeroOrAtLeast(const std::string& option, double min) {
+  char bound[32];
+  std::snprintf(bound, sizeof(bound), "%g", min);
+  return Rule(option, std::string("0 or finite and >= ") + bound, [min](const std::string& s) {
+    double v = 0;
+    return ParseDouble(s, &v) && (v == 0 || (std::isfinite(v) && v >= min));
   });
 }
 

@@ -29,6 +29,9 @@ CLI::Validator ThreadCount(const std::string& option);
 CLI::Validator Positive(const std::string& option, const std::string& unit = "");
 // A finite number >= 0: "--energy-tol = -1 is invalid: must be finite and >= 0".
 CLI::Validator NonNegative(const std::string& option);
+// 0 or a finite number >= min: "--early-stop = 0.5 is invalid: must be 0 or
+// finite and >= 1".
+CLI::Validator ZeroOrAtLeast(const std::string& option, double min);
 // A number in (0, 1), or (0, 1] with include_one: "--rtol = 0 is invalid:
 // must be in (0, 1)".
 CLI::Validator Fraction(const std::string& option, bool include_one = false);

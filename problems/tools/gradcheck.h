@@ -94,6 +94,11 @@ struct GradCheckOptions {
   double tolerance = 1e-4;     // relative tolerance of every verdict; > 0
   double largest_step = 1e-2;  // first step e, in units of the input's scale; > 0
   int step_count = 6;          // steps e, each a tenth of the one before; >= 2
+  // Stop taking smaller steps once the differences at the first three (or
+  // all, if fewer) pass with at least this margin: the remaining steps
+  // could only lower the floor of a derivative already resolved. Halves
+  // the rollouts of a clean check. 0: always take all step_count steps.
+  double early_stop_margin = 10;
   // Compare with a Newton-Cholesky rollout's gradient; unset: for pd,
   // pd-lbfgs and newton-pcg (never for semi-implicit, whose time
   // discretisation differs).
@@ -146,6 +151,7 @@ struct GradCheckResult {
   CheckVerdict verdict = CheckVerdict::kPass;  // worst over the inputs
   double max_error = 0;                        // over the inputs
   double min_margin = 0;                       // over the inputs
+  long perturbed_rollouts = 0;                 // rollouts simulated for the differences (the check's cost)
 
   int Count(CheckVerdict verdict) const;
 };

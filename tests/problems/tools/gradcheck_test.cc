@@ -145,6 +145,28 @@ TEST(GradCheckTest, TableAndJsonReportTheResult) {
       << table;
 }
 
+// A clean check stops after three steps per direction, half the rollouts of
+// all six, with the same verdict and a margin of at least early_stop_margin.
+TEST(GradCheckTest, AResolvedDerivativeStopsAfterThreeStepsWithTheSameVerdict) {
+  const SolverOptions options = CheckOptions(Method::kNewtonCholesky);
+  const GradCheckResult early = Check(options);
+  GradCheckOptions all_steps;
+  all_steps.early_stop_margin = 0;
+  const GradCheckResult full = Check(options, all_steps);
+  ASSERT_EQ(early.verdict, CheckVerdict::kPass) << GradCheckTable(early);
+  ASSERT_EQ(full.verdict, CheckVerdict::kPass) << GradCheckTable(full);
+  EXPECT_GE(early.min_margin, GradCheckOptions().early_stop_margin);
+  long directions = 0;
+  for (const auto& e : early.inputs) directions += e.directions;
+  EXPECT_EQ(early.perturbed_rollouts, 2 * 3 * directions);
+  EXPECT_EQ(full.perturbed_rollouts, 2 * 6 * directions);
+  ASSERT_EQ(early.inputs.size(), full.inputs.size());
+  for (size_t i = 0; i < early.inputs.size(); ++i) {
+    EXPECT_EQ(early.inputs[i].input, full.inputs[i].input);
+    EXPECT_EQ(early.inputs[i].verdict, full.inputs[i].verdict) << early.inputs[i].input;
+  }
+}
+
 TEST(GradCheckTest, InvalidOptionsAreRefusedWithExactMessages) {
   GradCheckOptions o;
   o.directions = 0;
@@ -160,6 +182,10 @@ TEST(GradCheckTest, InvalidOptionsAreRefusedWithExactMessages) {
   o.reference_rel_tolerance = 1;
   EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }),
             "reference_rel_tolerance = 1 is invalid: must be in (0, 1)");
+  o = GradCheckOptions();
+  o.early_stop_margin = 0.5;
+  EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }),
+            "early_stop_margin = 0.5 is invalid: must be 0 or finite and >= 1");
   o = GradCheckOptions();
   o.decisive_margin = 0.5;
   EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }),
