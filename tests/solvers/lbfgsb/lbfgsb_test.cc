@@ -95,7 +95,9 @@ TEST(LbfgsbTest, BoundedQuadraticFindsItsKktPointAndItsActiveSet) {
   EXPECT_EQ(r.stop, LbfgsbStop::kProjectedGradient) << ToString(r.stop);
   EXPECT_LE((r.x - x_star).lpNorm<Eigen::Infinity>(), 1e-5);
   for (int i = 0; i < n; ++i) {
-    if (i % 4 < 2) EXPECT_EQ(r.x(i), x_star(i)) << "variable " << i << " must sit exactly on its bound";
+    if (i % 4 < 2) {
+      EXPECT_EQ(r.x(i), x_star(i)) << "variable " << i << " must sit exactly on its bound";
+    }
   }
   EXPECT_LE((r.gradient - g_star).lpNorm<Eigen::Infinity>(), 1e-5);
   // The truncated subspace step of the 1995 paper reaches the same point.
