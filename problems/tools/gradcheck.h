@@ -96,8 +96,9 @@ struct GradCheckOptions {
   int step_count = 6;          // steps e, each a tenth of the one before; >= 2
   // Stop taking smaller steps once the differences at the first three (or
   // all, if fewer) pass with at least this margin: the remaining steps
-  // could only lower the floor of a derivative already resolved. Halves
-  // the rollouts of a clean check. 0: always take all step_count steps.
+  // could only lower the floor of a derivative already resolved (its
+  // reported margin is then a lower bound). Halves the rollouts of a clean
+  // check. 0: always take all step_count steps.
   double early_stop_margin = 10;
   // Compare with a Newton-Cholesky rollout's gradient; unset: for pd,
   // pd-lbfgs and newton-pcg (never for semi-implicit, whose time
