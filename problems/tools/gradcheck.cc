@@ -29,6 +29,9 @@ VectorXd Direction(std::mt19937_64* rng, Eigen::Index n) {
   return d * (std::sqrt(double(n)) / d.norm());
 }
 
+// Steps taken before the early stop is considered (GradCheckOptions::early_stop_margin).
+constexpr int kEarlyStopSteps = 3;
+
 bool UsesReferenceByDefault(Method m) { return m == Method::kPd || m == Method::kPdLbfgs || m == Method::kNewtonPcg; }
 // Newton with a direct solve: its adjoint is exact for its own trajectory.
 bool IsDirectNewton(Method m) { return m == Method::kNewtonCholesky || m == Method::kNewtonLdlt; }
@@ -211,15 +214,16 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
         return std::numeric_limits<double>::quiet_NaN();
       }
     };
-    const int first_steps = check.early_stop_margin > 0 ? std::min(3, check.step_count) : check.step_count;
-    for (int k = 0; k < first_steps; ++k, e /= 10)
-      differences.push_back({e, central(e), rounding / e, solve_bound / e});
-    DerivativeJudgement j = JudgeDerivative(analytic, differences, check.tolerance);
-    if (first_steps < check.step_count && !(j.verdict == CheckVerdict::kPass && j.margin >= check.early_stop_margin)) {
-      for (int k = first_steps; k < check.step_count; ++k, e /= 10)
+    // Takes the next steps, each a tenth of the one before, up to `count` in all.
+    auto take_steps = [&](int count) {
+      for (int k = static_cast<int>(differences.size()); k < count; ++k, e /= 10)
         differences.push_back({e, central(e), rounding / e, solve_bound / e});
-      j = JudgeDerivative(analytic, differences, check.tolerance);
-    }
+      return JudgeDerivative(analytic, differences, check.tolerance);
+    };
+    const bool may_stop_early = check.early_stop_margin > 0 && kEarlyStopSteps < check.step_count;
+    DerivativeJudgement j = take_steps(may_stop_early ? kEarlyStopSteps : check.step_count);
+    if (may_stop_early && !(j.verdict == CheckVerdict::kPass && j.margin >= check.early_stop_margin))
+      j = take_steps(check.step_count);
     if (j.verdict == CheckVerdict::kUnresolved && check.widen_steps) {
       // Larger steps, where the perturbed input may leave the scene's valid
       // range or the solver's reach: such a difference counts as non-finite.
