@@ -4,13 +4,14 @@
 # kind error / floor / basis), e.g. into docs/results/.
 #
 #   scripts/gradcheck_table.sh [-p "problem ..."] [-m "method ..."] [-s STEPS] [-t SECONDS]
-#                              [-o PREFIX] [-b DIFFPD]
+#                              [-c CONCURRENT] [-o PREFIX] [-b DIFFPD]
 #
 # Defaults: every problem `diffpd list` names, the methods newton-cholesky,
 # newton-ldlt, newton-pcg, pd, pd-lbfgs and semi-implicit, 3 steps, at most
 # 600 s per run (a run stopped by it is listed as "timeout"), PREFIX
 # out/gradcheck_table (writes PREFIX.json and PREFIX.md), one thread per run
-# at the solve tolerance the tool recommends. Needs python3.
+# at the solve tolerance the tool recommends, CONCURRENT (default 1)
+# perturbed rollouts at once (`--concurrent-rollouts`). Needs python3.
 set -euo pipefail
 
 diffpd=build/bin/diffpd
@@ -19,12 +20,14 @@ methods="newton-cholesky newton-ldlt newton-pcg pd pd-lbfgs semi-implicit"
 steps=3
 limit=600
 prefix=out/gradcheck_table
+concurrent=1
 while [[ $# -gt 0 ]]; do
   case "$1" in
     -p) problems="$2"; shift 2 ;;
     -m) methods="$2"; shift 2 ;;
     -s) steps="$2"; shift 2 ;;
     -t) limit="$2"; shift 2 ;;
+    -c) concurrent="$2"; shift 2 ;;
     -o) prefix="$2"; shift 2 ;;
     -b) diffpd="$2"; shift 2 ;;
     *) echo "gradcheck_table.sh: unknown argument '$1'" >&2; exit 2 ;;
@@ -39,7 +42,8 @@ for problem in $problems; do
   for method in $methods; do
     start=$(date +%s.%N)
     status=0
-    timeout "$limit" "$diffpd" gradcheck "$problem" --method "$method" --steps "$steps" --threads 1 --json \
+    timeout "$limit" "$diffpd" gradcheck "$problem" --method "$method" --steps "$steps" --threads 1 \
+      --concurrent-rollouts "$concurrent" --json \
       >"$work/$problem.$method.json" 2>"$work/$problem.$method.log" || status=$?
     end=$(date +%s.%N)
     echo "$problem $method $status $(awk "BEGIN { print $end - $start }")" >>"$work/runs.txt"
@@ -66,30 +70,5 @@ for line in open(work + "/runs.txt"):
     rows.append(row)
 with open(prefix + ".json", "w") as h:
     json.dump({"steps": int(steps), "runs": rows}, h, indent=1)
-
-def cell(e):
-    if e["verdict"] == "pass" and e.get("basis") == "tangent":
-        return f"tangent {e['tangent_error']:.1e} (floor {e['floor']:.1e})"
-    return f"{e['verdict']} {e['error']:.1e} / {e['floor']:.1e}"
-kinds = []
-for r in rows:
-    for k in r.get("result", {}).get("inputs", {}):
-        if k not in kinds:
-            kinds.append(k)
-lines = [f"| problem | method | verdict | smallest margin | {' | '.join(kinds)} | s |",
-         "|" + "---|" * (len(kinds) + 5)]
-for r in rows:
-    if r["outcome"] != "checked":
-        msg = r["outcome"] + ("" if r["outcome"] == "timeout" else ": " + " ".join(r.get("message", [])))
-        lines.append(f"| {r['problem']} | {r['method']} | {msg} | | " + " | " * len(kinds) + f"{r['seconds']:.0f} |")
-        continue
-    res = r["result"]
-    inputs = res["inputs"]
-    margin = res["min_margin"]
-    cells = [cell(inputs[k]) if k in inputs else "" for k in kinds]
-    lines.append(f"| {r['problem']} | {r['method']} | {res['verdict']} | "
-                 f"{'inf' if margin is None else format(margin, '.3g')} | {' | '.join(cells)} | {r['seconds']:.0f} |")
-with open(prefix + ".md", "w") as h:
-    h.write("\n".join(lines) + "\n")
-print("\n".join(lines))
 EOF
+python3 "$(dirname "$0")/gradcheck_table_report.py" "$prefix.json" | tee "$prefix.md"

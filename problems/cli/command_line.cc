@@ -117,6 +117,10 @@ int RunCommandLine(const std::vector<std::string>& argv) {
                    "stop at three steps per direction where they pass with this margin (0: always six)")
       ->check(ZeroOrAtLeast("--early-stop", 1))
       ->capture_default_str();
+  grad->add_option("--concurrent-rollouts", grad_check.concurrent_rollouts,
+                   "perturbed rollouts simulated at once, each on one thread (the result is the same)")
+      ->check(IntegerIn("--concurrent-rollouts", 1, MaxSolverThreads()))
+      ->capture_default_str();
   bool grad_reference = false, grad_no_reference = false;
   grad->add_flag("--reference", grad_reference,
                  "also compare with a tightly converged Newton-Cholesky rollout's gradient (default for pd, pd-lbfgs, "
@@ -135,7 +139,9 @@ differences do not pass with a margin of 3, the forward-mode tangent of the
 same states (the tangent column) decides; the basis column says which did.
 For the iterative methods the gradient is also compared with a
 Newton-Cholesky rollout's at rel_tolerance 1e-12 (the reference column).
-Exit code 4 when an input fails.)");
+The solves run at --rtol (default 1e-11; pd 1e-10 with up to 5000
+iterations per step), the perturbed rollouts one at a time unless
+--concurrent-rollouts says more. Exit code 4 when an input fails.)");
   const auto bench = AddBenchCommand(&app);
   const auto tradeoff = AddTradeoffCommand(&app);
   const auto stress = AddStressCommand(&app);

@@ -73,7 +73,8 @@ struct CommandArgs {
 int ListCommand(bool json);
 int RunCommand(const CommandArgs& args);
 // `diffpd gradcheck`: the check's own options in `check`; --rtol defaults to
-// RecommendedGradCheckRelTolerance(method). Exit code 4 when an input fails.
+// RecommendedGradCheckRelTolerance(method), the iteration limit is
+// RecommendedGradCheckMaxIterations(method). Exit code 4 when an input fails.
 int GradcheckCommand(const CommandArgs& args, const GradCheckOptions& check);
 
 // A subcommand that declares its own options: `app` is the CLI11 subcommand

@@ -18,6 +18,7 @@ int GradcheckCommand(const CommandArgs& args, const GradCheckOptions& check) {
   SolverOptions options =
       OptionsFromArgs(args, problem->default_time_step(), RecommendedGradCheckRelTolerance(args.method));
   options.abs_tolerance = 1e-12;
+  options.max_iterations = RecommendedGradCheckMaxIterations(options.method);
   options.backward_rel_tolerance = 1e-12;
   const Scene scene = problem->MakeScene();
   Simulator sim(scene, options);

@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <functional>
 #include <limits>
 #include <memory>
 #include <random>
+
+#include <omp.h>
 
 #include "cli/invalid_option.h"
 #include "diffpd/error.h"
@@ -42,6 +45,10 @@ std::string Format(double v) {
   return buffer;
 }
 
+// Thrown by a perturbed rollout that lies on another piece of a frictional
+// contact trajectory (its active set differs from the checked rollout's).
+struct OtherPiece {};
+
 // The losses of a check: the loss vectors, the baseline inputs and the
 // gradient of one method's rollout.
 struct Evaluation {
@@ -64,6 +71,8 @@ void GradCheckOptions::Validate() const {
     fail("decisive_margin", decisive_margin, "finite and >= 1");
   if (!(reference_rel_tolerance > 0 && reference_rel_tolerance < 1))
     fail("reference_rel_tolerance", reference_rel_tolerance, "in (0, 1)");
+  if (concurrent_rollouts < 1 || concurrent_rollouts > MaxSolverThreads())
+    fail("concurrent_rollouts", concurrent_rollouts, "in [1, " + std::to_string(MaxSolverThreads()) + "]");
 }
 
 int GradCheckResult::Count(CheckVerdict v) const {
@@ -77,6 +86,10 @@ double RecommendedGradCheckRelTolerance(Method method) {
   // these (measured on every problem, docs/benchmarks.md); PD converges
   // linearly, so a looser tolerance saves most of its iterations.
   return method == Method::kPd ? 1e-10 : 1e-11;
+}
+
+int RecommendedGradCheckMaxIterations(Method method) {
+  return method == Method::kPd ? 5000 : SolverOptions().max_iterations;
 }
 
 GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& options, const State& initial, int steps,
@@ -182,11 +195,65 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   Eigen::Map<const Eigen::Matrix3Xd> x0(initial.x.data(), 3, n / 3);
   const double size = (x0.rowwise().maxCoeff() - x0.rowwise().minCoeff()).norm();  // m
 
+  // The simulators of the perturbed rollouts, one per rollout at once: the
+  // checked rollout's own when they run one at a time, otherwise one each,
+  // on one thread. The loss of a rollout throws OtherPiece where it leaves
+  // the checked rollout's piece.
+  SolverOptions worker_options = options;
+  worker_options.num_threads = 1;
+  std::vector<std::unique_ptr<Simulator>> own_workers;
+  std::vector<Simulator*> workers = {&sim};
+  if (check.concurrent_rollouts > 1) {
+    workers.clear();
+    for (int w = 0; w < check.concurrent_rollouts; ++w) {
+      own_workers.push_back(std::make_unique<Simulator>(scene, worker_options));
+      workers.push_back(own_workers.back().get());
+    }
+  }
+  const SolverOptions& perturbed_options = check.concurrent_rollouts > 1 ? worker_options : options;
+  auto rollout_loss = [&](Simulator& s, const State& init, const std::vector<StepInput>& in) {
+    const Rollout r = s.Simulate(init, in);
+    if (other_piece(r) >= 0) throw OtherPiece();
+    return loss_of(r.states.back());
+  };
+  // perturbed(simulator, e) at every e of `at`, check.concurrent_rollouts at
+  // a time, each on its worker's simulator. A rollout on another piece gives
+  // NaN and counts in set_changes; so does one whose solves fail
+  // (SolverError), counted unless tolerate_all; with tolerate_all every other
+  // exception gives NaN too, without it the first (in the order of `at`) is
+  // rethrown.
+  auto losses = [&](const std::function<double(Simulator&, double)>& perturbed, const std::vector<double>& at,
+                    bool tolerate_all) {
+    const int m = static_cast<int>(at.size());
+    std::vector<double> values(m, std::numeric_limits<double>::quiet_NaN());
+    std::vector<char> counted(m, 0);
+    std::vector<std::exception_ptr> errors(m);
+    const int count = static_cast<int>(workers.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(count) if (count > 1)
+    for (int i = 0; i < m; ++i) {
+      try {
+        values[i] = perturbed(*workers[count > 1 ? omp_get_thread_num() : 0], at[i]);
+      } catch (const OtherPiece&) {
+        counted[i] = 1;
+      } catch (const SolverError&) {
+        counted[i] = !tolerate_all;
+      } catch (...) {
+        if (!tolerate_all) errors[i] = std::current_exception();
+      }
+    }
+    result.perturbed_rollouts += m;
+    for (int i = 0; i < m; ++i) {
+      if (errors[i]) std::rethrow_exception(errors[i]);
+      set_changes += counted[i];
+    }
+    return values;
+  };
+
   // One direction of one input kind: perturbed(e) is the loss with the input
   // moved by e (units of its scale along the direction); analytic and
   // reference are the derivatives along the same.
   auto record = [&](const std::string& name, long entries, double analytic, double reference_value,
-                    double tangent_value, const std::function<double(double)>& perturbed) {
+                    double tangent_value, const std::function<double(Simulator&, double)>& perturbed) {
     GradCheckInput* entry = nullptr;
     for (auto& e : result.inputs)
       if (e.input == name) entry = &e;
@@ -203,21 +270,20 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     const int changes_before = set_changes;
     std::vector<FiniteDifference> differences;
     double e = check.largest_step;
-    // A perturbed rollout whose solves fail (e.g. a contact step that would
-    // gain energy from a perturbed state) gives no difference: non-finite.
-    auto central = [&](double step) {
-      result.perturbed_rollouts += 2;
-      try {
-        return (perturbed(step) - perturbed(-step)) / (2 * step);
-      } catch (const SolverError&) {
-        ++set_changes;
-        return std::numeric_limits<double>::quiet_NaN();
-      }
-    };
-    // Takes the next steps, each a tenth of the one before, up to `count` in all.
+    // Takes the next steps, each a tenth of the one before, up to `count` in
+    // all. A perturbed rollout whose solves fail (e.g. a contact step that
+    // would gain energy from a perturbed state) gives no difference:
+    // non-finite.
     auto take_steps = [&](int count) {
-      for (int k = static_cast<int>(differences.size()); k < count; ++k, e /= 10)
-        differences.push_back({e, central(e), rounding / e, solve_bound / e});
+      std::vector<double> at;
+      double step = e;
+      for (int k = static_cast<int>(differences.size()); k < count; ++k, step /= 10) {
+        at.push_back(step);
+        at.push_back(-step);
+      }
+      const std::vector<double> loss = losses(perturbed, at, /*tolerate_all=*/false);
+      for (size_t i = 0; i < at.size(); i += 2, e /= 10)
+        differences.push_back({e, (loss[i] - loss[i + 1]) / (2 * e), rounding / e, solve_bound / e});
       return JudgeDerivative(analytic, differences, check.tolerance);
     };
     const bool may_stop_early = check.early_stop_margin > 0 && kEarlyStopSteps < check.step_count;
@@ -227,17 +293,11 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     if (j.verdict == CheckVerdict::kUnresolved && check.widen_steps) {
       // Larger steps, where the perturbed input may leave the scene's valid
       // range or the solver's reach: such a difference counts as non-finite.
+      const double w30 = 30.0 * check.largest_step, w3 = 3.0 * check.largest_step;
+      const std::vector<double> loss = losses(perturbed, {w30, -w30, w3, -w3}, /*tolerate_all=*/true);
       std::vector<FiniteDifference> wider;
-      for (double factor : {30.0, 3.0}) {
-        const double w = factor * check.largest_step;
-        double value = std::numeric_limits<double>::quiet_NaN();
-        result.perturbed_rollouts += 2;
-        try {
-          value = (perturbed(w) - perturbed(-w)) / (2 * w);
-        } catch (const std::exception&) {
-        }
-        wider.push_back({w, value, rounding / w, solve_bound / w});
-      }
+      wider.push_back({w30, (loss[0] - loss[1]) / (2 * w30), rounding / w30, solve_bound / w30});
+      wider.push_back({w3, (loss[2] - loss[3]) / (2 * w3), rounding / w3, solve_bound / w3});
       wider.insert(wider.end(), differences.begin(), differences.end());
       const DerivativeJudgement widened = JudgeDerivative(analytic, wider, check.tolerance);
       if (widened.verdict == CheckVerdict::kPass || widened.floor < j.floor) j = widened;
@@ -318,33 +378,25 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   auto reference_dot = [&](const std::function<double(const RolloutGradient&)>& along) {
     return result.reference ? along(reference) : 0.0;
   };
-  auto rollout_loss = [&](Simulator& s, const State& init, const std::vector<StepInput>& in) {
-    const Rollout r = s.Simulate(init, in);
-    if (other_piece(r) >= 0) {
-      ++set_changes;
-      return std::numeric_limits<double>::quiet_NaN();
-    }
-    return loss_of(r.states.back());
-  };
 
   for (int k = 0; k < check.directions; ++k) {
     const VectorXd dx = size * Direction(&rng, n);
     auto along_x = [&](const RolloutGradient& g) { return g.x0.dot(dx); };
     InputDirection along_x0;
     along_x0.x0 = dx;
-    record("x0", n, along_x(grad), reference_dot(along_x), tangent_of(along_x0), [&](double e) {
+    record("x0", n, along_x(grad), reference_dot(along_x), tangent_of(along_x0), [&](Simulator& worker, double e) {
       State s = initial;
       s.x += e * dx;
-      return rollout_loss(sim, s, inputs);
+      return rollout_loss(worker, s, inputs);
     });
     const VectorXd dv = (size / h) * Direction(&rng, n);
     auto along_v = [&](const RolloutGradient& g) { return g.v0.dot(dv); };
     InputDirection along_v0;
     along_v0.v0 = dv;
-    record("v0", n, along_v(grad), reference_dot(along_v), tangent_of(along_v0), [&](double e) {
+    record("v0", n, along_v(grad), reference_dot(along_v), tangent_of(along_v0), [&](Simulator& worker, double e) {
       State s = initial;
       s.v += e * dv;
-      return rollout_loss(sim, s, inputs);
+      return rollout_loss(worker, s, inputs);
     });
     // A force that moves a node by about `size` in one step: m size / h^2.
     std::vector<VectorXd> df(steps);
@@ -358,10 +410,10 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     InputDirection along_forces;
     along_forces.external_force = df;
     record("external_force", long(n) * steps, along_f(grad), reference_dot(along_f), tangent_of(along_forces),
-           [&](double e) {
+           [&](Simulator& worker, double e) {
              std::vector<StepInput> in = inputs;
              for (int i = 0; i < steps; ++i) in[i].external_force += e * df[i];
-             return rollout_loss(sim, initial, in);
+             return rollout_loss(worker, initial, in);
            });
     if (num_muscles > 0) {
       std::vector<VectorXd> da(steps);
@@ -374,10 +426,10 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
       InputDirection along_activations;
       along_activations.activation = da;
       record("activation", long(num_muscles) * steps, along_a(grad), reference_dot(along_a),
-             tangent_of(along_activations), [&](double e) {
+             tangent_of(along_activations), [&](Simulator& worker, double e) {
                std::vector<StepInput> in = inputs;
                for (int i = 0; i < steps; ++i) in[i].activation += e * da[i];
-               return rollout_loss(sim, initial, in);
+               return rollout_loss(worker, initial, in);
              });
     }
   }
@@ -389,10 +441,10 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
                           const std::function<double(const RolloutGradient&)>& derivative,
                           const std::function<void(Scene*, double)>& perturb, const InputDirection& unit) {
     record(name, 1, scale * derivative(grad), scale * reference_dot(derivative), scale * tangent_of(unit),
-           [&](double e) {
+           [&](Simulator&, double e) {
              Scene p = scene;
              perturb(&p, e * scale);
-             Simulator s(p, options);
+             Simulator s(p, perturbed_options);
              return rollout_loss(s, initial, inputs);
            });
   };
@@ -457,18 +509,18 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
       [&](const std::string& name, double scale, const std::function<double(const RolloutGradient&)>& derivative,
           const std::function<void(MaterialParameters*, double)>& perturb, const InputDirection& unit) {
         record(name, 1, scale * derivative(grad), scale * reference_dot(derivative), scale * tangent_of(unit),
-               [&](double e) {
+               [&](Simulator& worker, double e) {
                  MaterialParameters m = material;
                  perturb(&m, e * scale);
-                 sim.SetMaterial(m);
+                 worker.SetMaterial(m);
                  double l = 0;
                  try {
-                   l = rollout_loss(sim, initial, inputs);
+                   l = rollout_loss(worker, initial, inputs);
                  } catch (...) {
-                   sim.SetMaterial(material);
+                   worker.SetMaterial(material);
                    throw;
                  }
-                 sim.SetMaterial(material);
+                 worker.SetMaterial(material);
                  return l;
                });
       };

@@ -116,6 +116,16 @@ struct GradCheckOptions {
   // Differences that pass with at least this margin decide alone; below it,
   // or unresolved, the tangent decides where it gives the larger margin.
   double decisive_margin = 3;
+  // Perturbed rollouts simulated at once, in [1, MaxSolverThreads()]. 1:
+  // one after the other on the checked rollout's simulator, with the
+  // options' num_threads. Above 1: each on a simulator of its own (one per
+  // rollout at once, so memory grows by as many simulators) on one thread;
+  // the same rollouts and, up to rounding, the same differences, but which
+  // thread runs which rollout changes that rounding (and each simulator's
+  // SVD warm starts carry over from the rollout it ran before), so errors,
+  // floors and margins at the differences' noise level differ from run to
+  // run.
+  int concurrent_rollouts = 1;
 
   // Throws InvalidInputError naming the field, its value and the valid range.
   void Validate() const;
@@ -167,6 +177,12 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
 // The solve tolerance `diffpd gradcheck` recommends for a method: tight enough
 // that the differences resolve the gradient to well within 1e-4.
 double RecommendedGradCheckRelTolerance(Method method);
+// The iteration limit per step `diffpd gradcheck` gives a method's solves: 5000
+// for pd, whose local-global iteration converges linearly and needs 1400 to
+// 2400 iterations per step to reach 1e-10 on the contact and muscle problems
+// (the library's default of 1000 stops it short), 1000 (the default) for the
+// others.
+int RecommendedGradCheckMaxIterations(Method method);
 
 // Reports made from a result: a table (one line per input and a summary
 // line) and one JSON object with the same fields.

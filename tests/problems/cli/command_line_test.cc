@@ -101,6 +101,10 @@ TEST(CommandLineTest, RefusesOutOfRangeValuesOfTheSimulatingCommands) {
       {{"gradcheck", "cantilever", "--early-stop", "nan"},
        2,
        Invalid("--early-stop = nan is invalid: must be 0 or finite and >= 1")},
+      {{"gradcheck", "cantilever", "--concurrent-rollouts", "0"},
+       2,
+       Invalid("--concurrent-rollouts = 0 is invalid: must be an integer in [1, " + std::to_string(MaxSolverThreads()) +
+               "]")},
       {{"run", "calibrate-plant", "--max-iterations", "-5"},
        2,
        Invalid("--max-iterations = -5 is invalid: must be an integer >= 1")},

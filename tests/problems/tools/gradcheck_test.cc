@@ -3,8 +3,9 @@
 // at least 10 (pd-lbfgs also against the Newton-Cholesky reference); an
 // inaccurate adjoint fails, and says against what; where the differences
 // cannot resolve a derivative with margin (h = 1e-5 s) the forward-mode
-// tangent decides it; the reports carry the
-// result's numbers; bad options are refused with exact messages.
+// tangent decides it; perturbed rollouts run three at once give the same
+// verdicts; the reports carry the result's numbers; bad options are refused
+// with exact messages.
 #include "tools/gradcheck.h"
 
 #include <gtest/gtest.h>
@@ -167,6 +168,41 @@ TEST(GradCheckTest, AResolvedDerivativeStopsAfterThreeStepsWithTheSameVerdict) {
   }
 }
 
+// Running the perturbed rollouts three at once gives the same check: the
+// same rollouts and verdicts, every input resolved with a margin of at least
+// 10 as when they run one at a time (which thread runs which rollout changes
+// only their rounding, so margins far above the tolerance are not compared
+// exactly), with the plain steps and with the widened ones (h = 1e-5 s).
+TEST(GradCheckTest, ConcurrentRolloutsGiveTheSameVerdicts) {
+  for (const double h : {1e-2, 1e-5}) {
+    SCOPED_TRACE("h = " + std::to_string(h));
+    SolverOptions options = CheckOptions(Method::kPdLbfgs);
+    options.time_step = h;
+    options.num_threads = 1;
+    GradCheckOptions one;
+    one.directions = 1;
+    GradCheckOptions three = one;
+    three.concurrent_rollouts = 3;
+    const GradCheckResult a = Check(options, one);
+    const GradCheckResult b = Check(options, three);
+    ASSERT_EQ(a.verdict, CheckVerdict::kPass) << GradCheckTable(a);
+    EXPECT_EQ(b.verdict, CheckVerdict::kPass) << GradCheckTable(b);
+    EXPECT_EQ(a.perturbed_rollouts, b.perturbed_rollouts);
+    EXPECT_GE(a.min_margin, 10.0) << GradCheckTable(a);
+    EXPECT_GE(b.min_margin, 10.0) << GradCheckTable(b);
+    ASSERT_EQ(a.inputs.size(), b.inputs.size());
+    bool widened = false;  // some input decided at a step above the largest of the six
+    for (size_t i = 0; i < a.inputs.size(); ++i) {
+      EXPECT_EQ(a.inputs[i].input, b.inputs[i].input);
+      EXPECT_EQ(a.inputs[i].verdict, b.inputs[i].verdict) << a.inputs[i].input;
+      widened = widened || a.inputs[i].step > one.largest_step;
+    }
+    if (h == 1e-5) {
+      EXPECT_TRUE(widened) << GradCheckTable(a);
+    }
+  }
+}
+
 TEST(GradCheckTest, InvalidOptionsAreRefusedWithExactMessages) {
   GradCheckOptions o;
   o.directions = 0;
@@ -190,6 +226,10 @@ TEST(GradCheckTest, InvalidOptionsAreRefusedWithExactMessages) {
   o.decisive_margin = 0.5;
   EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }),
             "decisive_margin = 0.5 is invalid: must be finite and >= 1");
+  o = GradCheckOptions();
+  o.concurrent_rollouts = 0;
+  EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }),
+            "concurrent_rollouts = 0 is invalid: must be in [1, " + std::to_string(MaxSolverThreads()) + "]");
 }
 
 }  // namespace

@@ -1,0 +1,61 @@
+#!/usr/bin/env python3
+"""One markdown table from the JSON of `scripts/gradcheck_table.sh` runs.
+
+    scripts/gradcheck_table_report.py RUNS.json [RUNS.json ...] > TABLE.md
+
+A row per problem and method in the order given: the verdict, the smallest
+margin and per input kind "verdict error / floor" (or "tangent ERROR (floor
+FLOOR)" where the forward-mode tangent decided), the run's seconds; runs
+stopped by their time limit say "timeout", runs that ended with an error give
+its last line. An error or floor the differences could not measure (every
+perturbed rollout left the contact piece) reads "inf".
+"""
+import json
+import sys
+
+
+def number(x):
+    return "inf" if x is None else f"{x:.1e}"
+
+
+def cell(e):
+    if e["verdict"] == "pass" and e.get("basis") == "tangent":
+        return f"tangent {number(e['tangent_error'])} (floor {number(e['floor'])})"
+    return f"{e['verdict']} {number(e['error'])} / {number(e['floor'])}"
+
+
+def table(rows):
+    kinds = []
+    for r in rows:
+        for k in r.get("result", {}).get("inputs", {}):
+            if k not in kinds:
+                kinds.append(k)
+    lines = [f"| problem | method | verdict | smallest margin | {' | '.join(kinds)} | s |",
+             "|" + "---|" * (len(kinds) + 5)]
+    for r in rows:
+        if r["outcome"] != "checked":
+            what = r["outcome"] + ("" if r["outcome"] == "timeout" else ": " + " ".join(r.get("message", [])))
+            lines.append(f"| {r['problem']} | {r['method']} | {what} | | " + " | " * len(kinds) +
+                         f"{r['seconds']:.0f} |")
+            continue
+        res = r["result"]
+        margin = res["min_margin"]
+        cells = [cell(res["inputs"][k]) if k in res["inputs"] else "" for k in kinds]
+        lines.append(f"| {r['problem']} | {r['method']} | {res['verdict']} | "
+                     f"{'inf' if margin is None else format(margin, '.3g')} | {' | '.join(cells)} | "
+                     f"{r['seconds']:.0f} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(paths):
+    rows = []
+    for path in paths:
+        with open(path) as f:
+            rows += json.load(f)["runs"]
+    sys.stdout.write(table(rows))
+
+
+if __name__ == "__main__":
+    if len(sys.argv) < 2:
+        sys.exit("usage: gradcheck_table_report.py RUNS.json [RUNS.json ...]")
+    main(sys.argv[1:])
