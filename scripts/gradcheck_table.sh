@@ -4,14 +4,16 @@
 # kind error / floor / basis), e.g. into docs/results/.
 #
 #   scripts/gradcheck_table.sh [-p "problem ..."] [-m "method ..."] [-s STEPS] [-t SECONDS]
-#                              [-c CONCURRENT] [-o PREFIX] [-b DIFFPD]
+#                              [-c CONCURRENT] [-a "extra gradcheck options"] [-o PREFIX] [-b DIFFPD]
 #
 # Defaults: every problem `diffpd list` names, the methods newton-cholesky,
 # newton-ldlt, newton-pcg, pd, pd-lbfgs and semi-implicit, 3 steps, at most
 # 600 s per run (a run stopped by it is listed as "timeout"), PREFIX
 # out/gradcheck_table (writes PREFIX.json and PREFIX.md), one thread per run
 # at the solve tolerance the tool recommends, CONCURRENT (default 1)
-# perturbed rollouts at once (`--concurrent-rollouts`). Needs python3.
+# perturbed rollouts at once (`--concurrent-rollouts`); -a adds options to
+# every run (e.g. "--dt 1e-4" for semi-implicit, which diverges at most
+# problems' own time step). Needs python3.
 set -euo pipefail
 
 diffpd=build/bin/diffpd
@@ -21,6 +23,7 @@ steps=3
 limit=600
 prefix=out/gradcheck_table
 concurrent=1
+extra=""
 while [[ $# -gt 0 ]]; do
   case "$1" in
     -p) problems="$2"; shift 2 ;;
@@ -28,6 +31,7 @@ while [[ $# -gt 0 ]]; do
     -s) steps="$2"; shift 2 ;;
     -t) limit="$2"; shift 2 ;;
     -c) concurrent="$2"; shift 2 ;;
+    -a) extra="$2"; shift 2 ;;
     -o) prefix="$2"; shift 2 ;;
     -b) diffpd="$2"; shift 2 ;;
     *) echo "gradcheck_table.sh: unknown argument '$1'" >&2; exit 2 ;;
@@ -43,7 +47,7 @@ for problem in $problems; do
     start=$(date +%s.%N)
     status=0
     timeout "$limit" "$diffpd" gradcheck "$problem" --method "$method" --steps "$steps" --threads 1 \
-      --concurrent-rollouts "$concurrent" --json \
+      --concurrent-rollouts "$concurrent" $extra --json \
       >"$work/$problem.$method.json" 2>"$work/$problem.$method.log" || status=$?
     end=$(date +%s.%N)
     echo "$problem $method $status $(awk "BEGIN { print $end - $start }")" >>"$work/runs.txt"

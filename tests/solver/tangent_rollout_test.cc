@@ -10,6 +10,7 @@
 
 #include "diffpd/box_mesh.h"
 #include "diffpd/error.h"
+#include "diffpd/quad_hydrodynamics.h"
 #include "diffpd/state_forces.h"
 #include "diffpd/simulator.h"
 #include "test_scenes.h"
@@ -540,6 +541,97 @@ TEST(TangentRolloutTest, StateForceTangentsMatchCentralDifferencesAndReverseMode
   }
 }
 
+// A hexahedral beam in a current of water on one-sided quads: the flow
+// (0.5 m/s) outruns the beam's own motion, so no face changes side within the
+// differences' steps (the force jumps where one does).
+Scene QuadSwimmingBeamScene() {
+  Scene scene = testing::SmallBeamScene();
+  QuadHydrodynamics water;
+  water.quads = BoundaryQuads(scene.mesh);
+  water.flow_velocity = Vec3(0.3, -0.4, 0.2);
+  scene.quad_hydrodynamics = water;
+  return scene;
+}
+
+Rollout QuadPerturbed(const Scene& scene, const SolverOptions& options, const State& start, int steps,
+                      const InputDirection& d, double eps) {
+  Scene s = scene;
+  const QuadHydrodynamicsGradient& q = d.state_forces.quad_hydrodynamics;
+  s.quad_hydrodynamics->fluid_density += eps * q.fluid_density;
+  s.quad_hydrodynamics->flow_velocity += eps * q.flow_velocity;
+  s.quad_hydrodynamics->drag_curve += eps * q.drag_curve;
+  s.quad_hydrodynamics->thrust_curve += eps * q.thrust_curve;
+  s.material.density += eps * d.density;
+  Simulator sim(s, options);
+  State init = start;
+  if (d.x0.size()) init.x += eps * d.x0;
+  if (d.v0.size()) init.v += eps * d.v0;
+  return sim.Simulate(init, std::vector<StepInput>(steps));
+}
+
+// Forward mode through the quad hydrodynamics along its parameters and along
+// x0, v0 and the density, vs central differences of every state and vs
+// reverse mode (the tangents ignored these forces before).
+TEST(TangentRolloutTest, QuadHydrodynamicsTangentsMatchCentralDifferencesAndReverseMode) {
+  const Scene scene = QuadSwimmingBeamScene();
+  for (Method method : {Method::kNewtonCholesky, Method::kPdLbfgs, Method::kSemiImplicit}) {
+    SolverOptions options = TightOptions(method);
+    if (method == Method::kSemiImplicit) options.time_step = 1e-4;
+    Simulator sim(scene, options);
+    const int n = sim.num_dofs();
+    const State start = MovingStart(sim);
+    const int steps = method == Method::kSemiImplicit ? 20 : 4;
+    const Rollout rollout = sim.Simulate(start, std::vector<StepInput>(steps));
+    std::vector<InputDirection> dirs(6);
+    dirs[0].state_forces.quad_hydrodynamics.fluid_density = 1e3;
+    dirs[1].state_forces.quad_hydrodynamics.flow_velocity = Vec3(0.1, 0.05, -0.1);
+    dirs[2].state_forces.quad_hydrodynamics.drag_curve = Eigen::Vector4d(0.1, -0.2, 0.3, 0.5);
+    dirs[3].state_forces.quad_hydrodynamics.thrust_curve = Eigen::Vector4d(-0.3, 0.2, 0.4, 1.0);
+    std::mt19937_64 rng(7);
+    dirs[4].x0 = RandomVector(n, &rng, 1e-3);
+    dirs[5].v0 = RandomVector(n, &rng, 0.05);
+    InputDirection rho = InputDirection::Density();
+    rho.density = 1e3;
+    dirs.push_back(rho);
+    const TangentRollout t = sim.Tangents(rollout, dirs);
+    const double noise = method == Method::kSemiImplicit ? 1e-15 : options.rel_tolerance;
+    const double eps = testing::CentralDifferenceStep(noise, 1.0);
+    for (size_t p = 0; p < dirs.size(); ++p) {
+      const Rollout plus = QuadPerturbed(scene, options, start, steps, dirs[p], eps);
+      const Rollout minus = QuadPerturbed(scene, options, start, steps, dirs[p], -eps);
+      testing::DifferenceOptions check;
+      check.noise = noise;
+      check.floor = method == Method::kSemiImplicit ? 1e-14 * plus.states.back().x.norm() / eps : 0.0;
+      check.rtol = 1e-5;
+      for (int k = 1; k <= steps; ++k) check.derivative_scale = std::max(check.derivative_scale, t.dx[k].col(p).norm());
+      ASSERT_GT(check.derivative_scale, 0.0) << ToString(method) << " direction " << p;
+      for (int k = 1; k <= steps; ++k)
+        EXPECT_TRUE(testing::Passes(
+            testing::CompareCentralDifference(plus.states[k].x, minus.states[k].x, eps, t.dx[k].col(p), check)))
+            << ToString(method) << " direction " << p << " x_" << k;
+    }
+    LossGradient loss(steps);
+    for (int k = 0; k <= steps; ++k) {
+      loss.dx[k] = RandomVector(n, &rng, 1.0);
+      loss.dv[k] = RandomVector(n, &rng, 0.01);
+    }
+    const RolloutGradient g = sim.Backward(rollout, loss);
+    const QuadHydrodynamicsGradient& gq = g.state_forces.quad_hydrodynamics;
+    for (size_t p = 0; p < dirs.size(); ++p) {
+      double forward = 0;
+      for (int k = 0; k <= steps; ++k) forward += loss.dx[k].dot(t.dx[k].col(p)) + loss.dv[k].dot(t.dv[k].col(p));
+      const InputDirection& d = dirs[p];
+      const QuadHydrodynamicsGradient& q = d.state_forces.quad_hydrodynamics;
+      double reverse = g.density * d.density + gq.fluid_density * q.fluid_density +
+                       gq.flow_velocity.dot(q.flow_velocity) + gq.drag_curve.dot(q.drag_curve) +
+                       gq.thrust_curve.dot(q.thrust_curve);
+      if (d.x0.size()) reverse += g.x0.dot(d.x0);
+      if (d.v0.size()) reverse += g.v0.dot(d.v0);
+      EXPECT_NEAR(forward, reverse, 1e-8 * std::abs(reverse)) << ToString(method) << " direction " << p;
+    }
+  }
+}
+
 TEST(TangentRolloutTest, RejectsStateForceDirectionsTheSceneDoesNotDeclare) {
   Scene scene = testing::SmallBeamScene();
   scene.linear_damping = 0.5;
@@ -556,6 +648,11 @@ TEST(TangentRolloutTest, RejectsStateForceDirectionsTheSceneDoesNotDeclare) {
   ASSERT_THROW_MESSAGE(swim.Tangents(swim_rollout, {friction}), InvalidInputError,
                        "Tangents: direction 0 has penalty_friction for 2 contacts, expected 0 or 1 (one per penalty "
                        "contact)");
+  InputDirection quad;
+  quad.state_forces.quad_hydrodynamics.drag_curve(2) = 1;
+  ASSERT_THROW_MESSAGE(swim.Tangents(swim_rollout, {quad}), InvalidInputError,
+                       "Tangents: direction 0 has a quad_hydrodynamics component, but the scene declares no quad "
+                       "hydrodynamics");
   InputDirection nan;
   nan.state_forces.linear_damping = std::nan("");
   ASSERT_THROW_MESSAGE(sim.Tangents(rollout, {nan}), InvalidInputError,

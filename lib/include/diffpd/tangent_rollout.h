@@ -35,8 +35,9 @@ struct InputDirection {
   // The declared state forces' parameters (state_forces.h), laid out as
   // their gradient: linear damping (1/s), fluid density (kg/m^3), drag and
   // thrust coefficients, flow velocity (m/s), penalty friction per
-  // Scene::penalty_contacts entry (empty: zero). Components of terms the
-  // scene does not declare must be zero.
+  // Scene::penalty_contacts entry (empty: zero), the quad hydrodynamics'
+  // fluid density, flow velocity and curve control values. Components of
+  // terms the scene does not declare must be zero.
   StateForceGradient state_forces;
 
   // The unit direction of one base-material parameter.

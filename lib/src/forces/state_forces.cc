@@ -202,6 +202,47 @@ void StateForces::AddJvp(const VectorXd& x, const VectorXd& v, const VectorXd& m
       }
     }
   }
+  if (quad_hydro_) {
+    const Eigen::Matrix4Xi& quads = quad_hydro_->quads;
+    for (int q = 0; q < quads.cols(); ++q) {
+      const std::array<Vec3, 4> corners = QuadCorners(x, quads, q);
+      const Vec3 u = QuadRelativeVelocity(v, *quad_hydro_, q);
+      // The face force's Jacobians with respect to its corners (3 x 12), the
+      // relative velocity (3 x 3) and the parameters (fluid density, the
+      // drag and the thrust curve's control values: 3 x 9), row by row from
+      // the vector-Jacobian products with the unit vectors.
+      Eigen::Matrix<double, 3, 12> d_corners;
+      Mat3 d_u;
+      Eigen::Matrix<double, 3, 9> d_param;
+      for (int k = 0; k < 3; ++k) {
+        std::array<Vec3, 4> g_corners;
+        Vec3 g_u;
+        QuadHydrodynamicsGradient g;
+        internal::QuadHydrodynamicForceVjp(*quad_hydro_, corners, u, Vec3::Unit(k), &g_corners, &g_u, &g);
+        for (int c = 0; c < 4; ++c) d_corners.block<1, 3>(k, 3 * c) = g_corners[c].transpose();
+        d_u.row(k) = g_u.transpose();
+        d_param(k, 0) = g.fluid_density;
+        d_param.block<1, 4>(k, 1) = g.drag_curve.transpose();
+        d_param.block<1, 4>(k, 5) = g.thrust_curve.transpose();
+      }
+      if (d_corners.isZero(0) && d_u.isZero(0) && d_param.isZero(0)) continue;  // a face the water does not meet
+      for (int p = 0; p < dirs; ++p) {
+        Eigen::Matrix<double, 12, 1> dcorners;
+        Vec3 dmean = Vec3::Zero();
+        for (int c = 0; c < 4; ++c) {
+          dcorners.segment<3>(3 * c) = dx.col(p).segment<3>(3 * quads(c, q));
+          dmean += dv.col(p).segment<3>(3 * quads(c, q));
+        }
+        const QuadHydrodynamicsGradient& dq = dtheta[p].quad_hydrodynamics;
+        Eigen::Matrix<double, 9, 1> dparam;
+        dparam << dq.fluid_density, dq.drag_curve, dq.thrust_curve;
+        // u = flow - mean corner velocity.
+        const Vec3 du = dq.flow_velocity - dmean / 4.0;
+        const Vec3 share = (d_corners * dcorners + d_u * du + d_param * dparam) / 4.0;
+        for (int c = 0; c < 4; ++c) df->col(p).segment<3>(3 * quads(c, q)) += share;
+      }
+    }
+  }
   for (const FrictionNode& fn : friction_) {
     const double gap = fn.normal.dot(x.segment<3>(3 * fn.node)) - fn.offset;
     if (gap >= 0) continue;

@@ -21,8 +21,8 @@
 // the step's recorded active set is held fixed (as in Backward); a pinned node
 // moves with its pin, dx = dpin/dx_i dx_i + dpin/dv_i dv_i, and the free DoFs
 // solve H_ff dx_f = b_f - H_fp dx_p. Explicit state forces f(x_i, v_i; M,
-// theta) (damping, hydrodynamics, penalty friction) enter both methods'
-// force directions as df = df/dx dx_i + df/dv dv_i + df/dM dM + df/dtheta
+// theta) (damping, hydrodynamics on triangles or on one-sided quads, penalty
+// friction) enter both methods' force directions as df = df/dx dx_i + df/dv dv_i + df/dM dM + df/dtheta
 // dtheta (their Jacobian-vector products).
 #include <chrono>
 #include <functional>
@@ -171,7 +171,9 @@ void CheckStateForceDirections(const std::vector<InputDirection>& dirs, const Sc
     std::ostringstream msg;
     msg << "Tangents: direction " << p << " ";
     const double hydro[4] = {d.fluid_density, d.drag_tangential, d.drag_normal, d.thrust};
-    bool finite = std::isfinite(d.linear_damping) && d.flow_velocity.allFinite();
+    const QuadHydrodynamicsGradient& quad = d.quad_hydrodynamics;
+    bool finite = std::isfinite(d.linear_damping) && d.flow_velocity.allFinite() && std::isfinite(quad.fluid_density) &&
+                  quad.flow_velocity.allFinite() && quad.drag_curve.allFinite() && quad.thrust_curve.allFinite();
     for (const double c : hydro) finite = finite && std::isfinite(c);
     for (const double c : d.penalty_friction) finite = finite && std::isfinite(c);
     if (!finite) {
@@ -186,6 +188,12 @@ void CheckStateForceDirections(const std::vector<InputDirection>& dirs, const Sc
     for (const double c : hydro) any_hydro = any_hydro || c != 0;
     if (any_hydro && !scene.hydrodynamics) {
       msg << "has a hydrodynamics component, but the scene declares no hydrodynamics";
+      throw InvalidInputError(msg.str());
+    }
+    const bool any_quad = quad.fluid_density != 0 || !quad.flow_velocity.isZero(0) || !quad.drag_curve.isZero(0) ||
+                          !quad.thrust_curve.isZero(0);
+    if (any_quad && !scene.quad_hydrodynamics) {
+      msg << "has a quad_hydrodynamics component, but the scene declares no quad hydrodynamics";
       throw InvalidInputError(msg.str());
     }
     if (!d.penalty_friction.empty() && static_cast<int>(d.penalty_friction.size()) != contacts) {
