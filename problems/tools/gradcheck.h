@@ -61,7 +61,12 @@
 // where no step keeps the piece (a node resting exactly on the surface
 // leaves the set when lifted by any amount) the tangent, which holds the
 // sets fixed as the adjoint does, decides. A reference rollout on another
-// piece is not compared (reference_failure says so).
+// piece is not compared (reference_failure says so). The one-sided faces of
+// Scene::quad_hydrodynamics make the force jump where a face starts or stops
+// meeting the water; such jumps are mostly tiny (a face moving nearly along
+// its plane, slowly), so differences across them still count, but where a
+// perturbed rollout switched a face they cannot fail an input: the input is
+// unresolved (the reason says how many switched) and the tangent decides.
 //
 // Reference: for the iterative methods (pd, pd-lbfgs, newton-pcg) by
 // default, the same loss's gradient from a Newton-Cholesky rollout at
@@ -178,10 +183,9 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
 // that the differences resolve the gradient to well within 1e-4.
 double RecommendedGradCheckRelTolerance(Method method);
 // The iteration limit per step `diffpd gradcheck` gives a method's solves: 5000
-// for pd, whose local-global iteration converges linearly and needs 1400 to
-// 2400 iterations per step to reach 1e-10 on the contact and muscle problems
-// (the library's default of 1000 stops it short), 1000 (the default) for the
-// others.
+// for pd, whose local-global iteration converges linearly (the library's
+// default of 1000 stops it short of 1e-10 on the routing tendon, bunny,
+// quadruped and cow), 1000 (the default) for the others.
 int RecommendedGradCheckMaxIterations(Method method);
 
 // Reports made from a result: a table (one line per input and a summary
