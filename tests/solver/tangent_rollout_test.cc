@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <random>
 
 #include "diffpd/box_mesh.h"
@@ -463,45 +464,46 @@ std::vector<InputDirection> StateForceDirections(int n) {
   return dirs;
 }
 
-Rollout StateForcePerturbed(const Scene& scene, const SolverOptions& options, const State& start, int steps,
-                            const InputDirection& d, double eps) {
-  Scene s = scene;
-  s.material.density += eps * d.density;
-  *s.linear_damping += eps * d.state_forces.linear_damping;
-  s.hydrodynamics->fluid_density += eps * d.state_forces.fluid_density;
-  s.hydrodynamics->drag_tangential += eps * d.state_forces.drag_tangential;
-  s.hydrodynamics->drag_normal += eps * d.state_forces.drag_normal;
-  s.hydrodynamics->thrust += eps * d.state_forces.thrust;
-  s.hydrodynamics->flow_velocity += eps * d.state_forces.flow_velocity;
-  if (!d.state_forces.penalty_friction.empty())
-    s.penalty_contacts[0].friction += eps * d.state_forces.penalty_friction[0];
-  Simulator sim(s, options);
-  State init = start;
-  if (d.x0.size()) init.x += eps * d.x0;
-  if (d.v0.size()) init.v += eps * d.v0;
-  return sim.Simulate(init, std::vector<StepInput>(steps));
-}
+// Moves a scene's state-force parameters by eps along a direction's components.
+using ForcePerturbation = std::function<void(Scene*, const StateForceGradient&, double)>;
+// The state-force part of dL/dtheta . d.
+using ForceDot = std::function<double(const StateForceGradient& gradient, const StateForceGradient& direction)>;
 
-// Forward mode through damping, drag and thrust, and penalty friction, along
-// their parameters and along the states and density they depend on, vs
-// central differences of every state and vs reverse mode.
-TEST(TangentRolloutTest, StateForceTangentsMatchCentralDifferencesAndReverseMode) {
-  const Scene scene = SwimmingBeamScene();
+// For Newton-Cholesky, PD-LBFGS and semi-implicit Euler (at its own time step
+// if > 0): every state's tangent along every direction against central
+// differences of rollouts perturbed along it (x0, v0, density, and the
+// state-force parameters by `perturb`), and each direction's tangent against
+// reverse mode on a random linear loss of every state.
+void ExpectStateForceTangentsMatch(const Scene& scene,
+                                   const std::function<std::vector<InputDirection>(int)>& directions,
+                                   const ForcePerturbation& perturb, const ForceDot& dot, double semi_implicit_step) {
   for (Method method : {Method::kNewtonCholesky, Method::kPdLbfgs, Method::kSemiImplicit}) {
-    const SolverOptions options = TightOptions(method);
+    SCOPED_TRACE(ToString(method));
+    SolverOptions options = TightOptions(method);
+    if (method == Method::kSemiImplicit && semi_implicit_step > 0) options.time_step = semi_implicit_step;
     Simulator sim(scene, options);
     const int n = sim.num_dofs();
     const State start = MovingStart(sim);
     const int steps = method == Method::kSemiImplicit ? 20 : 4;
     const Rollout rollout = sim.Simulate(start, std::vector<StepInput>(steps));
-    const std::vector<InputDirection> dirs = StateForceDirections(n);
+    const std::vector<InputDirection> dirs = directions(n);
     const TangentRollout t = sim.Tangents(rollout, dirs);
+    auto perturbed = [&](const InputDirection& d, double eps) {
+      Scene s = scene;
+      s.material.density += eps * d.density;
+      perturb(&s, d.state_forces, eps);
+      Simulator other(s, options);
+      State init = start;
+      if (d.x0.size()) init.x += eps * d.x0;
+      if (d.v0.size()) init.v += eps * d.v0;
+      return other.Simulate(init, std::vector<StepInput>(steps));
+    };
     // Semi-implicit steps solve nothing: their noise is rounding.
     const double noise = method == Method::kSemiImplicit ? 1e-15 : options.rel_tolerance;
     const double eps = testing::CentralDifferenceStep(noise, 1.0);
     for (size_t p = 0; p < dirs.size(); ++p) {
-      const Rollout plus = StateForcePerturbed(scene, options, start, steps, dirs[p], eps);
-      const Rollout minus = StateForcePerturbed(scene, options, start, steps, dirs[p], -eps);
+      const Rollout plus = perturbed(dirs[p], eps);
+      const Rollout minus = perturbed(dirs[p], -eps);
       testing::DifferenceOptions check;
       check.noise = noise;
       // The implicit solves converge far below their tolerance (no floor);
@@ -510,13 +512,12 @@ TEST(TangentRolloutTest, StateForceTangentsMatchCentralDifferencesAndReverseMode
       check.floor = method == Method::kSemiImplicit ? 1e-14 * plus.states.back().x.norm() / eps : 0.0;
       check.rtol = 1e-5;  // the differences' truncation reaches 2e-6 of the tangent
       for (int k = 1; k <= steps; ++k) check.derivative_scale = std::max(check.derivative_scale, t.dx[k].col(p).norm());
-      ASSERT_GT(check.derivative_scale, 0.0) << ToString(method) << " direction " << p;
+      ASSERT_GT(check.derivative_scale, 0.0) << "direction " << p;
       for (int k = 1; k <= steps; ++k)
         EXPECT_TRUE(testing::Passes(
             testing::CompareCentralDifference(plus.states[k].x, minus.states[k].x, eps, t.dx[k].col(p), check)))
-            << ToString(method) << " direction " << p << " x_" << k;
+            << "direction " << p << " x_" << k;
     }
-    // Reverse mode on a random linear loss of every state.
     std::mt19937_64 rng(3);
     LossGradient loss(steps);
     for (int k = 0; k <= steps; ++k) {
@@ -528,22 +529,42 @@ TEST(TangentRolloutTest, StateForceTangentsMatchCentralDifferencesAndReverseMode
       double forward = 0;
       for (int k = 0; k <= steps; ++k) forward += loss.dx[k].dot(t.dx[k].col(p)) + loss.dv[k].dot(t.dv[k].col(p));
       const InputDirection& d = dirs[p];
-      const StateForceGradient& s = d.state_forces;
-      double reverse = g.density * d.density + g.state_forces.linear_damping * s.linear_damping +
-                       g.state_forces.fluid_density * s.fluid_density +
-                       g.state_forces.drag_tangential * s.drag_tangential + g.state_forces.drag_normal * s.drag_normal +
-                       g.state_forces.thrust * s.thrust + g.state_forces.flow_velocity.dot(s.flow_velocity);
-      if (!s.penalty_friction.empty()) reverse += g.state_forces.penalty_friction[0] * s.penalty_friction[0];
+      double reverse = g.density * d.density + dot(g.state_forces, d.state_forces);
       if (d.x0.size()) reverse += g.x0.dot(d.x0);
       if (d.v0.size()) reverse += g.v0.dot(d.v0);
-      EXPECT_NEAR(forward, reverse, 1e-8 * std::abs(reverse)) << ToString(method) << " direction " << p;
+      EXPECT_NEAR(forward, reverse, 1e-8 * std::abs(reverse)) << "direction " << p;
     }
   }
 }
 
+// Forward mode through damping, drag and thrust, and penalty friction, along
+// their parameters and along the states and density they depend on, vs
+// central differences of every state and vs reverse mode.
+TEST(TangentRolloutTest, StateForceTangentsMatchCentralDifferencesAndReverseMode) {
+  ExpectStateForceTangentsMatch(
+      SwimmingBeamScene(), StateForceDirections,
+      [](Scene* s, const StateForceGradient& d, double eps) {
+        *s->linear_damping += eps * d.linear_damping;
+        s->hydrodynamics->fluid_density += eps * d.fluid_density;
+        s->hydrodynamics->drag_tangential += eps * d.drag_tangential;
+        s->hydrodynamics->drag_normal += eps * d.drag_normal;
+        s->hydrodynamics->thrust += eps * d.thrust;
+        s->hydrodynamics->flow_velocity += eps * d.flow_velocity;
+        if (!d.penalty_friction.empty()) s->penalty_contacts[0].friction += eps * d.penalty_friction[0];
+      },
+      [](const StateForceGradient& g, const StateForceGradient& d) {
+        double dot = g.linear_damping * d.linear_damping + g.fluid_density * d.fluid_density +
+                     g.drag_tangential * d.drag_tangential + g.drag_normal * d.drag_normal + g.thrust * d.thrust +
+                     g.flow_velocity.dot(d.flow_velocity);
+        if (!d.penalty_friction.empty()) dot += g.penalty_friction[0] * d.penalty_friction[0];
+        return dot;
+      },
+      /*semi_implicit_step=*/0);
+}
+
 // A hexahedral beam in a current of water on one-sided quads: the flow
-// (0.5 m/s) outruns the beam's own motion, so no face changes side within the
-// differences' steps (the force jumps where one does).
+// (about 0.5 m/s) outruns the beam's own motion, so no face changes side
+// within the differences' steps (the force jumps where one does).
 Scene QuadSwimmingBeamScene() {
   Scene scene = testing::SmallBeamScene();
   QuadHydrodynamics water;
@@ -553,35 +574,11 @@ Scene QuadSwimmingBeamScene() {
   return scene;
 }
 
-Rollout QuadPerturbed(const Scene& scene, const SolverOptions& options, const State& start, int steps,
-                      const InputDirection& d, double eps) {
-  Scene s = scene;
-  const QuadHydrodynamicsGradient& q = d.state_forces.quad_hydrodynamics;
-  s.quad_hydrodynamics->fluid_density += eps * q.fluid_density;
-  s.quad_hydrodynamics->flow_velocity += eps * q.flow_velocity;
-  s.quad_hydrodynamics->drag_curve += eps * q.drag_curve;
-  s.quad_hydrodynamics->thrust_curve += eps * q.thrust_curve;
-  s.material.density += eps * d.density;
-  Simulator sim(s, options);
-  State init = start;
-  if (d.x0.size()) init.x += eps * d.x0;
-  if (d.v0.size()) init.v += eps * d.v0;
-  return sim.Simulate(init, std::vector<StepInput>(steps));
-}
-
 // Forward mode through the quad hydrodynamics along its parameters and along
 // x0, v0 and the density, vs central differences of every state and vs
-// reverse mode (the tangents ignored these forces before).
+// reverse mode (semi-implicit at h = 1e-4 s, where it is stable).
 TEST(TangentRolloutTest, QuadHydrodynamicsTangentsMatchCentralDifferencesAndReverseMode) {
-  const Scene scene = QuadSwimmingBeamScene();
-  for (Method method : {Method::kNewtonCholesky, Method::kPdLbfgs, Method::kSemiImplicit}) {
-    SolverOptions options = TightOptions(method);
-    if (method == Method::kSemiImplicit) options.time_step = 1e-4;
-    Simulator sim(scene, options);
-    const int n = sim.num_dofs();
-    const State start = MovingStart(sim);
-    const int steps = method == Method::kSemiImplicit ? 20 : 4;
-    const Rollout rollout = sim.Simulate(start, std::vector<StepInput>(steps));
+  auto directions = [](int n) {
     std::vector<InputDirection> dirs(6);
     dirs[0].state_forces.quad_hydrodynamics.fluid_density = 1e3;
     dirs[1].state_forces.quad_hydrodynamics.flow_velocity = Vec3(0.1, 0.05, -0.1);
@@ -593,43 +590,23 @@ TEST(TangentRolloutTest, QuadHydrodynamicsTangentsMatchCentralDifferencesAndReve
     InputDirection rho = InputDirection::Density();
     rho.density = 1e3;
     dirs.push_back(rho);
-    const TangentRollout t = sim.Tangents(rollout, dirs);
-    const double noise = method == Method::kSemiImplicit ? 1e-15 : options.rel_tolerance;
-    const double eps = testing::CentralDifferenceStep(noise, 1.0);
-    for (size_t p = 0; p < dirs.size(); ++p) {
-      const Rollout plus = QuadPerturbed(scene, options, start, steps, dirs[p], eps);
-      const Rollout minus = QuadPerturbed(scene, options, start, steps, dirs[p], -eps);
-      testing::DifferenceOptions check;
-      check.noise = noise;
-      check.floor = method == Method::kSemiImplicit ? 1e-14 * plus.states.back().x.norm() / eps : 0.0;
-      check.rtol = 1e-5;
-      for (int k = 1; k <= steps; ++k) check.derivative_scale = std::max(check.derivative_scale, t.dx[k].col(p).norm());
-      ASSERT_GT(check.derivative_scale, 0.0) << ToString(method) << " direction " << p;
-      for (int k = 1; k <= steps; ++k)
-        EXPECT_TRUE(testing::Passes(
-            testing::CompareCentralDifference(plus.states[k].x, minus.states[k].x, eps, t.dx[k].col(p), check)))
-            << ToString(method) << " direction " << p << " x_" << k;
-    }
-    LossGradient loss(steps);
-    for (int k = 0; k <= steps; ++k) {
-      loss.dx[k] = RandomVector(n, &rng, 1.0);
-      loss.dv[k] = RandomVector(n, &rng, 0.01);
-    }
-    const RolloutGradient g = sim.Backward(rollout, loss);
-    const QuadHydrodynamicsGradient& gq = g.state_forces.quad_hydrodynamics;
-    for (size_t p = 0; p < dirs.size(); ++p) {
-      double forward = 0;
-      for (int k = 0; k <= steps; ++k) forward += loss.dx[k].dot(t.dx[k].col(p)) + loss.dv[k].dot(t.dv[k].col(p));
-      const InputDirection& d = dirs[p];
-      const QuadHydrodynamicsGradient& q = d.state_forces.quad_hydrodynamics;
-      double reverse = g.density * d.density + gq.fluid_density * q.fluid_density +
-                       gq.flow_velocity.dot(q.flow_velocity) + gq.drag_curve.dot(q.drag_curve) +
-                       gq.thrust_curve.dot(q.thrust_curve);
-      if (d.x0.size()) reverse += g.x0.dot(d.x0);
-      if (d.v0.size()) reverse += g.v0.dot(d.v0);
-      EXPECT_NEAR(forward, reverse, 1e-8 * std::abs(reverse)) << ToString(method) << " direction " << p;
-    }
-  }
+    return dirs;
+  };
+  ExpectStateForceTangentsMatch(
+      QuadSwimmingBeamScene(), directions,
+      [](Scene* s, const StateForceGradient& d, double eps) {
+        const QuadHydrodynamicsGradient& q = d.quad_hydrodynamics;
+        s->quad_hydrodynamics->fluid_density += eps * q.fluid_density;
+        s->quad_hydrodynamics->flow_velocity += eps * q.flow_velocity;
+        s->quad_hydrodynamics->drag_curve += eps * q.drag_curve;
+        s->quad_hydrodynamics->thrust_curve += eps * q.thrust_curve;
+      },
+      [](const StateForceGradient& g, const StateForceGradient& d) {
+        const QuadHydrodynamicsGradient &gq = g.quad_hydrodynamics, &q = d.quad_hydrodynamics;
+        return gq.fluid_density * q.fluid_density + gq.flow_velocity.dot(q.flow_velocity) +
+               gq.drag_curve.dot(q.drag_curve) + gq.thrust_curve.dot(q.thrust_curve);
+      },
+      /*semi_implicit_step=*/1e-4);
 }
 
 TEST(TangentRolloutTest, RejectsStateForceDirectionsTheSceneDoesNotDeclare) {
