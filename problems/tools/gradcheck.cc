@@ -9,13 +9,12 @@
 #include <memory>
 #include <random>
 
-#include <Eigen/Geometry>
 #include <omp.h>
 
 #include "cli/invalid_option.h"
 #include "diffpd/error.h"
-#include "diffpd/quad_hydrodynamics.h"
 #include "diffpd/simulator.h"
+#include "diffpd/wetted_quads.h"
 #include "tools/stress.h"
 
 namespace diffpd::problems {
@@ -32,27 +31,6 @@ VectorXd RandomVector(std::mt19937_64* rng, Eigen::Index n) {
 VectorXd Direction(std::mt19937_64* rng, Eigen::Index n) {
   const VectorXd d = RandomVector(rng, n);
   return d * (std::sqrt(double(n)) / d.norm());
-}
-
-// Per face of `water`, whether the water acts on it at `state` (the force
-// of quad_hydrodynamics.h is nonzero: the relative velocity u = flow - the
-// corners' mean velocity is not negligible and points against the face's
-// outward normal, the sum of its corner triangles' cross products).
-std::vector<char> WettedQuads(const QuadHydrodynamics& water, const State& state) {
-  constexpr int kTriangles[4][3] = {{0, 1, 2}, {0, 2, 3}, {0, 1, 3}, {3, 1, 2}};
-  std::vector<char> wetted(water.quads.cols(), 0);
-  for (Eigen::Index f = 0; f < water.quads.cols(); ++f) {
-    Vec3 p[4], mean = Vec3::Zero();
-    for (int c = 0; c < 4; ++c) {
-      p[c] = state.x.segment<3>(3 * water.quads(c, f));
-      mean += state.v.segment<3>(3 * water.quads(c, f));
-    }
-    Vec3 normal = Vec3::Zero();
-    for (const auto& t : kTriangles) normal += (p[t[1]] - p[t[0]]).cross(p[t[2]] - p[t[1]]);
-    const Vec3 u = water.flow_velocity - mean / 4.0;
-    wetted[f] = u.norm() >= 1e-14 && normal.dot(u) < 0;
-  }
-  return wetted;
 }
 
 // Steps taken before the early stop is considered (GradCheckOptions::early_stop_margin).
@@ -161,10 +139,11 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   // meeting the water differ from the checked rollout's at some step.
   std::vector<std::vector<char>> wetted;  // the checked rollout's, per step
   if (scene.quad_hydrodynamics)
-    for (int k = 0; k < steps; ++k) wetted.push_back(WettedQuads(*scene.quad_hydrodynamics, rollout.states[k]));
+    for (int k = 0; k < steps; ++k)
+      wetted.push_back(WettedQuads(*scene.quad_hydrodynamics, rollout.states[k].x, rollout.states[k].v));
   auto faces_switch = [&](const Rollout& r) {
     for (size_t k = 0; k < wetted.size() && k < r.states.size(); ++k)
-      if (WettedQuads(*scene.quad_hydrodynamics, r.states[k]) != wetted[k]) return true;
+      if (WettedQuads(*scene.quad_hydrodynamics, r.states[k].x, r.states[k].v) != wetted[k]) return true;
     return false;
   };
   int face_switches = 0;  // perturbed rollouts whose faces meeting the water differ

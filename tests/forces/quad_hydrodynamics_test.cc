@@ -1,15 +1,16 @@
 // Quad hydrodynamics (the original swimmers' model): boundary quads of hex
 // meshes are outward; a face pushed along its normal feels Cd = 2.05 and
 // Ct = 2.5, an oblique one the Bezier values at its angle, a face moving
-// away from the water nothing; each corner takes a quarter; the scene checks
-// its inputs. Derivatives: the quad_drag and quad_hydrodynamics rows of the
-// conformance test.
+// away from the water nothing; each corner takes a quarter; the faces the
+// water meets are those with a force; the scene checks its inputs. Derivatives: the quad_drag and quad_hydrodynamics
+// rows of the conformance test.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "diffpd/error.h"
 #include "diffpd/scene.h"
+#include "diffpd/wetted_quads.h"
 #include "forces/quad_hydrodynamic_force.h"
 #include "forces/state_forces.h"
 #include "test_scenes.h"
@@ -89,6 +90,41 @@ TEST(QuadHydrodynamicsTest, EachCornerTakesAQuarterAndTheFlowCounts) {
     const bool top = scene.mesh.vertices(2, i) > 0.05;
     EXPECT_NEAR(f(3 * i + 2), top ? total / 4 : 0.0, 1e-14) << "node " << i;
   }
+}
+
+// The faces the water meets are those whose force is not zero: a box moving
+// along +x meets it with its +x face only (the sides move along their own
+// planes, the -x face away), a box at rest in still water nowhere, and in a
+// current along -x with its +x face too.
+TEST(QuadHydrodynamicsTest, WettedQuadsAreTheFacesWithAForce) {
+  const Mesh mesh = testing::BoxHexMesh(1, 1, 1, 0.1, 0.1, 0.1);
+  QuadHydrodynamics water;
+  water.quads = BoundaryQuads(mesh);
+  const VectorXd x = Eigen::Map<const VectorXd>(mesh.vertices.data(), mesh.vertices.size());
+  VectorXd v = VectorXd::Zero(x.size());
+  auto expect_wetted_where_forced = [&](int expected_count) {
+    const std::vector<char> wetted = WettedQuads(water, x, v);
+    ASSERT_EQ(wetted.size(), 6u);
+    int count = 0;
+    for (int f = 0; f < 6; ++f) {
+      std::array<Vec3, 4> corners;
+      Vec3 mean = Vec3::Zero();
+      for (int c = 0; c < 4; ++c) {
+        corners[c] = x.segment<3>(3 * water.quads(c, f));
+        mean += v.segment<3>(3 * water.quads(c, f)) / 4;
+      }
+      const Vec3 force = internal::QuadHydrodynamicForce(water, corners, water.flow_velocity - mean);
+      EXPECT_EQ(wetted[f] != 0, !force.isZero(0)) << "face " << f;
+      count += wetted[f];
+    }
+    EXPECT_EQ(count, expected_count);
+  };
+  expect_wetted_where_forced(0);
+  for (int i = 0; i < mesh.num_vertices(); ++i) v(3 * i) = 0.2;
+  expect_wetted_where_forced(1);
+  v.setZero();
+  water.flow_velocity = Vec3(-0.2, 0, 0);
+  expect_wetted_where_forced(1);
 }
 
 TEST(QuadHydrodynamicsTest, SceneRefusesInvalidQuadHydrodynamics) {

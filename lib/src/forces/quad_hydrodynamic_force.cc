@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <Eigen/Geometry>
+
+#include "diffpd/wetted_quads.h"
 
 namespace diffpd::internal {
 namespace {
@@ -38,6 +41,17 @@ Geometry FaceGeometry(const std::array<Vec3, 4>& p) {
   return g;
 }
 
+// The face's geometry where the water meets it: the relative velocity u
+// (|u| = speed) is not negligible, the face not degenerate, and u points
+// against the face's outward normal (cos = n . u / |u| < 0); none otherwise
+// (no force).
+std::optional<Geometry> WetGeometry(const std::array<Vec3, 4>& corners, const Vec3& u, double speed) {
+  if (speed < kTinySpeed) return std::nullopt;
+  const Geometry g = FaceGeometry(corners);
+  if (g.sum_norm < kTinyArea || !(g.normal.dot(u) / speed < 0)) return std::nullopt;
+  return g;
+}
+
 // The angle phi and both coefficients at cos = n . d (< 0).
 struct Coefficients {
   double phi, drag, thrust, t_drag, t_thrust;
@@ -65,15 +79,18 @@ double BezierDerivative(const Eigen::Vector4d& b, double t) {
   return 3 * ((b(1) - b(0)) * s * s + 2 * (b(2) - b(1)) * t * s + (b(3) - b(2)) * t * t);
 }
 
+bool FaceMeetsWater(const std::array<Vec3, 4>& corners, const Vec3& u) {
+  const double speed = u.norm();
+  return WetGeometry(corners, u, speed).has_value();
+}
+
 Vec3 QuadHydrodynamicForce(const QuadHydrodynamics& params, const std::array<Vec3, 4>& corners, const Vec3& u) {
   const double speed = u.norm();
-  if (speed < kTinySpeed) return Vec3::Zero();
-  const Geometry g = FaceGeometry(corners);
-  if (g.sum_norm < kTinyArea) return Vec3::Zero();
-  const double cosine = g.normal.dot(u) / speed;
-  if (!(cosine < 0)) return Vec3::Zero();  // the face moves away from the water: no force
+  const std::optional<Geometry> g = WetGeometry(corners, u, speed);
+  if (!g) return Vec3::Zero();
+  const double cosine = g->normal.dot(u) / speed;
   const Coefficients k = Evaluate(params, cosine);
-  return 0.5 * params.fluid_density * g.area * speed * (k.drag * u - k.thrust * speed * g.normal);
+  return 0.5 * params.fluid_density * g->area * speed * (k.drag * u - k.thrust * speed * g->normal);
 }
 
 void QuadHydrodynamicForceVjp(const QuadHydrodynamics& params, const std::array<Vec3, 4>& corners, const Vec3& u,
@@ -82,12 +99,11 @@ void QuadHydrodynamicForceVjp(const QuadHydrodynamics& params, const std::array<
   for (Vec3& g : *g_corners) g.setZero();
   g_u->setZero();
   const double s = u.norm();
-  if (s < kTinySpeed) return;
-  const Geometry g = FaceGeometry(corners);
-  if (g.sum_norm < kTinyArea) return;
+  const std::optional<Geometry> wet = WetGeometry(corners, u, s);
+  if (!wet) return;
+  const Geometry& g = *wet;
   const Vec3& n = g.normal;
   const double c = n.dot(u) / s;
-  if (!(c < 0)) return;
   const Coefficients k = Evaluate(params, c);
   const double half_rho = 0.5 * params.fluid_density, a = g.area;
   const double wu = w.dot(u), wn = w.dot(n);
@@ -123,3 +139,21 @@ void QuadHydrodynamicForceVjp(const QuadHydrodynamics& params, const std::array<
 }
 
 }  // namespace diffpd::internal
+
+namespace diffpd {
+
+std::vector<char> WettedQuads(const QuadHydrodynamics& water, const VectorXd& x, const VectorXd& v) {
+  std::vector<char> wetted(water.quads.cols(), 0);
+  for (Eigen::Index f = 0; f < water.quads.cols(); ++f) {
+    std::array<Vec3, 4> corners;
+    Vec3 mean = Vec3::Zero();
+    for (int c = 0; c < 4; ++c) {
+      corners[c] = x.segment<3>(3 * water.quads(c, f));
+      mean += v.segment<3>(3 * water.quads(c, f));
+    }
+    wetted[f] = internal::FaceMeetsWater(corners, water.flow_velocity - mean / 4.0);
+  }
+  return wetted;
+}
+
+}  // namespace diffpd

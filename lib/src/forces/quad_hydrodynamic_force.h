@@ -14,6 +14,10 @@ namespace diffpd::internal {
 Eigen::Vector4d BezierBasis(double t);
 double BezierDerivative(const Eigen::Vector4d& b, double t);  // dB/dt
 
+// Whether the water meets the face (its force is not zero): u is not
+// negligible and points against the face's outward normal.
+bool FaceMeetsWater(const std::array<Vec3, 4>& corners, const Vec3& u);
+
 // F(p_0..p_3, u) for the relative velocity u = flow - mean corner velocity.
 Vec3 QuadHydrodynamicForce(const QuadHydrodynamics& params, const std::array<Vec3, 4>& corners, const Vec3& u);
 
