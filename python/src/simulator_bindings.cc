@@ -55,6 +55,8 @@ void BindSimulator(py::module_& m) {
       .def("rest_state", &Simulator::RestState)
       .def("lumped_mass", &Simulator::LumpedMass, "Lumped mass per DoF (3n, kg).")
       .def("elastic_energy", &Simulator::ElasticEnergy, "x"_a, "Total elastic energy (J) at positions x (3n).")
+      .def("explicit_stable_time_step", &Simulator::ExplicitStableTimeStep, "x"_a, "activation"_a = VectorXd(),
+           "Semi-implicit Euler's stability limit (s) at positions x (3n): 2 / the highest natural frequency.")
       .def(
           "step",
           [](Simulator& self, const State& state, const StepInput& input) {

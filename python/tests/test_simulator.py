@@ -117,3 +117,17 @@ def test_falling_cube_rollout_equals_the_cpp_programs():
         assert report.iterations == row["iterations"]
         assert displacement == pytest.approx(row["max_displacement"], rel=1e-12)
         assert kinetic == pytest.approx(row["kinetic_energy"], rel=1e-12)
+
+
+def test_a_diverging_semi_implicit_step_reports_the_stability_limit_explicit_stable_time_step_gives():
+    scene = beam_scene()
+    probe = diffpd.Simulator(scene, diffpd.SolverOptions(method=diffpd.Method.SEMI_IMPLICIT, time_step=1e-4))
+    limit = probe.explicit_stable_time_step(probe.rest_state().x)
+    assert 0 < limit < 1e-2
+    options = diffpd.SolverOptions(method=diffpd.Method.SEMI_IMPLICIT, time_step=1.5 * limit, num_threads=1)
+    sim = diffpd.Simulator(scene, options)
+    with pytest.raises(diffpd.SolverError, match=r"above semi-implicit Euler's stability limit at the rest shape, "
+                                                 r"about ([0-9.e+-]+) s") as info:
+        sim.simulate(sim.rest_state(), 200)
+    reported = float(info.value.args[0].split("about ")[1].split(" s")[0])
+    assert reported == pytest.approx(limit, rel=1e-5)

@@ -57,6 +57,19 @@ class Simulator {
   VectorXd LumpedMass() const;
   // Total elastic energy E(x) (J) of the scene at positions x (3n).
   double ElasticEnergy(const VectorXd& x);
+  // Semi-implicit Euler's stability limit at positions x (3n), with the
+  // muscles at `activation` (empty: zero): an estimate (s) of the largest
+  // stable time step, 2 / omega_max, omega_max^2 the largest eigenvalue of
+  // M^-1 K over the free DoFs, M the lumped mass and K the Hessian of the
+  // elastic, muscle and penalty-contact energies at x. Computed by Lanczos
+  // iteration to about 1e-6 relative, from below, so the step is at most
+  // that much above the limit of the linearised dynamics; damping and the
+  // other state forces are not included, and a deformed or moving body's
+  // limit differs. +infinity where nothing is stiff (every DoF fixed).
+  // Throws InvalidInputError for x or activation of the wrong size or with
+  // a non-finite entry ("ExplicitStableTimeStep: x has 5 entries, expected
+  // 48 (3 x number of nodes)").
+  double ExplicitStableTimeStep(const VectorXd& x, const VectorXd& activation = VectorXd());
 
   // One time step with the configured method. Throws InvalidInputError on
   // mismatched sizes or non-finite input, SolverError when the step fails

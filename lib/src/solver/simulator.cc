@@ -5,12 +5,14 @@
 #include <cstdio>
 #include <optional>
 #include <sstream>
+#include <string>
 
 #include "contact/active_set_step.h"
 #include "diffpd/error.h"
 #include "forces/activation_scope.h"
 #include "solver/adjoint_sweep.h"
 #include "solver/energy_bounded_step.h"
+#include "solver/explicit_stability.h"
 #include "solver/rollout_checks.h"
 #include "solver/simulator_impl.h"
 
@@ -34,9 +36,33 @@ void CheckVector(const VectorXd& v, Eigen::Index size, const char* name, bool al
 
 bool IsImplicit(Method m) { return m != Method::kSemiImplicit; }
 
+// Rest positions: the mesh's, Dirichlet DoFs at their prescribed values.
+VectorXd RestPositions(const SimulatorImpl& sim) {
+  VectorXd x = Eigen::Map<const VectorXd>(sim.scene.mesh.vertices.data(), sim.num_dofs());
+  for (size_t k = 0; k < sim.scene.dirichlet.dofs.size(); ++k)
+    x(sim.scene.dirichlet.dofs[k]) = sim.scene.dirichlet.values(k);
+  return x;
+}
+
+// The end of a divergence message: the time step and, for an explicit
+// method, how it compares with the stability limit at the rest shape.
+std::string StepAdvice(SimulatorImpl& sim) {
+  std::ostringstream msg;
+  msg << "h = " << sim.h() << " s";
+  if (IsImplicit(sim.options.method)) return msg.str();
+  const double limit = internal::ExplicitStableTimeStep(sim, RestPositions(sim));
+  if (sim.h() > limit)
+    msg << ", above semi-implicit Euler's stability limit at the rest shape, about " << limit << " s";
+  else
+    msg << ", within semi-implicit Euler's stability limit at the rest shape, about " << limit
+        << " s, which deformation, damping and the state forces lower";
+  msg << ": use a smaller time step or an implicit method";
+  return msg.str();
+}
+
 // SolverOptions::max_extent_ratio: throws SolverError(kDiverged) when the
 // nodes' bounding box at positions x is too large.
-void CheckExtent(const SimulatorImpl& sim, const VectorXd& x) {
+void CheckExtent(SimulatorImpl& sim, const VectorXd& x) {
   const double bound = sim.options.max_extent_ratio * sim.rest_extent;
   if (std::isinf(bound)) return;
   const Eigen::Map<const Eigen::Matrix3Xd> nodes(x.data(), 3, x.size() / 3);
@@ -45,8 +71,7 @@ void CheckExtent(const SimulatorImpl& sim, const VectorXd& x) {
   std::ostringstream msg;
   msg << ToString(sim.options.method) << ": the step diverged: the body's extent (its bounding box's diagonal) grew to "
       << extent << " m, beyond max_extent_ratio = " << sim.options.max_extent_ratio << " times its rest extent "
-      << sim.rest_extent << " m (h = " << sim.h() << " s"
-      << (IsImplicit(sim.options.method) ? ")" : "; an explicit method needs a smaller time step)");
+      << sim.rest_extent << " m (" << StepAdvice(sim) << ")";
   throw SolverError(SolverStatus::kDiverged, msg.str());
 }
 
@@ -90,9 +115,7 @@ void Simulator::SetRegionMaterial(int region, const MaterialParameters& material
 
 State Simulator::RestState() const {
   State s;
-  s.x = Eigen::Map<const VectorXd>(impl_->scene.mesh.vertices.data(), impl_->num_dofs());
-  for (size_t k = 0; k < impl_->scene.dirichlet.dofs.size(); ++k)
-    s.x(impl_->scene.dirichlet.dofs[k]) = impl_->scene.dirichlet.values(k);
+  s.x = RestPositions(*impl_);
   s.v = VectorXd::Zero(impl_->num_dofs());
   return s;
 }
@@ -102,6 +125,17 @@ VectorXd Simulator::LumpedMass() const { return impl_->Mass(); }
 double Simulator::ElasticEnergy(const VectorXd& x) {
   CheckVector(x, impl_->num_dofs(), "positions", false);
   return impl_->elastic.EnergyAndGradient(x, impl_->lame(), nullptr, impl_->threads());
+}
+
+double Simulator::ExplicitStableTimeStep(const VectorXd& x, const VectorXd& activation) {
+  try {
+    CheckVector(x, impl_->num_dofs(), "x", false);
+    internal::CheckActivation(activation, impl_->aux.num_muscles());
+  } catch (const InvalidInputError& e) {
+    throw InvalidInputError(std::string("ExplicitStableTimeStep: ") + e.what());
+  }
+  const internal::ActivationScope scope(*impl_, activation);
+  return internal::ExplicitStableTimeStep(*impl_, x);
 }
 
 int Simulator::num_pd_factorizations() const {
@@ -173,8 +207,7 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
   next.v = (next.x - state.x) / h;
   if (!next.x.allFinite() || !next.v.allFinite()) {
     std::ostringstream msg;
-    msg << ToString(sim.options.method) << ": the state became non-finite (h = " << h
-        << " s; an explicit method needs a smaller time step)";
+    msg << ToString(sim.options.method) << ": the state became non-finite (" << StepAdvice(sim) << ")";
     throw SolverError(SolverStatus::kNonFinite, msg.str());
   }
   CheckExtent(sim, next.x);
