@@ -50,8 +50,8 @@ double DenseStableTimeStep(Simulator* sim, const VectorXd& x, double delta) {
   for (int a = 0; a < m; ++a)
     for (int b = a; b < m; ++b) {
       const int i = free[a], j = free[b];
-      const double k = (energy(i, 1, j, 1) - energy(i, 1, j, -1) - energy(i, -1, j, 1) + energy(i, -1, j, -1)) /
-                       (4 * delta * delta);
+      const double k =
+          (energy(i, 1, j, 1) - energy(i, 1, j, -1) - energy(i, -1, j, 1) + energy(i, -1, j, -1)) / (4 * delta * delta);
       s(a, b) = s(b, a) = k / std::sqrt(mass(i) * mass(j));
     }
   const double largest = Eigen::SelfAdjointEigenSolver<MatrixXd>(s, Eigen::EigenvaluesOnly).eigenvalues()(m - 1);
