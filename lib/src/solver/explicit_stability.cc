@@ -8,7 +8,6 @@
 
 #include <Eigen/Eigenvalues>
 
-
 namespace diffpd::internal {
 
 double ExplicitStableTimeStep(SimulatorImpl& sim, const VectorXd& x) {
