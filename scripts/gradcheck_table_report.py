@@ -5,9 +5,10 @@
 
 A row per problem and method in the order given: the verdict, the smallest
 margin and per input kind "verdict error / floor" (or "tangent ERROR (floor
-FLOOR)" where the forward-mode tangent decided), the run's seconds; runs
-stopped by their time limit say "timeout", runs that ended with an error give
-its last line. An error or floor the differences could not measure (every
+FLOOR)" where the forward-mode tangent decided; "(k/n by tangent)" where it
+decided k of the n directions, the error and floor being the others'), the
+run's seconds; runs stopped by their time limit say "timeout", runs that ended
+with an error give its last line. An error or floor the differences could not measure (every
 perturbed rollout left the contact piece) reads "inf".
 """
 import json
@@ -21,7 +22,9 @@ def number(x):
 def cell(e):
     if e["verdict"] == "pass" and e.get("basis") == "tangent":
         return f"tangent {number(e['tangent_error'])} (floor {number(e['floor'])})"
-    return f"{e['verdict']} {number(e['error'])} / {number(e['floor'])}"
+    by_tangent = e.get("tangent_directions", 0)
+    mixed = f" ({by_tangent}/{e['directions']} by tangent)" if 0 < by_tangent < e["directions"] else ""
+    return f"{e['verdict']} {number(e['error'])} / {number(e['floor'])}{mixed}"
 
 
 def table(rows):

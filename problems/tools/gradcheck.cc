@@ -401,9 +401,20 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
       entry->basis = basis;
     }
     ++entry->directions;
-    entry->error = std::max(entry->error, j.error);
-    entry->floor = std::max(entry->floor, j.floor);
-    entry->bound = std::max(entry->bound, j.bound);
+    // error, floor and bound: over the directions the differences decided,
+    // or over all where the tangent decided every one.
+    const bool by_tangent = basis == "tangent";
+    entry->tangent_directions += by_tangent;
+    const int by_differences = entry->directions - entry->tangent_directions;
+    if (!by_tangent && by_differences == 1) {
+      entry->error = j.error;
+      entry->floor = j.floor;
+      entry->bound = j.bound;
+    } else if (!by_tangent || by_differences == 0) {
+      entry->error = std::max(entry->error, j.error);
+      entry->floor = std::max(entry->floor, j.floor);
+      entry->bound = std::max(entry->bound, j.bound);
+    }
     entry->verdict = first ? verdict : Worse(entry->verdict, verdict);
     entry->margin = std::min(entry->margin, margin);
   };
@@ -593,8 +604,13 @@ std::string GradCheckTable(const GradCheckResult& r) {
     };
     cell(ref, e.reference_error);
     cell(tangent, e.tangent_error);
+    // Where the tangent decided some directions but not all: how many.
+    const std::string basis = e.tangent_directions > 0 && e.tangent_directions < e.directions
+                                  ? e.basis + " (" + std::to_string(e.tangent_directions) + "/" +
+                                        std::to_string(e.directions) + " by tangent)"
+                                  : e.basis;
     std::snprintf(line, sizeof(line), "%-16s %10.2e %10.2e %10.3g %9.0e %10.2e %s %s %-11s %-11s %s\n", e.input.c_str(),
-                  e.error, e.floor, e.margin, e.step, e.bound, ref, tangent, ToString(e.verdict), e.basis.c_str(),
+                  e.error, e.floor, e.margin, e.step, e.bound, ref, tangent, ToString(e.verdict), basis.c_str(),
                   e.reason.c_str());
     out += line;
   }
@@ -623,6 +639,7 @@ nlohmann::json GradCheckToJson(const GradCheckResult& r) {
                        {"reference_error", number(e.reference_error)},
                        {"tangent_error", number(e.tangent_error)},
                        {"basis", e.basis},
+                       {"tangent_directions", e.tangent_directions},
                        {"reason", e.reason},
                        {"entries", e.entries},
                        {"directions", e.directions}};

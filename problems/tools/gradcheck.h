@@ -141,11 +141,13 @@ struct GradCheckInput {
   long entries = 0;   // number of scalar inputs of this kind
   int directions = 0;
   CheckVerdict verdict = CheckVerdict::kPass;  // worst over the directions (differences and reference)
-  double error = 0;                            // largest relative error against the differences
-  double floor = 0;                            // largest relative noise floor of the differences
-  double bound = 0;                            // largest relative worst case from the residuals
-  double margin = 0;                           // smallest tolerance / max(error, floor)
-  double step = 0;                             // the step of the worst direction (units of the scale)
+  // error, floor and bound: the largest over the directions the differences
+  // decided (over every direction where the tangent decided them all).
+  double error = 0;   // relative error against the differences
+  double floor = 0;   // relative noise floor of the differences
+  double bound = 0;   // relative worst case from the residuals
+  double margin = 0;  // smallest tolerance / max(error, floor)
+  double step = 0;    // the step of the worst direction (units of the scale)
   // Largest relative difference from the reference gradient; NaN: not compared.
   double reference_error = 0;
   // Largest relative difference from the forward-mode tangent; NaN: not
@@ -154,7 +156,8 @@ struct GradCheckInput {
   // What the verdict rests on: "differences", or "tangent" where the
   // differences could not resolve some direction (worst direction's basis).
   std::string basis = "differences";
-  std::string reason;  // empty for a pass: why the worst direction failed or is unresolved
+  int tangent_directions = 0;  // directions the tangent decided
+  std::string reason;          // empty for a pass: why the worst direction failed or is unresolved
 };
 
 struct GradCheckResult {

@@ -170,6 +170,7 @@ TEST(GradCheckTest, DifferencesAcrossAQuadFaceSwitchCannotFailAnInput) {
       std::find_if(t.inputs.begin(), t.inputs.end(), [](const GradCheckInput& e) { return e.input == "v0"; });
   ASSERT_NE(tv0, t.inputs.end());
   EXPECT_EQ(tv0->basis, "tangent");
+  EXPECT_EQ(tv0->tangent_directions, tv0->directions);
 }
 
 TEST(GradCheckTest, TableAndJsonReportTheResult) {
@@ -185,6 +186,7 @@ TEST(GradCheckTest, TableAndJsonReportTheResult) {
   EXPECT_TRUE(j.at("inputs").at("x0").at("reference_error").is_null());  // not compared
   EXPECT_DOUBLE_EQ(j.at("inputs").at("x0").at("tangent_error").get<double>(), r.inputs[0].tangent_error);
   EXPECT_EQ(j.at("inputs").at("x0").at("basis"), "differences");
+  EXPECT_EQ(j.at("inputs").at("x0").at("tangent_directions").get<int>(), 0);
   EXPECT_EQ(j.at("tangent"), true);
   const std::string table = GradCheckTable(r);
   EXPECT_NE(table.find("youngs_modulus"), std::string::npos) << table;
