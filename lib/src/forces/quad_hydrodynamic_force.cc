@@ -79,6 +79,17 @@ double BezierDerivative(const Eigen::Vector4d& b, double t) {
   return 3 * ((b(1) - b(0)) * s * s + 2 * (b(2) - b(1)) * t * s + (b(3) - b(2)) * t * t);
 }
 
+std::array<Vec3, 4> QuadCorners(const VectorXd& x, const Eigen::Matrix4Xi& quads, int f) {
+  return {x.segment<3>(3 * quads(0, f)), x.segment<3>(3 * quads(1, f)), x.segment<3>(3 * quads(2, f)),
+          x.segment<3>(3 * quads(3, f))};
+}
+
+Vec3 QuadRelativeVelocity(const VectorXd& v, const QuadHydrodynamics& q, int f) {
+  Vec3 mean = Vec3::Zero();
+  for (int c = 0; c < 4; ++c) mean += v.segment<3>(3 * q.quads(c, f));
+  return q.flow_velocity - mean / 4.0;
+}
+
 bool FaceMeetsWater(const std::array<Vec3, 4>& corners, const Vec3& u) {
   const double speed = u.norm();
   return WetGeometry(corners, u, speed).has_value();
@@ -144,15 +155,9 @@ namespace diffpd {
 
 std::vector<char> WettedQuads(const QuadHydrodynamics& water, const VectorXd& x, const VectorXd& v) {
   std::vector<char> wetted(water.quads.cols(), 0);
-  for (Eigen::Index f = 0; f < water.quads.cols(); ++f) {
-    std::array<Vec3, 4> corners;
-    Vec3 mean = Vec3::Zero();
-    for (int c = 0; c < 4; ++c) {
-      corners[c] = x.segment<3>(3 * water.quads(c, f));
-      mean += v.segment<3>(3 * water.quads(c, f));
-    }
-    wetted[f] = internal::FaceMeetsWater(corners, water.flow_velocity - mean / 4.0);
-  }
+  for (int f = 0; f < static_cast<int>(water.quads.cols()); ++f)
+    wetted[f] =
+        internal::FaceMeetsWater(internal::QuadCorners(x, water.quads, f), internal::QuadRelativeVelocity(v, water, f));
   return wetted;
 }
 

@@ -14,6 +14,11 @@ namespace diffpd::internal {
 Eigen::Vector4d BezierBasis(double t);
 double BezierDerivative(const Eigen::Vector4d& b, double t);  // dB/dt
 
+// Corner positions of quad f of `quads` (4 x F node indices) at x (3n), and
+// the water's velocity relative to quad f at velocities v (3n).
+std::array<Vec3, 4> QuadCorners(const VectorXd& x, const Eigen::Matrix4Xi& quads, int f);
+Vec3 QuadRelativeVelocity(const VectorXd& v, const QuadHydrodynamics& q, int f);
+
 // Whether the water meets the face (its force is not zero): u is not
 // negligible and points against the face's outward normal.
 bool FaceMeetsWater(const std::array<Vec3, 4>& corners, const Vec3& u);

@@ -20,17 +20,6 @@ Vec3 MeanVelocity(const VectorXd& v, int a, int b, int c) {
   return (v.segment<3>(3 * a) + v.segment<3>(3 * b) + v.segment<3>(3 * c)) / 3.0;
 }
 
-// Corner positions of quad f and the water's velocity relative to it.
-std::array<Vec3, 4> QuadCorners(const VectorXd& x, const Eigen::Matrix4Xi& quads, int f) {
-  return {x.segment<3>(3 * quads(0, f)), x.segment<3>(3 * quads(1, f)), x.segment<3>(3 * quads(2, f)),
-          x.segment<3>(3 * quads(3, f))};
-}
-Vec3 QuadRelativeVelocity(const VectorXd& v, const QuadHydrodynamics& q, int f) {
-  Vec3 mean = Vec3::Zero();
-  for (int c = 0; c < 4; ++c) mean += v.segment<3>(3 * q.quads(c, f));
-  return q.flow_velocity - mean / 4.0;
-}
-
 }  // namespace
 
 StateForces::StateForces(const Scene& scene)
