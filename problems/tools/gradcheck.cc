@@ -49,11 +49,6 @@ std::string Format(double v) {
 // Thrown by a perturbed rollout that lies on another piece of a frictional
 // contact trajectory (its active set differs from the checked rollout's).
 struct OtherPiece {};
-// Thrown, with its loss, by a perturbed rollout in which a quad face starts or
-// stops meeting the water (Scene::quad_hydrodynamics) at some step.
-struct FaceSwitch {
-  double loss;
-};
 
 // The losses of a check: the loss vectors, the baseline inputs and the
 // gradient of one method's rollout.
@@ -117,14 +112,21 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   if (num_muscles > 0)
     for (auto& in : base.inputs)
       in.activation = VectorXd::Constant(num_muscles, 0.9) + 0.02 * RandomVector(&rng, num_muscles);
-  const std::vector<StepInput>& inputs = base.inputs;
   const VectorXd &cx = base.cx, &cv = base.cv;
   auto loss_of = [&](const State& last) { return cx.dot(last.x) + cv.dot(last.v); };
   LossGradient dl(steps);
   dl.dx[steps] = cx;
   dl.dv[steps] = cv;
-  const Rollout rollout = sim.Simulate(initial, inputs);
+  const Rollout rollout = sim.Simulate(initial, base.inputs);
   const RolloutGradient grad = sim.Backward(rollout, dl);
+  // The one-sided faces of Scene::quad_hydrodynamics: the force jumps where a
+  // face starts or stops meeting the water. Every other rollout of the check
+  // holds each step's faces at the checked rollout's, so that it lies on the
+  // checked rollout's smooth piece, whose derivative the adjoint is.
+  if (scene.quad_hydrodynamics)
+    for (int k = 0; k < steps; ++k)
+      base.inputs[k].wetted_quads = WettedQuads(*scene.quad_hydrodynamics, rollout.states[k].x, rollout.states[k].v);
+  const std::vector<StepInput>& inputs = base.inputs;
   // With frictional contact the gradient is that of the rollout's smooth
   // piece, its active sets held fixed (contact.h): a rollout whose sets
   // differ lies on another piece. Returns the first step whose set differs
@@ -134,20 +136,7 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
       if (r.reports[k].contact_nodes != rollout.reports[k].contact_nodes) return static_cast<int>(k);
     return -1;
   };
-  // The one-sided faces of Scene::quad_hydrodynamics: the force jumps where a
-  // face starts or stops meeting the water. Whether a rollout's faces
-  // meeting the water differ from the checked rollout's at some step.
-  std::vector<std::vector<char>> wetted;  // the checked rollout's, per step
-  if (scene.quad_hydrodynamics)
-    for (int k = 0; k < steps; ++k)
-      wetted.push_back(WettedQuads(*scene.quad_hydrodynamics, rollout.states[k].x, rollout.states[k].v));
-  auto faces_switch = [&](const Rollout& r) {
-    for (size_t k = 0; k < wetted.size() && k < r.states.size(); ++k)
-      if (WettedQuads(*scene.quad_hydrodynamics, r.states[k].x, r.states[k].v) != wetted[k]) return true;
-    return false;
-  };
-  int face_switches = 0;  // perturbed rollouts whose faces meeting the water differ
-  int set_changes = 0;    // perturbed rollouts that left the piece (their differences count as non-finite)
+  int set_changes = 0;  // perturbed rollouts that left the piece (their differences count as non-finite)
 
   GradCheckResult result;
   result.method = ToString(options.method);
@@ -233,7 +222,6 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   auto rollout_loss = [&](Simulator& s, const State& init, const std::vector<StepInput>& in) {
     const Rollout r = s.Simulate(init, in);
     if (other_piece(r) >= 0) throw OtherPiece();
-    if (faces_switch(r)) throw FaceSwitch{loss_of(r.states.back())};
     return loss_of(r.states.back());
   };
   // perturbed(simulator, e) at every e of `at`, check.concurrent_rollouts at
@@ -246,16 +234,13 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
                     bool tolerate_all) {
     const int m = static_cast<int>(at.size());
     std::vector<double> values(m, std::numeric_limits<double>::quiet_NaN());
-    std::vector<char> counted(m, 0), switched(m, 0);
+    std::vector<char> counted(m, 0);
     std::vector<std::exception_ptr> errors(m);
     const int count = static_cast<int>(workers.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(count) if (count > 1)
     for (int i = 0; i < m; ++i) {
       try {
         values[i] = perturbed(*workers[count > 1 ? omp_get_thread_num() : 0], at[i]);
-      } catch (const FaceSwitch& e) {
-        values[i] = e.loss;
-        switched[i] = 1;
       } catch (const OtherPiece&) {
         counted[i] = 1;
       } catch (const SolverError&) {
@@ -268,7 +253,6 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     for (int i = 0; i < m; ++i) {
       if (errors[i]) std::rethrow_exception(errors[i]);
       set_changes += counted[i];
-      face_switches += switched[i];
     }
     return values;
   };
@@ -291,7 +275,7 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
       result.inputs.push_back(fresh);
       entry = &result.inputs.back();
     }
-    const int changes_before = set_changes, switches_before = face_switches;
+    const int changes_before = set_changes;
     std::vector<FiniteDifference> differences;
     double e = check.largest_step;
     // Takes the next steps, each a tenth of the one before, up to `count` in
@@ -331,14 +315,6 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     if (set_changes > changes_before && verdict != CheckVerdict::kPass)
       reason += "; " + std::to_string(set_changes - changes_before) +
                 " perturbed rollouts changed the contact active set or failed (no difference there)";
-    // Differences across a quad face switch measure the force's jump, not the
-    // gradient of the smooth piece: they cannot fail it.
-    if (face_switches > switches_before && verdict == CheckVerdict::kFail) {
-      verdict = CheckVerdict::kUnresolved;
-      reason =
-          std::to_string(face_switches - switches_before) +
-          " perturbed rollouts changed which quad faces meet the water (the force jumps there); differences: " + reason;
-    }
     std::string basis = "differences";
     double margin = j.margin;
     double tangent_error = std::numeric_limits<double>::quiet_NaN();

@@ -63,10 +63,10 @@
 // sets fixed as the adjoint does, decides. A reference rollout on another
 // piece is not compared (reference_failure says so). The one-sided faces of
 // Scene::quad_hydrodynamics make the force jump where a face starts or stops
-// meeting the water; such jumps are mostly tiny (a face moving nearly along
-// its plane, slowly), so differences across them still count, but where a
-// perturbed rollout switched a face they cannot fail an input: the input is
-// unresolved (the reason says how many switched) and the tangent decides.
+// meeting the water: every perturbed rollout, and the reference, holds each
+// step's faces at the checked rollout's (StepInput::wetted_quads), so that
+// the differences are those of the checked rollout's smooth piece, whose
+// derivative the adjoint is.
 //
 // Reference: for the iterative methods (pd, pd-lbfgs, newton-pcg) by
 // default, the same loss's gradient from a Newton-Cholesky rollout at

@@ -61,6 +61,12 @@ void BindRollout(py::module_& m) {
            "external_force"_a = VectorXd(), "activation"_a = VectorXd());
   EigenMember(input, "external_force", &StepInput::external_force, "3n (N), or empty for none; a view");
   EigenMember(input, "activation", &StepInput::activation, "one per muscle, or empty (at rest); a view");
+  input.def_property(
+      "wetted_quads",
+      [](const StepInput& in) { return std::vector<bool>(in.wetted_quads.begin(), in.wetted_quads.end()); },
+      [](StepInput& in, const std::vector<bool>& wetted) { in.wetted_quads.assign(wetted.begin(), wetted.end()); },
+      "Scene.quad_hydrodynamics only: per face, held wet (True) or dry (False) during the step; empty (the "
+      "default): each face's state decides (see wetted_quads()); a copy");
 
   py::class_<StepReport> step_report(m, "StepReport", "Outcome of one step.");
   step_report.def(py::init<>())

@@ -9,9 +9,11 @@
 
 #include "bindings.h"
 #include "diffpd/contact.h"
+#include "diffpd/error.h"
 #include "diffpd/muscle.h"
 #include "diffpd/muscle_strip.h"
 #include "diffpd/quad_hydrodynamics.h"
+#include "diffpd/wetted_quads.h"
 #include "diffpd/scene.h"
 #include "diffpd/state_forces.h"
 
@@ -110,6 +112,21 @@ void BindScene(py::module_& m) {
       .def_readwrite("flow_velocity", &QuadHydrodynamics::flow_velocity)
       .def_readwrite("drag_curve", &QuadHydrodynamics::drag_curve)
       .def_readwrite("thrust_curve", &QuadHydrodynamics::thrust_curve);
+  m.def(
+      "wetted_quads",
+      [](const QuadHydrodynamics& water, const VectorXd& x, const VectorXd& v) {
+        const Eigen::Index nodes = x.size() / 3;
+        if (x.size() % 3 != 0 || v.size() != x.size())
+          throw InvalidInputError("wetted_quads: x and v must have the same length, a multiple of 3 (got " +
+                                  std::to_string(x.size()) + " and " + std::to_string(v.size()) + ")");
+        if (water.quads.size() > 0 && (water.quads.minCoeff() < 0 || water.quads.maxCoeff() >= nodes))
+          throw InvalidInputError("wetted_quads: water.quads has node indices outside [0, " + std::to_string(nodes) +
+                                  ") for x of " + std::to_string(x.size()) + " entries");
+        const std::vector<char> wetted = WettedQuads(water, x, v);
+        return std::vector<bool>(wetted.begin(), wetted.end());
+      },
+      "water"_a, "x"_a, "v"_a,
+      "Per face of water.quads, whether the water meets it at positions x and velocities v (3n each).");
   py::class_<QuadHydrodynamicsGradient>(m, "QuadHydrodynamicsGradient")
       .def(py::init<>())
       .def_readwrite("fluid_density", &QuadHydrodynamicsGradient::fluid_density)

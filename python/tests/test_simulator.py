@@ -131,3 +131,37 @@ def test_a_diverging_semi_implicit_step_reports_the_stability_limit_explicit_sta
         sim.simulate(sim.rest_state(), 200)
     reported = float(info.value.args[0].split("about ")[1].split(" s")[0])
     assert reported == pytest.approx(limit, rel=1e-5)
+
+
+def test_holding_a_rollouts_own_quad_faces_reproduces_it_and_a_wrong_hold_is_refused():
+    scene = beam_scene()
+    scene.dirichlet = diffpd.DirichletBoundary()
+    scene.gravity = np.zeros(3)
+    water = diffpd.QuadHydrodynamics()
+    water.quads = diffpd.boundary_quads(scene.mesh)
+    scene.quad_hydrodynamics = water
+    sim = diffpd.Simulator(scene, diffpd.SolverOptions(method=diffpd.Method.NEWTON_CHOLESKY))
+    v = np.zeros(sim.num_dofs)
+    v[0::3] = 0.5  # gliding along x: the side faces move along their planes
+    start = diffpd.State(sim.rest_state().x.copy(), v)
+    free_next, _ = sim.step(start, diffpd.StepInput())
+    wetted = diffpd.wetted_quads(water, start.x, start.v)
+    assert len(wetted) == water.quads.shape[1]
+    assert 0 < sum(wetted) < len(wetted)
+    held = diffpd.StepInput()
+    held.wetted_quads = wetted
+    assert held.wetted_quads == wetted
+    held_next, _ = sim.step(start, held)
+    assert np.array_equal(held_next.x, free_next.x)
+    held.wetted_quads = wetted[:-1]
+    with pytest.raises(diffpd.InvalidInputError) as info:
+        sim.step(start, held)
+    faces = len(wetted)
+    assert str(info.value) == (
+        f"wetted_quads has {faces - 1} entries, expected {faces} (one per quad_hydrodynamics face)"
+    )
+    with pytest.raises(diffpd.InvalidInputError) as info:
+        diffpd.wetted_quads(water, start.x[:-3], start.v)
+    assert str(info.value) == (
+        f"wetted_quads: x and v must have the same length, a multiple of 3 (got {sim.num_dofs - 3} and {sim.num_dofs})"
+    )

@@ -565,14 +565,14 @@ ForceTerm StateForceTerm(const std::string& name, const Scene& scene, std::vecto
   t.name = "state forces, " + name;
   t.force = [scene_of, n](const VectorXd& y) {
     VectorXd f = VectorXd::Zero(n);
-    internal::StateForces(scene_of(y)).Add(y.segment(0, n), y.segment(n, n), y.segment(2 * n, n), &f);
+    internal::StateForces(scene_of(y)).Add(y.segment(0, n), y.segment(n, n), y.segment(2 * n, n), {}, &f);
     return f;
   };
   t.vjp = [scene_of, n, p](const VectorXd& y, const VectorXd& w) {
     VectorXd gx = VectorXd::Zero(n), gv = VectorXd::Zero(n), dmass = VectorXd::Zero(n);
     StateForceGradient grad;
     internal::StateForces(scene_of(y))
-        .AddVjp(y.segment(0, n), y.segment(n, n), y.segment(2 * n, n), w, &gx, &gv, &grad, &dmass);
+        .AddVjp(y.segment(0, n), y.segment(n, n), y.segment(2 * n, n), {}, w, &gx, &gv, &grad, &dmass);
     VectorXd out(3 * n + p);
     out << gx, gv, dmass, grad.linear_damping, grad.fluid_density, grad.drag_tangential, grad.drag_normal, grad.thrust,
         grad.flow_velocity, grad.penalty_friction.empty() ? 0.0 : grad.penalty_friction[0];
@@ -756,13 +756,13 @@ ForceTerm QuadStateForceTerm() {
   t.name = "state forces, drag and thrust on one-sided quads";
   t.force = [scene_of, n, mass](const VectorXd& y) {
     VectorXd f = VectorXd::Zero(n);
-    internal::StateForces(scene_of(y)).Add(y.segment(0, n), y.segment(n, n), mass, &f);
+    internal::StateForces(scene_of(y)).Add(y.segment(0, n), y.segment(n, n), mass, {}, &f);
     return f;
   };
   t.vjp = [scene_of, n, p, mass](const VectorXd& y, const VectorXd& w) {
     VectorXd gx = VectorXd::Zero(n), gv = VectorXd::Zero(n), dmass = VectorXd::Zero(n);
     StateForceGradient grad;
-    internal::StateForces(scene_of(y)).AddVjp(y.segment(0, n), y.segment(n, n), mass, w, &gx, &gv, &grad, &dmass);
+    internal::StateForces(scene_of(y)).AddVjp(y.segment(0, n), y.segment(n, n), mass, {}, w, &gx, &gv, &grad, &dmass);
     EXPECT_EQ(dmass.norm(), 0.0);
     const QuadHydrodynamicsGradient& q = grad.quad_hydrodynamics;
     VectorXd out(2 * n + p);

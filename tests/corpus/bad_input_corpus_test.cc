@@ -475,6 +475,24 @@ std::vector<Row> StepRows() {
   add(
       "activation without muscles", [](State*, StepInput* in) { in->activation = VectorXd::Ones(2); },
       "activation has 2 entries, expected 0 (one per muscle)");
+  add(
+      "held quad faces without quad hydrodynamics",
+      [](State*, StepInput* in) {
+        in->wetted_quads = {1, 0};
+      },
+      "wetted_quads has 2 entries, expected 0 (one per quad_hydrodynamics face)");
+  rows.push_back({"simulate with a held quad face that is neither wet nor dry",
+                  [] {
+                    Scene scene = testing::SmallBeamScene();
+                    scene.quad_hydrodynamics = QuadHydrodynamics();
+                    scene.quad_hydrodynamics->quads = BoundaryQuads(scene.mesh);
+                    Simulator sim(scene, testing::TightOptions(Method::kPd));
+                    std::vector<StepInput> inputs(3);
+                    inputs[1].wetted_quads.assign(scene.quad_hydrodynamics->quads.cols(), 1);
+                    inputs[1].wetted_quads[4] = 7;
+                    sim.Simulate(sim.RestState(), inputs);
+                  },
+                  "Simulate: inputs[1]: wetted_quads[4] = 7 is invalid: must be 0 or 1"});
   rows.push_back({"simulate with a short external force",
                   [] {
                     Simulator sim(testing::SmallBeamScene(), testing::TightOptions(Method::kPd));
@@ -554,6 +572,14 @@ std::vector<Row> RolloutRows() {
                     backward(r, loss, pd);
                   },
                   "Backward: the rollout has 3 states for 1 inputs (needs one more state than inputs)"});
+  rows.push_back({"rollout holding quad faces to a simulator without quad hydrodynamics",
+                  [=] {
+                    Rollout r = BeamRollout(pd);
+                    r.inputs[1].wetted_quads = {0, 1, 1};
+                    backward(r, OnesLoss(r), pd);
+                  },
+                  "Backward: the rollout's input 1: wetted_quads has 3 entries, expected 0 (one per "
+                  "quad_hydrodynamics face)"});
   rows.push_back({"loss gradient nan",
                   [=] {
                     const Rollout r = BeamRollout(pd);

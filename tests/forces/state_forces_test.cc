@@ -88,11 +88,11 @@ TEST(StateForcesTest, VectorJacobianProductsMatchFiniteDifferences) {
     VectorXd gx = VectorXd::Zero(n), gv = VectorXd::Zero(n);
     StateForceGradient grad;
     VectorXd dmass = VectorXd::Zero(n);
-    forces.AddVjp(x, v, mass, w, &gx, &gv, &grad, &dmass);
+    forces.AddVjp(x, v, mass, {}, w, &gx, &gv, &grad, &dmass);
     const double drho = dmass.dot(unit_mass);  // M = rho m
     auto wf = [&](const VectorXd& xx, const VectorXd& vv, double r) {
       VectorXd f = VectorXd::Zero(n);
-      forces.Add(xx, vv, r * unit_mass, &f);
+      forces.Add(xx, vv, r * unit_mass, {}, &f);
       return w.dot(f);
     };
     const VectorXd dx = Random(n, &rng), dv = Random(n, &rng);
@@ -111,7 +111,7 @@ TEST(StateForcesTest, VectorJacobianProductsMatchFiniteDifferences) {
         Scene s = scene;
         field(s) = p(0);
         VectorXd f = VectorXd::Zero(n);
-        internal::StateForces(s).Add(x, v, mass, &f);
+        internal::StateForces(s).Add(x, v, mass, {}, &f);
         return w.dot(f);
       };
       EXPECT_TRUE(testing::Passes(

@@ -20,6 +20,9 @@
 // parameters (StateForceGradient::quad_hydrodynamics). The force jumps
 // where a face turns (n . d = 0); d phi / d(n . d) = -1 / sqrt(1 - (n . d)^2)
 // is capped at 1e8 where a face moves exactly along its normal.
+// StepInput::wetted_quads (rollout.h) can hold a step's faces wet or dry
+// instead: a face held wet where n . d >= 0 keeps the formulas above with
+// phi <= 0 (Cd(phi) = B(drag_curve; 2 phi / pi), the same polynomial).
 //
 // Scene::Validate rejects, with InvalidInputError, e.g.:
 //   "scene: quad_hydrodynamics.quads(3, 5) = 99 is out of range [0, 45) (no such node)",

@@ -22,6 +22,19 @@ struct StepInput {
   // One activation per Scene::muscles entry (muscle.h), finite;
   // empty: all at rest (1). Held during the step.
   VectorXd activation;
+  // Scene::quad_hydrodynamics only: which faces feel the water during the
+  // step, one entry (1 wet, 0 dry) per face; empty (the default): each
+  // face's state decides (WettedQuads, wetted_quads.h). A face held wet
+  // where the water does not meet it keeps the wet formula continued past
+  // grazing incidence (phi < 0). The forward, Backward and Tangents all
+  // follow it. The force jumps where a face switches; holding each step's
+  // set at a rollout's own (WettedQuads of its states) makes nearby inputs
+  // give that rollout's smooth piece, whose derivative Backward returns,
+  // as frictional contact's active sets do for contact (used by gradient
+  // checks). Simulate rejects another length or value:
+  // "Simulate: inputs[2]: wetted_quads has 3 entries, expected 860 (one per
+  // quad_hydrodynamics face)", "... wetted_quads[5] = 7 is invalid: must be 0 or 1".
+  std::vector<char> wetted_quads{};
 };
 
 // Outcome of one step.

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <sstream>
 
 #include <Eigen/Geometry>
 
+#include "diffpd/error.h"
 #include "diffpd/wetted_quads.h"
 
 namespace diffpd::internal {
@@ -41,18 +43,22 @@ Geometry FaceGeometry(const std::array<Vec3, 4>& p) {
   return g;
 }
 
-// The face's geometry where the water meets it: the relative velocity u
-// (|u| = speed) is not negligible, the face not degenerate, and u points
-// against the face's outward normal (cos = n . u / |u| < 0); none otherwise
-// (no force).
-std::optional<Geometry> WetGeometry(const std::array<Vec3, 4>& corners, const Vec3& u, double speed) {
-  if (speed < kTinySpeed) return std::nullopt;
+// The face's geometry where it feels the water: the relative velocity u
+// (|u| = speed) is not negligible, the face not degenerate, and, unless it is
+// held wet, u points against the face's outward normal (cos = n . u / |u| <
+// 0); none otherwise (no force), and none for a face held dry.
+std::optional<Geometry> WetGeometry(const std::array<Vec3, 4>& corners, const Vec3& u, double speed, FaceWater water) {
+  if (water == FaceWater::kHeldDry || speed < kTinySpeed) return std::nullopt;
   const Geometry g = FaceGeometry(corners);
-  if (g.sum_norm < kTinyArea || !(g.normal.dot(u) / speed < 0)) return std::nullopt;
+  if (g.sum_norm < kTinyArea) return std::nullopt;
+  if (water == FaceWater::kByState && !(g.normal.dot(u) / speed < 0)) return std::nullopt;
   return g;
 }
 
-// The angle phi and both coefficients at cos = n . d (< 0).
+// The angle phi and both coefficients at cos = n . d: phi > 0 where the
+// water meets the face (cos < 0), so t_drag = 2 |phi| / pi = 2 phi / pi;
+// a face held wet past grazing incidence (cos >= 0) continues the same
+// polynomials to phi <= 0.
 struct Coefficients {
   double phi, drag, thrust, t_drag, t_thrust;
 };
@@ -60,7 +66,7 @@ struct Coefficients {
 Coefficients Evaluate(const QuadHydrodynamics& params, double cosine) {
   Coefficients k;
   k.phi = std::acos(std::clamp(cosine, -1.0, 1.0)) - M_PI / 2;
-  k.t_drag = std::abs(k.phi) / (M_PI / 2);
+  k.t_drag = k.phi / (M_PI / 2);
   k.t_thrust = k.phi / M_PI + 0.5;
   k.drag = params.drag_curve.dot(BezierBasis(k.t_drag));
   k.thrust = params.thrust_curve.dot(BezierBasis(k.t_thrust));
@@ -92,12 +98,29 @@ Vec3 QuadRelativeVelocity(const VectorXd& v, const QuadHydrodynamics& q, int f) 
 
 bool FaceMeetsWater(const std::array<Vec3, 4>& corners, const Vec3& u) {
   const double speed = u.norm();
-  return WetGeometry(corners, u, speed).has_value();
+  return WetGeometry(corners, u, speed, FaceWater::kByState).has_value();
 }
 
-Vec3 QuadHydrodynamicForce(const QuadHydrodynamics& params, const std::array<Vec3, 4>& corners, const Vec3& u) {
+void CheckWettedQuads(const std::vector<char>& wetted, const std::optional<QuadHydrodynamics>& water) {
+  if (wetted.empty()) return;
+  const long num_faces = water ? water->quads.cols() : 0;
+  std::ostringstream msg;
+  if (static_cast<long>(wetted.size()) != num_faces) {
+    msg << "wetted_quads has " << wetted.size() << " entries, expected " << num_faces
+        << " (one per quad_hydrodynamics face)";
+    throw InvalidInputError(msg.str());
+  }
+  for (size_t f = 0; f < wetted.size(); ++f)
+    if (wetted[f] != 0 && wetted[f] != 1) {
+      msg << "wetted_quads[" << f << "] = " << static_cast<int>(wetted[f]) << " is invalid: must be 0 or 1";
+      throw InvalidInputError(msg.str());
+    }
+}
+
+Vec3 QuadHydrodynamicForce(const QuadHydrodynamics& params, const std::array<Vec3, 4>& corners, const Vec3& u,
+                           FaceWater water) {
   const double speed = u.norm();
-  const std::optional<Geometry> g = WetGeometry(corners, u, speed);
+  const std::optional<Geometry> g = WetGeometry(corners, u, speed, water);
   if (!g) return Vec3::Zero();
   const double cosine = g->normal.dot(u) / speed;
   const Coefficients k = Evaluate(params, cosine);
@@ -105,12 +128,12 @@ Vec3 QuadHydrodynamicForce(const QuadHydrodynamics& params, const std::array<Vec
 }
 
 void QuadHydrodynamicForceVjp(const QuadHydrodynamics& params, const std::array<Vec3, 4>& corners, const Vec3& u,
-                              const Vec3& w, std::array<Vec3, 4>* g_corners, Vec3* g_u,
-                              QuadHydrodynamicsGradient* grad) {
+                              const Vec3& w, std::array<Vec3, 4>* g_corners, Vec3* g_u, QuadHydrodynamicsGradient* grad,
+                              FaceWater water) {
   for (Vec3& g : *g_corners) g.setZero();
   g_u->setZero();
   const double s = u.norm();
-  const std::optional<Geometry> wet = WetGeometry(corners, u, s);
+  const std::optional<Geometry> wet = WetGeometry(corners, u, s, water);
   if (!wet) return;
   const Geometry& g = *wet;
   const Vec3& n = g.normal;
@@ -120,7 +143,7 @@ void QuadHydrodynamicForceVjp(const QuadHydrodynamics& params, const std::array<
   const double wu = w.dot(u), wn = w.dot(n);
   // w . dF/dCd and w . dF/dCt.
   const double w_drag = half_rho * a * s * wu, w_thrust = -half_rho * a * s * s * wn;
-  // phi = arccos(c) - pi/2: dphi/dc = -1 / sqrt(1 - c^2); phi > 0 here.
+  // phi = arccos(c) - pi/2: dphi/dc = -1 / sqrt(1 - c^2).
   const double dphi_dc = -1.0 / std::max(std::sqrt(std::max(1 - c * c, 0.0)), kMinSine);
   const double g_c = w_drag * BezierDerivative(params.drag_curve, k.t_drag) * (2 / M_PI) * dphi_dc +
                      w_thrust * BezierDerivative(params.thrust_curve, k.t_thrust) * (1 / M_PI) * dphi_dc;

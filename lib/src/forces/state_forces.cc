@@ -36,7 +36,8 @@ StateForces::StateForces(const Scene& scene)
   }
 }
 
-void StateForces::Add(const VectorXd& x, const VectorXd& v, const VectorXd& mass, VectorXd* f) const {
+void StateForces::Add(const VectorXd& x, const VectorXd& v, const VectorXd& mass, const std::vector<char>& wetted_quads,
+                      VectorXd* f) const {
   if (empty()) return;
   if (damping_) f->array() -= *damping_ * mass.array() * v.array();
   if (hydro_) {
@@ -52,9 +53,10 @@ void StateForces::Add(const VectorXd& x, const VectorXd& v, const VectorXd& mass
   }
   if (quad_hydro_) {
     for (int q = 0; q < quad_hydro_->quads.cols(); ++q) {
-      const Vec3 share = internal::QuadHydrodynamicForce(*quad_hydro_, QuadCorners(x, quad_hydro_->quads, q),
-                                                         QuadRelativeVelocity(v, *quad_hydro_, q)) /
-                         4.0;
+      const Vec3 share =
+          internal::QuadHydrodynamicForce(*quad_hydro_, QuadCorners(x, quad_hydro_->quads, q),
+                                          QuadRelativeVelocity(v, *quad_hydro_, q), FaceWaterOf(wetted_quads, q)) /
+          4.0;
       for (int c = 0; c < 4; ++c) f->segment<3>(3 * quad_hydro_->quads(c, q)) += share;
     }
   }
@@ -68,8 +70,9 @@ void StateForces::Add(const VectorXd& x, const VectorXd& v, const VectorXd& mass
   }
 }
 
-void StateForces::AddVjp(const VectorXd& x, const VectorXd& v, const VectorXd& mass, const VectorXd& w, VectorXd* gx,
-                         VectorXd* gv, StateForceGradient* grad, VectorXd* dmass) const {
+void StateForces::AddVjp(const VectorXd& x, const VectorXd& v, const VectorXd& mass,
+                         const std::vector<char>& wetted_quads, const VectorXd& w, VectorXd* gx, VectorXd* gv,
+                         StateForceGradient* grad, VectorXd* dmass) const {
   if (empty()) return;
   if (damping_) {
     const VectorXd mw = mass.cwiseProduct(w);
@@ -106,7 +109,7 @@ void StateForces::AddVjp(const VectorXd& x, const VectorXd& v, const VectorXd& m
       wq /= 4.0;
       internal::QuadHydrodynamicForceVjp(*quad_hydro_, QuadCorners(x, quads, q),
                                          QuadRelativeVelocity(v, *quad_hydro_, q), wq, &g_corners, &g_u,
-                                         &grad->quad_hydrodynamics);
+                                         &grad->quad_hydrodynamics, FaceWaterOf(wetted_quads, q));
       for (int c = 0; c < 4; ++c) {
         gx->segment<3>(3 * quads(c, q)) += g_corners[c];
         gv->segment<3>(3 * quads(c, q)) -= g_u / 4.0;
@@ -133,9 +136,10 @@ void StateForces::AddVjp(const VectorXd& x, const VectorXd& v, const VectorXd& m
   }
 }
 
-void StateForces::AddJvp(const VectorXd& x, const VectorXd& v, const VectorXd& mass, const MatrixXd& dx,
-                         const MatrixXd& dv, const std::vector<VectorXd>& dmass,
-                         const std::vector<StateForceGradient>& dtheta, MatrixXd* df) const {
+void StateForces::AddJvp(const VectorXd& x, const VectorXd& v, const VectorXd& mass,
+                         const std::vector<char>& wetted_quads, const MatrixXd& dx, const MatrixXd& dv,
+                         const std::vector<VectorXd>& dmass, const std::vector<StateForceGradient>& dtheta,
+                         MatrixXd* df) const {
   if (empty()) return;
   const int dirs = static_cast<int>(df->cols());
   auto mass_direction = [&](int p) -> const VectorXd* {
@@ -207,7 +211,8 @@ void StateForces::AddJvp(const VectorXd& x, const VectorXd& v, const VectorXd& m
         std::array<Vec3, 4> g_corners;
         Vec3 g_u;
         QuadHydrodynamicsGradient g;
-        internal::QuadHydrodynamicForceVjp(*quad_hydro_, corners, u, Vec3::Unit(k), &g_corners, &g_u, &g);
+        internal::QuadHydrodynamicForceVjp(*quad_hydro_, corners, u, Vec3::Unit(k), &g_corners, &g_u, &g,
+                                           FaceWaterOf(wetted_quads, q));
         for (int c = 0; c < 4; ++c) d_corners.block<1, 3>(k, 3 * c) = g_corners[c].transpose();
         d_u.row(k) = g_u.transpose();
         d_param(k, 0) = g.fluid_density;

@@ -102,13 +102,14 @@ void AdjointSweep::Step(int i, const State& s0, const State& s1, const StepInput
     sim.elastic.EnergyAndGradient(s0.x, sim.lame(), &grad_e, sim.threads());
     sim.aux.AddEnergyAndGradient(s0.x, sim.activation, &grad_e);
     VectorXd net = input.external_force.size() ? input.external_force : VectorXd::Zero(n);
-    sim.state_forces.Add(s0.x, s0.v, mass, &net);
+    sim.state_forces.Add(s0.x, s0.v, mass, input.wetted_quads, &net);
     net -= grad_e;
     dmass_ -= w.cwiseProduct(net).cwiseQuotient(mass);
     external_force_ = std::move(w);
   }
   // Explicit state forces f(x_i, v_i; M): dL/df = external_force_.
-  sim.state_forces.AddVjp(s0.x, s0.v, mass, external_force_, &gx_prev, &gv_prev, &out_.state_forces, &dmass_);
+  sim.state_forces.AddVjp(s0.x, s0.v, mass, input.wetted_quads, external_force_, &gx_prev, &gv_prev, &out_.state_forces,
+                          &dmass_);
   if (controller_) {
     // The action u_i = pi(x_i, v_i, m_i): dL/du_i flows into the state and memory.
     const ControlAction g_action{activation_, external_force_};

@@ -4,6 +4,7 @@
 
 #include "diffpd/error.h"
 #include "forces/activation_scope.h"
+#include "forces/quad_hydrodynamic_force.h"
 #include "solver/checkpoint_schedule.h"
 
 namespace diffpd::internal {
@@ -38,7 +39,7 @@ void CheckState(const State& s, int n, const std::string& caller, const std::str
     }
 }
 
-// Every input's external force and activation, then the settings the
+// Every input's external force, activation and held quad faces, then the settings the
 // rollout was made with (the rules of CheckRolloutForDerivatives).
 void CheckInputsAndSettings(const SimulatorImpl& sim, const std::vector<StepInput>& inputs,
                             const MaterialParameters& material, const std::vector<MaterialParameters>& region_materials,
@@ -48,6 +49,7 @@ void CheckInputsAndSettings(const SimulatorImpl& sim, const std::vector<StepInpu
     CheckEntries(inputs[k].external_force, n, true, caller, "input", k, "external_force");
     try {
       CheckActivation(inputs[k].activation, sim.aux.num_muscles());
+      CheckWettedQuads(inputs[k].wetted_quads, sim.scene.quad_hydrodynamics);
     } catch (const InvalidInputError& e) {
       throw InvalidInputError(caller + ": the rollout's input " + std::to_string(k) + ": " + e.what());
     }

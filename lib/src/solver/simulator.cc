@@ -10,6 +10,7 @@
 #include "contact/active_set_step.h"
 #include "diffpd/error.h"
 #include "forces/activation_scope.h"
+#include "forces/quad_hydrodynamic_force.h"
 #include "solver/adjoint_sweep.h"
 #include "solver/energy_bounded_step.h"
 #include "solver/explicit_stability.h"
@@ -154,6 +155,7 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
   CheckVector(state.v, n, "state.v", false);
   CheckVector(input.external_force, n, "external_force", true);
   internal::CheckActivation(input.activation, sim.aux.num_muscles());
+  internal::CheckWettedQuads(input.wetted_quads, sim.scene.quad_hydrodynamics);
   const internal::ActivationScope activation(sim, input.activation);
   const auto start = Clock::now();
   // Cold SVDs: the step's result depends on (state, input) alone.
@@ -163,7 +165,7 @@ State Simulator::Step(const State& state, const StepInput& input, StepReport* re
   *rep = StepReport();
   const double h = sim.h();
   VectorXd f = sim.ExplicitForce(input);
-  sim.state_forces.Add(state.x, state.v, sim.Mass(), &f);
+  sim.state_forces.Add(state.x, state.v, sim.Mass(), input.wetted_quads, &f);
   State next;
   if (sim.options.method == Method::kSemiImplicit) {
     if (!sim.scene.frictional_contacts.empty())
@@ -225,6 +227,7 @@ Rollout Simulator::Simulate(const State& initial, const std::vector<StepInput>& 
     try {
       CheckVector(inputs[i].external_force, impl_->num_dofs(), "external_force", true);
       internal::CheckActivation(inputs[i].activation, impl_->aux.num_muscles());
+      internal::CheckWettedQuads(inputs[i].wetted_quads, impl_->scene.quad_hydrodynamics);
     } catch (const InvalidInputError& e) {
       throw InvalidInputError("Simulate: inputs[" + std::to_string(i) + "]: " + e.what());
     }

@@ -360,7 +360,7 @@ TangentRollout TangentPass(SimulatorImpl& sim, const std::vector<StepInput>& inp
       for (int p = 0; p < num_dirs; ++p)
         if (!directions[p].external_force.empty() && directions[p].external_force[i].size())
           b.col(p) += directions[p].external_force[i];
-      sim.state_forces.AddJvp(s0.x, s0.v, mass, dx0, dv0, dmass, state_force_dirs, &b);
+      sim.state_forces.AddJvp(s0.x, s0.v, mass, inputs[i].wetted_quads, dx0, dv0, dmass, state_force_dirs, &b);
       subtract_activation_terms(i, s1.x, &b);
       const std::vector<int> no_pins;
       const std::vector<int>& pinned = contact ? at.report->contact_nodes : no_pins;
@@ -397,7 +397,7 @@ TangentRollout TangentPass(SimulatorImpl& sim, const std::vector<StepInput>& inp
         if (!directions[p].external_force.empty() && directions[p].external_force[i].size())
           force.col(p) += directions[p].external_force[i];
       }
-      sim.state_forces.AddJvp(s0.x, s0.v, mass, dx0, dv0, dmass, state_force_dirs, &force);
+      sim.state_forces.AddJvp(s0.x, s0.v, mass, inputs[i].wetted_quads, dx0, dv0, dmass, state_force_dirs, &force);
       subtract_lame_terms(s0.x, &force);
       subtract_activation_terms(i, s0.x, &force);
       MatrixXd dv1 = dv0 + h * mass.cwiseInverse().asDiagonal() * force;
@@ -407,7 +407,7 @@ TangentRollout TangentPass(SimulatorImpl& sim, const std::vector<StepInput>& inp
         sim.aux.AddEnergyAndGradient(s0.x, sim.activation, &grad_e);
         const VectorXd& user = inputs[i].external_force;
         VectorXd force_sum = user.size() ? user : VectorXd::Zero(n);
-        sim.state_forces.Add(s0.x, s0.v, mass, &force_sum);
+        sim.state_forces.Add(s0.x, s0.v, mass, inputs[i].wetted_quads, &force_sum);
         const VectorXd net = (force_sum - grad_e).cwiseQuotient(mass.cwiseAbs2());
         for (int p = 0; p < num_dirs; ++p)
           if (mass_dir[p]) dv1.col(p) -= h * dmass[p].cwiseProduct(net);

@@ -3,15 +3,14 @@
 // at least 10 (pd-lbfgs also against the Newton-Cholesky reference); an
 // inaccurate adjoint fails, and says against what; where the differences
 // cannot resolve a derivative with margin (h = 1e-5 s) the forward-mode
-// tangent decides it; differences across a quad face's jump cannot fail an
-// input; perturbed rollouts run three at once give the same
+// tangent decides it; differences hold the checked rollout's quad faces and
+// resolve across their jumps; perturbed rollouts run three at once give the same
 // verdicts; the reports carry the result's numbers; bad options are refused
 // with exact messages.
 #include "tools/gradcheck.h"
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -133,11 +132,13 @@ TEST(GradCheckTest, TheTangentDecidesWhatTheDifferencesCannotResolve) {
 // its boundary faces): its side faces move exactly along their own planes,
 // so the water does not meet them, and any perturbation of v0 turns some of
 // them into the water, where the force jumps (Cd and Ct are not zero at
-// grazing incidence). Differences across such a jump measure it, not the
-// gradient of the checked rollout's piece: without the tangent v0 is
-// unresolved with the switching rollouts counted, never failed; with it the
-// tangent decides, and agrees with the adjoint.
-TEST(GradCheckTest, DifferencesAcrossAQuadFaceSwitchCannotFailAnInput) {
+// grazing incidence). The check holds each step's faces at the checked
+// rollout's, so its differences are those of the checked rollout's smooth
+// piece: without the tangent every input, v0 included, passes on the
+// differences alone with a margin of at least 10. Left to their states the
+// perturbed rollouts measure the jump: v0 then fails, its differences 0.68
+// relative off against a floor of 0.11.
+TEST(GradCheckTest, DifferencesHoldTheCheckedRolloutsQuadFacesAndResolveAcrossTheirJumps) {
   Scene scene = testing::SmallBeamScene();
   scene.dirichlet = DirichletBoundary();
   scene.gravity = Vec3::Zero();
@@ -151,26 +152,9 @@ TEST(GradCheckTest, DifferencesAcrossAQuadFaceSwitchCannotFailAnInput) {
   check.directions = 1;
   check.tangent = false;
   const GradCheckResult d = CheckRolloutGradient(scene, options, start, 3, check);
-  EXPECT_EQ(d.Count(CheckVerdict::kFail), 0) << GradCheckTable(d);
-  const auto v0 =
-      std::find_if(d.inputs.begin(), d.inputs.end(), [](const GradCheckInput& e) { return e.input == "v0"; });
-  ASSERT_NE(v0, d.inputs.end());
-  EXPECT_EQ(v0->verdict, CheckVerdict::kUnresolved) << GradCheckTable(d);
-  EXPECT_NE(v0->reason.find(" perturbed rollouts changed which quad faces meet the water (the force jumps there); "
-                            "differences: "),
-            std::string::npos)
-      << v0->reason;
-  EXPECT_GT(v0->error, check.tolerance) << "the differences measure the jump";
-
-  check.tangent = true;
-  const GradCheckResult t = CheckRolloutGradient(scene, options, start, 3, check);
-  EXPECT_EQ(t.verdict, CheckVerdict::kPass) << GradCheckTable(t);
-  for (const auto& e : t.inputs) EXPECT_LE(e.tangent_error, 1e-8) << e.input;
-  const auto tv0 =
-      std::find_if(t.inputs.begin(), t.inputs.end(), [](const GradCheckInput& e) { return e.input == "v0"; });
-  ASSERT_NE(tv0, t.inputs.end());
-  EXPECT_EQ(tv0->basis, "tangent");
-  EXPECT_EQ(tv0->tangent_directions, tv0->directions);
+  EXPECT_EQ(d.verdict, CheckVerdict::kPass) << GradCheckTable(d);
+  EXPECT_GE(d.min_margin, 10.0) << GradCheckTable(d);
+  for (const auto& e : d.inputs) EXPECT_EQ(e.basis, "differences") << e.input;
 }
 
 TEST(GradCheckTest, TableAndJsonReportTheResult) {
