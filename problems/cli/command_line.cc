@@ -134,7 +134,8 @@ from differences at several steps), the margin tolerance / max(error, floor)
 and a verdict: pass, fail, or unresolved (the differences cannot resolve the
 derivative to the tolerance; the reason gives the floor). Three steps per
 direction suffice where they pass with the --early-stop margin; otherwise
-six are taken (and two wider ones where still unresolved). Where the
+six are taken, and two wider ones where still unresolved or passing with a
+margin below 10 (kept where they pass with a larger one). Where the
 differences do not pass with a margin of 3, the forward-mode tangent of the
 same states (the tangent column) decides; the basis column says which did.
 For the iterative methods the gradient is also compared with a

@@ -68,6 +68,8 @@ void GradCheckOptions::Validate() const {
   if (step_count < 2) fail("step_count", step_count, ">= 2");
   if (!(early_stop_margin == 0 || (early_stop_margin >= 1 && std::isfinite(early_stop_margin))))
     fail("early_stop_margin", early_stop_margin, "0 or finite and >= 1");
+  if (!(widen_below_margin >= 1 && std::isfinite(widen_below_margin)))
+    fail("widen_below_margin", widen_below_margin, "finite and >= 1");
   if (!(decisive_margin >= 1 && std::isfinite(decisive_margin)))
     fail("decisive_margin", decisive_margin, "finite and >= 1");
   if (!(reference_rel_tolerance > 0 && reference_rel_tolerance < 1))
@@ -298,7 +300,8 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     DerivativeJudgement j = take_steps(may_stop_early ? kEarlyStopSteps : check.step_count);
     if (may_stop_early && !(j.verdict == CheckVerdict::kPass && j.margin >= check.early_stop_margin))
       j = take_steps(check.step_count);
-    if (j.verdict == CheckVerdict::kUnresolved && check.widen_steps) {
+    const bool weak_pass = j.verdict == CheckVerdict::kPass && j.margin < check.widen_below_margin;
+    if ((j.verdict == CheckVerdict::kUnresolved || weak_pass) && check.widen_steps) {
       // Larger steps, where the perturbed input may leave the scene's valid
       // range or the solver's reach: such a difference counts as non-finite.
       const double w30 = 30.0 * check.largest_step, w3 = 3.0 * check.largest_step;
@@ -308,7 +311,9 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
       wider.push_back({w3, (loss[2] - loss[3]) / (2 * w3), rounding / w3, solve_bound / w3});
       wider.insert(wider.end(), differences.begin(), differences.end());
       const DerivativeJudgement widened = JudgeDerivative(analytic, wider, check.tolerance);
-      if (widened.verdict == CheckVerdict::kPass || widened.floor < j.floor) j = widened;
+      if (weak_pass ? widened.verdict == CheckVerdict::kPass && widened.margin > j.margin
+                    : widened.verdict == CheckVerdict::kPass || widened.floor < j.floor)
+        j = widened;
     }
     CheckVerdict verdict = j.verdict;
     std::string reason = j.reason;

@@ -115,6 +115,11 @@ struct GradCheckOptions {
   // as non-finite: noise falls as 1/e, and the Richardson estimate tells
   // whether truncation allows the larger step.
   bool widen_steps = true;
+  // With widen_steps, differences that pass with a margin below this are
+  // widened too, and the wider judgement kept where it passes with a larger
+  // margin (a derivative the loss's rounding nearly buries, e.g. a material
+  // parameter over a few tiny steps). Finite and >= 1.
+  double widen_below_margin = 10;
   // Compare with the forward-mode tangent (Simulator::Tangents) of the
   // checked rollout; where the differences do not decide, it does (see above).
   bool tangent = true;

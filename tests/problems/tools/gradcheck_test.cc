@@ -4,7 +4,8 @@
 // inaccurate adjoint fails, and says against what; where the differences
 // cannot resolve a derivative with margin (h = 1e-5 s) the forward-mode
 // tangent decides it; differences hold the checked rollout's quad faces and
-// resolve across their jumps; perturbed rollouts run three at once give the same
+// resolve across their jumps; a weak pass is widened where wider steps
+// resolve it better; perturbed rollouts run three at once give the same
 // verdicts; the reports carry the result's numbers; bad options are refused
 // with exact messages.
 #include "tools/gradcheck.h"
@@ -17,6 +18,7 @@
 #include "diffpd/error.h"
 #include "diffpd/quad_hydrodynamics.h"
 #include "diffpd/simulator.h"
+#include "problem_registry.h"
 #include "test_scenes.h"
 #include "util/expect_message.h"
 
@@ -157,6 +159,41 @@ TEST(GradCheckTest, DifferencesHoldTheCheckedRolloutsQuadFacesAndResolveAcrossTh
   for (const auto& e : d.inputs) EXPECT_EQ(e.basis, "differences") << e.input;
 }
 
+// Semi-implicit Euler on calibrate-plant at h = 1e-4 s: over three tiny
+// steps Poisson's ratio barely moves the loss, and its differences at the
+// usual steps pass with a margin of only 5.7 (the loss's rounding). Where a
+// pass's margin is below widen_below_margin the check also takes the two
+// wider steps, whose noise is 3x and 30x lower, and keeps them where they
+// pass with a larger margin: 17 here, still on the differences.
+TEST(GradCheckTest, AWeakPassIsWidenedWhereWiderStepsResolveItBetter) {
+  const auto problem = MakeProblem("calibrate-plant");
+  SolverOptions options;
+  options.method = Method::kSemiImplicit;
+  options.time_step = 1e-4;
+  options.num_threads = 1;
+  const Scene scene = problem->MakeScene();
+  Simulator sim(scene, options);
+  const State initial = problem->InitialState(sim);
+  auto poissons_ratio = [](const GradCheckResult& r) {
+    for (const auto& e : r.inputs)
+      if (e.input == "poissons_ratio") return e;
+    ADD_FAILURE() << "no poissons_ratio row";
+    return GradCheckInput();
+  };
+  GradCheckOptions check;
+  check.widen_below_margin = 1;  // only unresolved inputs are widened
+  const GradCheckInput narrow = poissons_ratio(CheckRolloutGradient(scene, options, initial, 3, check));
+  EXPECT_EQ(narrow.verdict, CheckVerdict::kPass);
+  EXPECT_LT(narrow.margin, 10.0);
+  check.widen_below_margin = GradCheckOptions().widen_below_margin;
+  const GradCheckResult r = CheckRolloutGradient(scene, options, initial, 3, check);
+  const GradCheckInput wide = poissons_ratio(r);
+  EXPECT_EQ(wide.verdict, CheckVerdict::kPass) << GradCheckTable(r);
+  EXPECT_EQ(wide.basis, "differences") << GradCheckTable(r);
+  EXPECT_GE(wide.margin, 10.0) << GradCheckTable(r);
+  EXPECT_GT(wide.step, narrow.step) << "a wider step decided";
+}
+
 TEST(GradCheckTest, TableAndJsonReportTheResult) {
   GradCheckOptions check;
   check.directions = 1;
@@ -254,6 +291,10 @@ TEST(GradCheckTest, InvalidOptionsAreRefusedWithExactMessages) {
   o.early_stop_margin = 0.5;
   EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }),
             "early_stop_margin = 0.5 is invalid: must be 0 or finite and >= 1");
+  o = GradCheckOptions();
+  o.widen_below_margin = 0.5;
+  EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }),
+            "widen_below_margin = 0.5 is invalid: must be finite and >= 1");
   o = GradCheckOptions();
   o.decisive_margin = 0.5;
   EXPECT_EQ(testing::MessageOf<InvalidInputError>([&] { o.Validate(); }),
