@@ -143,6 +143,9 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   GradCheckResult result;
   result.method = ToString(options.method);
   result.tolerance = check.tolerance;
+  result.time_step = h;
+  if (options.method == Method::kSemiImplicit)
+    result.explicit_stable_time_step = sim.ExplicitStableTimeStep(initial.x, inputs.front().activation);
   result.reference = check.reference.value_or(UsesReferenceByDefault(options.method));
   result.tangent = check.tangent;
   RolloutGradient reference;
@@ -603,6 +606,13 @@ std::string GradCheckTable(const GradCheckResult& r) {
                 r.reference ? "; reference: newton-cholesky" : "");
   out += line;
   if (!r.reference_failure.empty()) out += "# the Newton-Cholesky reference failed: " + r.reference_failure + "\n";
+  if (r.time_step > r.explicit_stable_time_step) {
+    std::snprintf(line, sizeof(line),
+                  "# unstable: h = %g s is %.3g x semi-implicit Euler's stability limit at the initial state (%.3g s): "
+                  "the rollout grows without bound and the gradient is that of a diverging trajectory\n",
+                  r.time_step, r.time_step / r.explicit_stable_time_step, r.explicit_stable_time_step);
+    out += line;
+  }
   return out;
 }
 
@@ -636,6 +646,7 @@ nlohmann::json GradCheckToJson(const GradCheckResult& r) {
           {"fail", r.Count(CheckVerdict::kFail)},
           {"unresolved", r.Count(CheckVerdict::kUnresolved)},
           {"perturbed_rollouts", r.perturbed_rollouts},
+          {"explicit_stable_time_step", number(r.explicit_stable_time_step)},
           {"inputs", inputs}};
 }
 

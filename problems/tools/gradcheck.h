@@ -81,6 +81,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -176,6 +177,12 @@ struct GradCheckResult {
   double max_error = 0;                        // over the inputs
   double min_margin = 0;                       // over the inputs
   long perturbed_rollouts = 0;                 // rollouts simulated for the differences (the check's cost)
+  // Semi-implicit only (NaN otherwise): its stability limit at the initial
+  // state (Simulator::ExplicitStableTimeStep, s) and the checked step h (s).
+  // Above it the rollout grows without bound: the gradient is that of a
+  // diverging trajectory, and the table and JSON say so.
+  double explicit_stable_time_step = std::numeric_limits<double>::quiet_NaN();
+  double time_step = 0;
 
   int Count(CheckVerdict verdict) const;
 };

@@ -194,6 +194,35 @@ TEST(GradCheckTest, AWeakPassIsWidenedWhereWiderStepsResolveItBetter) {
   EXPECT_GT(wide.step, narrow.step) << "a wider step decided";
 }
 
+// Semi-implicit Euler on calibrate-cantilever at its own step, 0.005 s:
+// 5.8 x the stability limit at the initial state (8.6e-4 s), so the rollout
+// grows without bound though three steps do not yet stop it. The check
+// says so in its table and JSON; at 1e-4 s it does not.
+TEST(GradCheckTest, ASemiImplicitCheckAboveTheStabilityLimitSaysItIsUnstable) {
+  const auto problem = MakeProblem("calibrate-cantilever");
+  SolverOptions options;
+  options.method = Method::kSemiImplicit;
+  options.time_step = problem->default_time_step();
+  options.num_threads = 1;
+  const Scene scene = problem->MakeScene();
+  Simulator sim(scene, options);
+  const State initial = problem->InitialState(sim);
+  GradCheckOptions check;
+  check.directions = 1;
+  const GradCheckResult above = CheckRolloutGradient(scene, options, initial, 3, check);
+  EXPECT_NEAR(above.explicit_stable_time_step, 8.6e-4, 0.1e-4);
+  EXPECT_NE(GradCheckTable(above).find("# unstable: h = 0.005 s is 5.81 x semi-implicit Euler's stability limit at "
+                                       "the initial state (0.00086 s): the rollout grows without bound"),
+            std::string::npos)
+      << GradCheckTable(above);
+  EXPECT_EQ(GradCheckToJson(above)["explicit_stable_time_step"].get<double>(), above.explicit_stable_time_step);
+  options.time_step = 1e-4;
+  Simulator fine(scene, options);
+  const GradCheckResult below = CheckRolloutGradient(scene, options, problem->InitialState(fine), 3, check);
+  EXPECT_EQ(GradCheckTable(below).find("# unstable"), std::string::npos) << GradCheckTable(below);
+  EXPECT_EQ(below.Count(CheckVerdict::kFail), 0) << GradCheckTable(below);
+}
+
 TEST(GradCheckTest, TableAndJsonReportTheResult) {
   GradCheckOptions check;
   check.directions = 1;
