@@ -66,7 +66,10 @@
 // meeting the water: every perturbed rollout, and the reference, holds each
 // step's faces at the checked rollout's (StepInput::wetted_quads), so that
 // the differences are those of the checked rollout's smooth piece, whose
-// derivative the adjoint is.
+// derivative the adjoint is. That piece still has a kink where a wetted
+// face's relative velocity passes through zero (|u| u): differences whose
+// perturbed rollouts reversed one cannot fail an input (it is unresolved,
+// the reason counts them, and the tangent decides).
 //
 // Reference: for the iterative methods (pd, pd-lbfgs, newton-pcg) by
 // default, the same loss's gradient from a Newton-Cholesky rollout at

@@ -184,4 +184,10 @@ std::vector<char> WettedQuads(const QuadHydrodynamics& water, const VectorXd& x,
   return wetted;
 }
 
+Eigen::Matrix3Xd QuadRelativeVelocities(const QuadHydrodynamics& water, const VectorXd& v) {
+  Eigen::Matrix3Xd u(3, water.quads.cols());
+  for (int f = 0; f < static_cast<int>(water.quads.cols()); ++f) u.col(f) = internal::QuadRelativeVelocity(v, water, f);
+  return u;
+}
+
 }  // namespace diffpd
