@@ -38,6 +38,25 @@ GradCheckResult Check(const SolverOptions& options, const GradCheckOptions& chec
   return CheckRolloutGradient(scene, options, testing::MovingStart(sim), 3, check);
 }
 
+// A registered problem's scene and initial state with semi-implicit Euler at
+// step h (0: the problem's own), one thread.
+struct SemiImplicitCase {
+  Scene scene;
+  SolverOptions options;
+  State initial;
+};
+SemiImplicitCase SemiImplicit(const std::string& name, double h = 0) {
+  const auto problem = MakeProblem(name);
+  SemiImplicitCase c;
+  c.options.method = Method::kSemiImplicit;
+  c.options.time_step = h > 0 ? h : problem->default_time_step();
+  c.options.num_threads = 1;
+  c.scene = problem->MakeScene();
+  Simulator sim(c.scene, c.options);
+  c.initial = problem->InitialState(sim);
+  return c;
+}
+
 class GradCheckMethodTest : public ::testing::TestWithParam<Method> {};
 
 TEST_P(GradCheckMethodTest, EveryInputKindPassesWithAMarginOfAtLeastTen) {
@@ -166,14 +185,10 @@ TEST(GradCheckTest, DifferencesHoldTheCheckedRolloutsQuadFacesAndResolveAcrossTh
 // wider steps, whose noise is 3x and 30x lower, and keeps them where they
 // pass with a larger margin: 17 here, still on the differences.
 TEST(GradCheckTest, AWeakPassIsWidenedWhereWiderStepsResolveItBetter) {
-  const auto problem = MakeProblem("calibrate-plant");
-  SolverOptions options;
-  options.method = Method::kSemiImplicit;
-  options.time_step = 1e-4;
-  options.num_threads = 1;
-  const Scene scene = problem->MakeScene();
-  Simulator sim(scene, options);
-  const State initial = problem->InitialState(sim);
+  const SemiImplicitCase c = SemiImplicit("calibrate-plant", 1e-4);
+  const Scene& scene = c.scene;
+  const SolverOptions& options = c.options;
+  const State& initial = c.initial;
   auto poissons_ratio = [](const GradCheckResult& r) {
     for (const auto& e : r.inputs)
       if (e.input == "poissons_ratio") return e;
@@ -199,26 +214,18 @@ TEST(GradCheckTest, AWeakPassIsWidenedWhereWiderStepsResolveItBetter) {
 // grows without bound though three steps do not yet stop it. The check
 // says so in its table and JSON; at 1e-4 s it does not.
 TEST(GradCheckTest, ASemiImplicitCheckAboveTheStabilityLimitSaysItIsUnstable) {
-  const auto problem = MakeProblem("calibrate-cantilever");
-  SolverOptions options;
-  options.method = Method::kSemiImplicit;
-  options.time_step = problem->default_time_step();
-  options.num_threads = 1;
-  const Scene scene = problem->MakeScene();
-  Simulator sim(scene, options);
-  const State initial = problem->InitialState(sim);
+  const SemiImplicitCase own = SemiImplicit("calibrate-cantilever");
   GradCheckOptions check;
   check.directions = 1;
-  const GradCheckResult above = CheckRolloutGradient(scene, options, initial, 3, check);
+  const GradCheckResult above = CheckRolloutGradient(own.scene, own.options, own.initial, 3, check);
   EXPECT_NEAR(above.explicit_stable_time_step, 8.6e-4, 0.1e-4);
   EXPECT_NE(GradCheckTable(above).find("# unstable: h = 0.005 s is 5.81 x semi-implicit Euler's stability limit at "
                                        "the initial state (0.00086 s): the rollout grows without bound"),
             std::string::npos)
       << GradCheckTable(above);
   EXPECT_EQ(GradCheckToJson(above)["explicit_stable_time_step"].get<double>(), above.explicit_stable_time_step);
-  options.time_step = 1e-4;
-  Simulator fine(scene, options);
-  const GradCheckResult below = CheckRolloutGradient(scene, options, problem->InitialState(fine), 3, check);
+  const SemiImplicitCase fine = SemiImplicit("calibrate-cantilever", 1e-4);
+  const GradCheckResult below = CheckRolloutGradient(fine.scene, fine.options, fine.initial, 3, check);
   EXPECT_EQ(GradCheckTable(below).find("# unstable"), std::string::npos) << GradCheckTable(below);
   EXPECT_EQ(below.Count(CheckVerdict::kFail), 0) << GradCheckTable(below);
 }
@@ -231,14 +238,10 @@ TEST(GradCheckTest, ASemiImplicitCheckAboveTheStabilityLimitSaysItIsUnstable) {
 // a floor of 1.9e-5 without this rule) cannot fail an input: it is
 // unresolved with the reversing rollouts counted, and the tangent decides.
 TEST(GradCheckTest, DifferencesAcrossAFacesZeroRelativeVelocityCannotFailAnInput) {
-  const auto problem = MakeProblem("starfish-control");
-  SolverOptions options;
-  options.method = Method::kSemiImplicit;
-  options.time_step = 1e-4;
-  options.num_threads = 1;
-  const Scene scene = problem->MakeScene();
-  Simulator sim(scene, options);
-  const State initial = problem->InitialState(sim);
+  const SemiImplicitCase c = SemiImplicit("starfish-control", 1e-4);
+  const Scene& scene = c.scene;
+  const SolverOptions& options = c.options;
+  const State& initial = c.initial;
   GradCheckOptions check;
   check.tangent = false;
   check.concurrent_rollouts = 2;
