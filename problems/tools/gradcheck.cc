@@ -349,14 +349,18 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
       reason += "; " + std::to_string(set_changes - changes_before) +
                 " perturbed rollouts changed the contact active set or failed (no difference there)";
     // Differences across a wetted face's zero relative velocity straddle the
-    // force's kink (|u| u, the angle's jump): they cannot fail an input.
-    if (face_reversals > reversals_before && verdict == CheckVerdict::kFail) {
+    // force's kink (|u| u, the angle's jump): they cannot fail an input, and
+    // decide alone only with a margin of at least widen_below_margin.
+    const int reversals = face_reversals - reversals_before;
+    const std::string kink = std::to_string(reversals) +
+                             " perturbed rollouts reversed a wetted quad face's relative velocity (the force is not "
+                             "smooth where it passes through zero)";
+    if (reversals > 0 && verdict == CheckVerdict::kFail) {
       verdict = CheckVerdict::kUnresolved;
-      reason = std::to_string(face_reversals - reversals_before) +
-               " perturbed rollouts reversed a wetted quad face's relative velocity (the force is not smooth where "
-               "it passes through zero); differences: " +
-               reason;
+      reason = kink + "; differences: " + reason;
     }
+    const double decisive =
+        reversals > 0 ? std::max(check.decisive_margin, check.widen_below_margin) : check.decisive_margin;
     std::string basis = "differences";
     double margin = j.margin;
     double tangent_error = std::numeric_limits<double>::quiet_NaN();
@@ -365,8 +369,7 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
       tangent_error = scale > 0 ? std::abs(analytic - tangent_value) / scale : 0.0;
       entry->tangent_error = std::max(entry->tangent_error, tangent_error);
     }
-    const bool weak =
-        verdict == CheckVerdict::kUnresolved || (verdict == CheckVerdict::kPass && j.margin < check.decisive_margin);
+    const bool weak = verdict == CheckVerdict::kUnresolved || (verdict == CheckVerdict::kPass && j.margin < decisive);
     const bool tangent_decides = weak && std::isfinite(tangent_error);
     const double tangent_margin =
         tangent_error > 0 ? check.tolerance / tangent_error : std::numeric_limits<double>::infinity();
@@ -376,7 +379,8 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
       margin = tangent_margin;
       reason = (j.verdict == CheckVerdict::kPass ? "differences pass with margin " + Format(j.margin) + " only"
                                                  : "differences unresolved (" + j.reason + ")") +
-               "; agrees with the forward-mode tangent to " + Format(tangent_error);
+               (reversals > 0 ? "; " + kink : "") + "; agrees with the forward-mode tangent to " +
+               Format(tangent_error);
     } else if (tangent_decides && tangent_error > check.tolerance && verdict == CheckVerdict::kUnresolved &&
                IsDirectNewton(options.method)) {
       verdict = CheckVerdict::kFail;

@@ -69,7 +69,8 @@
 // derivative the adjoint is. That piece still has a kink where a wetted
 // face's relative velocity passes through zero (|u| u): differences whose
 // perturbed rollouts reversed one cannot fail an input (it is unresolved,
-// the reason counts them, and the tangent decides).
+// the reason counts them, and the tangent decides), and decide alone only
+// where they pass with a margin of at least widen_below_margin.
 //
 // Reference: for the iterative methods (pd, pd-lbfgs, newton-pcg) by
 // default, the same loss's gradient from a Newton-Cholesky rollout at
