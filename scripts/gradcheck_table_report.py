@@ -7,7 +7,8 @@ A row per problem and method in the order given: the verdict, the smallest
 margin and per input kind "verdict error / floor" (or "tangent ERROR (floor
 FLOOR)" where the forward-mode tangent decided; "(k/n by tangent)" where it
 decided k of the n directions, the error and floor being the others'), the
-run's seconds; a semi-implicit run above its stability limit says "unstable"; runs stopped by their time limit say "timeout", runs that ended
+run's seconds; a semi-implicit run above its stability limit says "unstable", a run at a looser tolerance than
+requested (the method did not reach it) says which; runs stopped by their time limit say "timeout", runs that ended
 with an error give its last line. An error or floor the differences could not measure (every
 perturbed rollout left the contact piece) reads "inf".
 """
@@ -47,6 +48,9 @@ def table(rows):
         limit, h = res.get("explicit_stable_time_step"), res.get("time_step")
         if limit is not None and h is not None and h > limit:
             verdict += f" (unstable: h {h / limit:.2g}x its stability limit)"
+        requested, used = res.get("requested_rel_tolerance"), res.get("rel_tolerance")
+        if requested is not None and used is not None and used != requested:
+            verdict += f" (at rtol {used:g}: {requested:g} not reached)"
         cells = [cell(res["inputs"][k]) if k in res["inputs"] else "" for k in kinds]
         lines.append(f"| {r['problem']} | {r['method']} | {verdict} | "
                      f"{'inf' if margin is None else format(margin, '.3g')} | {' | '.join(cells)} | "

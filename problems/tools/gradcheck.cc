@@ -610,6 +610,23 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   return result;
 }
 
+GradCheckResult CheckRolloutGradientAtReachableTolerance(const Scene& scene, const SolverOptions& options,
+                                                         const State& initial, int steps, const GradCheckOptions& check,
+                                                         double loosest_rel_tolerance, double* used_rel_tolerance) {
+  SolverOptions o = options;
+  for (;;) {
+    try {
+      GradCheckResult r = CheckRolloutGradient(scene, o, initial, steps, check);
+      if (used_rel_tolerance) *used_rel_tolerance = o.rel_tolerance;
+      return r;
+    } catch (const SolverError& e) {
+      // 1.001: the products of 100 carry rounding.
+      if (e.status() != SolverStatus::kMaxIterations || o.rel_tolerance * 100 > 1.001 * loosest_rel_tolerance) throw;
+      o.rel_tolerance *= 100;
+    }
+  }
+}
+
 std::string GradCheckTable(const GradCheckResult& r) {
   std::string out;
   char line[512];

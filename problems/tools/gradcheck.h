@@ -198,6 +198,17 @@ struct GradCheckResult {
 GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& options, const State& initial, int steps,
                                      const GradCheckOptions& check = GradCheckOptions());
 
+// CheckRolloutGradient at options.rel_tolerance or, where the checked
+// method cannot reach it within options.max_iterations (SolverError with
+// status kMaxIterations: plain pd's linear convergence on a stiff beam), at
+// the tightest of rel_tolerance x 100, x 10^4, ... up to loosest_rel_tolerance
+// that it reaches; its differences' floor then follows that tolerance.
+// *used_rel_tolerance (if not null) receives the tolerance checked at.
+// Rethrows the last SolverError where none is reached, and any other.
+GradCheckResult CheckRolloutGradientAtReachableTolerance(const Scene& scene, const SolverOptions& options,
+                                                         const State& initial, int steps, const GradCheckOptions& check,
+                                                         double loosest_rel_tolerance, double* used_rel_tolerance);
+
 // The solve tolerance `diffpd gradcheck` recommends for a method: tight enough
 // that the differences resolve the gradient to well within 1e-4.
 double RecommendedGradCheckRelTolerance(Method method);
