@@ -170,3 +170,10 @@ def test_holding_a_rollouts_own_quad_faces_reproduces_it_and_a_wrong_hold_is_ref
     assert str(info.value) == (
         f"wetted_quads: x and v must have the same length, a multiple of 3 (got {sim.num_dofs - 3} and {sim.num_dofs})"
     )
+    short_x = start.x[:-3]
+    with pytest.raises(diffpd.InvalidInputError) as info:
+        diffpd.wetted_quads(water, short_x, start.v[:-3])
+    nodes = sim.num_dofs // 3 - 1
+    assert str(info.value) == (
+        f"wetted_quads: water.quads has node indices outside [0, {nodes}) for x of {3 * nodes} entries"
+    )
