@@ -9,7 +9,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-PACKAGES=(g++ make cmake pkg-config libeigen3-dev libsuitesparse-dev libmetis-dev libceres-dev
+PACKAGES=(g++ make cmake ninja-build pkg-config libeigen3-dev libsuitesparse-dev libmetis-dev libceres-dev
           coinor-libipopt-dev libgtest-dev libgmock-dev libomp-dev libcli11-dev nlohmann-json3-dev
           gnuplot-nox tetgen clang-format git libopenmpi-dev openmpi-bin clang libclang-rt-14-dev python3-dev
           pybind11-dev python3-numpy python3-scipy python3-pytest python3-torch)
@@ -96,5 +96,10 @@ JOBS="${DIFFPD_BUILD_JOBS:-$(nproc)}"
 say "building (Release) into build/ with $JOBS jobs"
 # The Python package is built for Debian's interpreter, the one the packages
 # above (NumPy, pytest, PyTorch) belong to, whatever python3 comes first on PATH.
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >&2
+# Ninja for a new build directory (an existing one keeps its generator): it
+# schedules every target's files over the jobs, where the Makefiles wait for
+# each library before compiling what uses it.
+generator=()
+if [ ! -f build/CMakeCache.txt ]; then generator=(-G Ninja); fi
+cmake -S . -B build "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >&2
 cmake --build build -j "$JOBS" "$@" >&2
