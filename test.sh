@@ -11,7 +11,7 @@
 # The sanitized tests are a second build and take about 0.45 times as long as
 # everything before them (the scope `core` about 1.25 times, before Ninja). DIFFPD_SANITIZE
 # chooses:
-#   auto (default)  run them when the time so far times 1.5 (times 2.3 for
+#   auto (default)  run them when the time so far times 1.45 (times 2.3 for
 #                   the scope core or all) fits within
 #                   DIFFPD_TIME_BUDGET_MINUTES (default 45); otherwise say so
 #                   and skip them, so that the command ends within the budget
@@ -48,7 +48,7 @@ if [ "$sanitize" = auto ]; then
   # the sanitized tier took 0.44 (scope ci) and 1.25 (scope core, before the
   # build used Ninja) times the phases before it.
   so_far=$((SECONDS - start))
-  factor=150
+  factor=145
   [ "$scope" = ci ] || factor=230
   projected=$((so_far * factor / 100))
   if [ "$projected" -le $((budget_min * 60)) ]; then
