@@ -9,8 +9,8 @@
 # =all the whole suite, a second full build).
 #
 # The sanitized tests are a second build and take about 0.45 times as long as
-# everything before them (the scope `core` about 1.25 times, before Ninja). DIFFPD_SANITIZE
-# chooses:
+# everything before them (the scope `core` took 1.25 times, measured with
+# Makefiles and a static library). DIFFPD_SANITIZE chooses:
 #   auto (default)  run them when the time so far times 1.45 (times 2.3 for
 #                   the scope core or all) fits within
 #                   DIFFPD_TIME_BUDGET_MINUTES (default 45); otherwise say so
