@@ -140,7 +140,7 @@ differences do not pass with a margin of 3, the forward-mode tangent of the
 same states (the tangent column) decides; the basis column says which did.
 For the iterative methods the gradient is also compared with a
 Newton-Cholesky rollout's at rel_tolerance 1e-12 (the reference column).
-The solves run at --rtol (default 1e-11; pd 1e-10 with up to 5000
+The solves run at --rtol (default 1e-11; pd 1e-10 with up to 10000
 iterations per step; a method that does not reach it is checked at the
 tightest of 100x, 10^4x, ... up to 1e-6 it reaches, and says so), the
 perturbed rollouts one at a time unless

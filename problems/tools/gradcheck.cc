@@ -98,7 +98,7 @@ double RecommendedGradCheckRelTolerance(Method method) {
 }
 
 int RecommendedGradCheckMaxIterations(Method method) {
-  return method == Method::kPd ? 5000 : SolverOptions().max_iterations;
+  return method == Method::kPd ? 10000 : SolverOptions().max_iterations;
 }
 
 GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& options, const State& initial, int steps,

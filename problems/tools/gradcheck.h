@@ -212,10 +212,11 @@ GradCheckResult CheckRolloutGradientAtReachableTolerance(const Scene& scene, con
 // The solve tolerance `diffpd gradcheck` recommends for a method: tight enough
 // that the differences resolve the gradient to well within 1e-4.
 double RecommendedGradCheckRelTolerance(Method method);
-// The iteration limit per step `diffpd gradcheck` gives a method's solves: 5000
-// for pd, whose local-global iteration converges linearly (the library's
-// default of 1000 stops it short of 1e-10 on the routing tendon, bunny,
-// quadruped and cow), 1000 (the default) for the others.
+// The iteration limit per step `diffpd gradcheck` gives a method's solves:
+// 10000 for pd, whose local-global iteration converges linearly (the
+// library's default of 1000 stops it short of 1e-10 on the routing tendon,
+// bunny, quadruped and cow; on the full cantilever it takes about 7200 per
+// step), 1000 (the default) for the others.
 int RecommendedGradCheckMaxIterations(Method method);
 
 // Reports made from a result: a table (one line per input and a summary
