@@ -1,5 +1,6 @@
 // `diffpd gradcheck`: rollout gradients vs central finite differences, a
 // verdict per input kind (tools/gradcheck.h).
+#include <chrono>
 #include <cstdio>
 
 #include <nlohmann/json.hpp>
@@ -27,9 +28,18 @@ int GradcheckCommand(const CommandArgs& args, const GradCheckOptions& check) {
                ToString(options.method), steps, options.time_step, options.rel_tolerance);
   // A method that cannot reach the recommended tolerance on this problem
   // within its iterations is checked at the tightest it reaches (up to 1e-6).
+  // A line per judged direction: a check of a slow method runs for an hour.
+  GradCheckOptions with_progress = check;
+  const auto start = std::chrono::steady_clock::now();
+  with_progress.progress = [&](const GradCheckProgress& p) {
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "gradcheck %s: %s direction %d of %d: %s, margin %.3g (%s); %ld perturbed rollouts, %.0f s\n",
+                 problem->name().c_str(), p.input.c_str(), p.direction, p.directions, ToString(p.verdict), p.margin,
+                 p.basis.c_str(), p.perturbed_rollouts, seconds);
+  };
   double rel_tolerance = options.rel_tolerance;
   const GradCheckResult result =
-      CheckRolloutGradientAtReachableTolerance(scene, options, initial, steps, check, 1e-6, &rel_tolerance);
+      CheckRolloutGradientAtReachableTolerance(scene, options, initial, steps, with_progress, 1e-6, &rel_tolerance);
   if (rel_tolerance != options.rel_tolerance)
     std::fprintf(stderr,
                  "gradcheck %s: %s does not reach rtol %g within %d iterations per step; checked at rtol %g, the "

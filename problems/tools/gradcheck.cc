@@ -290,7 +290,7 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   // One direction of one input kind: perturbed(e) is the loss with the input
   // moved by e (units of its scale along the direction); analytic and
   // reference are the derivatives along the same.
-  auto record = [&](const std::string& name, long entries, double analytic, double reference_value,
+  auto record = [&](const std::string& name, long entries, int directions, double analytic, double reference_value,
                     double tangent_value, const std::function<double(Simulator&, double)>& perturbed) {
     GradCheckInput* entry = nullptr;
     for (auto& e : result.inputs)
@@ -439,6 +439,8 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     }
     entry->verdict = first ? verdict : Worse(entry->verdict, verdict);
     entry->margin = std::min(entry->margin, margin);
+    if (check.progress)
+      check.progress({name, entry->directions, directions, verdict, margin, basis, result.perturbed_rollouts});
   };
   auto reference_dot = [&](const std::function<double(const RolloutGradient&)>& along) {
     return result.reference ? along(reference) : 0.0;
@@ -449,20 +451,22 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     auto along_x = [&](const RolloutGradient& g) { return g.x0.dot(dx); };
     InputDirection along_x0;
     along_x0.x0 = dx;
-    record("x0", n, along_x(grad), reference_dot(along_x), tangent_of(along_x0), [&](Simulator& worker, double e) {
-      State s = initial;
-      s.x += e * dx;
-      return rollout_loss(worker, s, inputs);
-    });
+    record("x0", n, check.directions, along_x(grad), reference_dot(along_x), tangent_of(along_x0),
+           [&](Simulator& worker, double e) {
+             State s = initial;
+             s.x += e * dx;
+             return rollout_loss(worker, s, inputs);
+           });
     const VectorXd dv = (size / h) * Direction(&rng, n);
     auto along_v = [&](const RolloutGradient& g) { return g.v0.dot(dv); };
     InputDirection along_v0;
     along_v0.v0 = dv;
-    record("v0", n, along_v(grad), reference_dot(along_v), tangent_of(along_v0), [&](Simulator& worker, double e) {
-      State s = initial;
-      s.v += e * dv;
-      return rollout_loss(worker, s, inputs);
-    });
+    record("v0", n, check.directions, along_v(grad), reference_dot(along_v), tangent_of(along_v0),
+           [&](Simulator& worker, double e) {
+             State s = initial;
+             s.v += e * dv;
+             return rollout_loss(worker, s, inputs);
+           });
     // A force that moves a node by about `size` in one step: m size / h^2.
     std::vector<VectorXd> df(steps);
     for (int i = 0; i < steps; ++i)
@@ -474,8 +478,8 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     };
     InputDirection along_forces;
     along_forces.external_force = df;
-    record("external_force", long(n) * steps, along_f(grad), reference_dot(along_f), tangent_of(along_forces),
-           [&](Simulator& worker, double e) {
+    record("external_force", long(n) * steps, check.directions, along_f(grad), reference_dot(along_f),
+           tangent_of(along_forces), [&](Simulator& worker, double e) {
              std::vector<StepInput> in = inputs;
              for (int i = 0; i < steps; ++i) in[i].external_force += e * df[i];
              return rollout_loss(worker, initial, in);
@@ -490,7 +494,7 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
       };
       InputDirection along_activations;
       along_activations.activation = da;
-      record("activation", long(num_muscles) * steps, along_a(grad), reference_dot(along_a),
+      record("activation", long(num_muscles) * steps, check.directions, along_a(grad), reference_dot(along_a),
              tangent_of(along_activations), [&](Simulator& worker, double e) {
                std::vector<StepInput> in = inputs;
                for (int i = 0; i < steps; ++i) in[i].activation += e * da[i];
@@ -505,7 +509,7 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   auto record_scene = [&](const std::string& name, double scale,
                           const std::function<double(const RolloutGradient&)>& derivative,
                           const std::function<void(Scene*, double)>& perturb, const InputDirection& unit) {
-    record(name, 1, scale * derivative(grad), scale * reference_dot(derivative), scale * tangent_of(unit),
+    record(name, 1, 1, scale * derivative(grad), scale * reference_dot(derivative), scale * tangent_of(unit),
            [&](Simulator&, double e) {
              Scene p = scene;
              perturb(&p, e * scale);
@@ -573,7 +577,7 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
   auto record_material =
       [&](const std::string& name, double scale, const std::function<double(const RolloutGradient&)>& derivative,
           const std::function<void(MaterialParameters*, double)>& perturb, const InputDirection& unit) {
-        record(name, 1, scale * derivative(grad), scale * reference_dot(derivative), scale * tangent_of(unit),
+        record(name, 1, 1, scale * derivative(grad), scale * reference_dot(derivative), scale * tangent_of(unit),
                [&](Simulator& worker, double e) {
                  MaterialParameters m = material;
                  perturb(&m, e * scale);

@@ -84,6 +84,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <limits>
 #include <string>
@@ -97,6 +98,17 @@
 #include "tools/derivative_verdict.h"
 
 namespace diffpd::problems {
+
+// One direction of one input kind, judged (GradCheckOptions::progress).
+struct GradCheckProgress {
+  std::string input;                           // the input kind: "x0", "youngs_modulus", ...
+  int direction = 0;                           // which of its directions, from 1
+  int directions = 0;                          // how many it has (1 for a scalar parameter)
+  CheckVerdict verdict = CheckVerdict::kPass;  // this direction's
+  double margin = 0;                           // this direction's tolerance / max(error, floor)
+  std::string basis;                           // "differences" or "tangent"
+  long perturbed_rollouts = 0;                 // simulated so far in the whole check
+};
 
 struct GradCheckOptions {
   int directions = 2;          // random directions per input kind; >= 1
@@ -141,6 +153,9 @@ struct GradCheckOptions {
   // floors and margins at the differences' noise level differ from run to
   // run.
   int concurrent_rollouts = 1;
+  // Called on the calling thread after each direction is judged, e.g. to
+  // print progress through a long check; empty: not called. Must not throw.
+  std::function<void(const GradCheckProgress&)> progress;
 
   // Throws InvalidInputError naming the field, its value and the valid range.
   void Validate() const;

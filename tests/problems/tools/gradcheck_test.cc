@@ -6,14 +6,15 @@
 // tangent decides it; differences hold the checked rollout's quad faces and
 // resolve across their jumps; a weak pass is widened where wider steps
 // resolve it better; perturbed rollouts run three at once give the same
-// verdicts; the reports carry the result's numbers; bad options are refused
-// with exact messages.
+// verdicts; the reports and the progress calls carry the result's numbers;
+// bad options are refused with exact messages.
 #include "tools/gradcheck.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "diffpd/error.h"
 #include "diffpd/quad_hydrodynamics.h"
@@ -287,10 +288,25 @@ TEST(GradCheckTest, AMethodThatCannotReachTheToleranceIsCheckedAtTheTightestItRe
   EXPECT_THROW(CheckRolloutGradientAtReachableTolerance(scene, options, start, 3, check, 1e-6, &used), SolverError);
 }
 
-TEST(GradCheckTest, TableAndJsonReportTheResult) {
+TEST(GradCheckTest, TableJsonAndProgressReportTheResult) {
   GradCheckOptions check;
   check.directions = 1;
+  std::vector<GradCheckProgress> progress;
+  check.progress = [&](const GradCheckProgress& p) { progress.push_back(p); };
   const GradCheckResult r = Check(CheckOptions(Method::kNewtonCholesky), check);
+  // One progress report per judged direction, in the result's order, with
+  // its verdict and margin (one direction each here), the rollouts counting up.
+  ASSERT_EQ(progress.size(), r.inputs.size());
+  for (size_t i = 0; i < progress.size(); ++i) {
+    EXPECT_EQ(progress[i].input, r.inputs[i].input);
+    EXPECT_EQ(progress[i].direction, 1);
+    EXPECT_EQ(progress[i].directions, 1);
+    EXPECT_EQ(progress[i].verdict, r.inputs[i].verdict) << r.inputs[i].input;
+    EXPECT_EQ(progress[i].margin, r.inputs[i].margin) << r.inputs[i].input;
+    EXPECT_EQ(progress[i].basis, r.inputs[i].basis) << r.inputs[i].input;
+    EXPECT_GT(progress[i].perturbed_rollouts, i == 0 ? 0 : progress[i - 1].perturbed_rollouts);
+  }
+  EXPECT_EQ(progress.back().perturbed_rollouts, r.perturbed_rollouts);
   const nlohmann::json j = GradCheckToJson(r);
   EXPECT_EQ(j.at("method"), "newton-cholesky");
   EXPECT_EQ(j.at("verdict"), "pass");
