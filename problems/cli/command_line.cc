@@ -144,8 +144,11 @@ The solves run at --rtol (default 1e-11; pd 1e-10 with up to 10000
 iterations per step; a method that does not reach it is checked at the
 tightest of 100x, 10^4x, ... up to 1e-6 it reaches, and says so), the
 perturbed rollouts one at a time unless
---concurrent-rollouts says more. A line on stderr reports each direction as
-it is judged. Exit code 4 when an input fails.)");
+--concurrent-rollouts says more. Semi-implicit runs at the problem's step,
+or at half its stability limit at the initial state where the problem's step
+is above that (and says so); --dt sets the step for every method. A line on
+stderr reports each direction as it is judged. Exit code 4 when an input
+fails.)");
   const auto bench = AddBenchCommand(&app);
   const auto tradeoff = AddTradeoffCommand(&app);
   const auto stress = AddStressCommand(&app);

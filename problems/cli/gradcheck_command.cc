@@ -24,6 +24,15 @@ int GradcheckCommand(const CommandArgs& args, const GradCheckOptions& check) {
   const Scene scene = problem->MakeScene();
   Simulator sim(scene, options);
   const State initial = problem->InitialState(sim);
+  const double problem_time_step = options.time_step;
+  if (args.dt <= 0) {
+    options.time_step = RecommendedGradCheckTimeStep(scene, options, initial);
+    if (options.time_step != problem_time_step)
+      std::fprintf(stderr,
+                   "gradcheck %s: %s is unstable at the problem's step %g s (above half its stability limit at the "
+                   "initial state); checked at h = %g s (--dt sets the step)\n",
+                   problem->name().c_str(), ToString(options.method), problem_time_step, options.time_step);
+  }
   std::fprintf(stderr, "gradcheck %s: method %s, %d steps, h = %g s, rtol %g\n", problem->name().c_str(),
                ToString(options.method), steps, options.time_step, options.rel_tolerance);
   // A method that cannot reach the recommended tolerance on this problem
@@ -51,6 +60,7 @@ int GradcheckCommand(const CommandArgs& args, const GradCheckOptions& check) {
     out["problem"] = problem->name();
     out["steps"] = steps;
     out["time_step"] = options.time_step;
+    out["problem_time_step"] = problem_time_step;
     out["rel_tolerance"] = rel_tolerance;
     out["requested_rel_tolerance"] = options.rel_tolerance;
     std::printf("%s\n", out.dump(2).c_str());

@@ -97,6 +97,18 @@ double RecommendedGradCheckRelTolerance(Method method) {
   return method == Method::kPd ? 1e-10 : 1e-11;
 }
 
+double RecommendedGradCheckTimeStep(const Scene& scene, const SolverOptions& options, const State& initial) {
+  if (options.method != Method::kSemiImplicit) return options.time_step;
+  Simulator sim(scene, options);
+  const double half_limit =
+      0.5 *
+      sim.ExplicitStableTimeStep(initial.x, VectorXd::Constant(static_cast<Eigen::Index>(scene.muscles.size()), 0.9));
+  if (!(options.time_step > half_limit)) return options.time_step;
+  // Two significant digits, rounded down: a step that reads well.
+  const double unit = std::pow(10.0, std::floor(std::log10(half_limit)) - 1);
+  return std::floor(half_limit / unit) * unit;
+}
+
 int RecommendedGradCheckMaxIterations(Method method) {
   return method == Method::kPd ? 10000 : SolverOptions().max_iterations;
 }
