@@ -7,7 +7,8 @@ A row per problem and method in the order given: the verdict, the smallest
 margin and per input kind "verdict error / floor" (or "tangent ERROR (floor
 FLOOR)" where the forward-mode tangent decided; "(k/n by tangent)" where it
 decided k of the n directions, the error and floor being the others'), the
-run's seconds; a semi-implicit run above its stability limit says "unstable", a run at a looser tolerance than
+run's seconds; a semi-implicit run above its stability limit says "unstable", one at a step other than the
+problem's says which, a run at a looser tolerance than
 requested (the method did not reach it) says which; runs stopped by their time limit say "timeout", runs that ended
 with an error give its last line. An error or floor the differences could not measure (every
 perturbed rollout left the contact piece) reads "inf".
@@ -48,6 +49,9 @@ def table(rows):
         limit, h = res.get("explicit_stable_time_step"), res.get("time_step")
         if limit is not None and h is not None and h > limit:
             verdict += f" (unstable: h {h / limit:.2g}x its stability limit)"
+        problem_h = res.get("problem_time_step")
+        if problem_h is not None and h is not None and h != problem_h:
+            verdict += f" (at h = {h:g} s: the problem's {problem_h:g} s is above half its stability limit)"
         requested, used = res.get("requested_rel_tolerance"), res.get("rel_tolerance")
         if requested is not None and used is not None and used != requested:
             verdict += f" (at rtol {used:g}: {requested:g} not reached)"

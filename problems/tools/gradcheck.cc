@@ -105,8 +105,8 @@ double RecommendedGradCheckTimeStep(const Scene& scene, const SolverOptions& opt
       sim.ExplicitStableTimeStep(initial.x, VectorXd::Constant(static_cast<Eigen::Index>(scene.muscles.size()), 0.9));
   if (!(options.time_step > half_limit)) return options.time_step;
   // Two significant digits, rounded down: a step that reads well.
-  const double unit = std::pow(10.0, std::floor(std::log10(half_limit)) - 1);
-  return std::floor(half_limit / unit) * unit;
+  const double scale = std::pow(10.0, 1 - std::floor(std::log10(half_limit)));  // exact for the steps in use
+  return std::floor(half_limit * scale) / scale;
 }
 
 int RecommendedGradCheckMaxIterations(Method method) {

@@ -231,6 +231,32 @@ TEST(GradCheckTest, ASemiImplicitCheckAboveTheStabilityLimitSaysItIsUnstable) {
   EXPECT_EQ(below.Count(CheckVerdict::kFail), 0) << GradCheckTable(below);
 }
 
+// The step the check recommends: semi-implicit Euler above half its
+// stability limit (calibrate-cantilever's 0.005 s against 8.6e-4 s) is
+// checked at half the limit, two digits rounded down, where the check
+// passes every input and no longer says unstable; a step already below half
+// the limit, and every implicit method, keep theirs.
+TEST(GradCheckTest, SemiImplicitIsCheckedAtHalfItsStabilityLimitWhereTheProblemsStepIsAbove) {
+  SemiImplicitCase c = SemiImplicit("calibrate-cantilever");
+  Simulator sim(c.scene, c.options);
+  const double limit = sim.ExplicitStableTimeStep(c.initial.x);
+  const double h = RecommendedGradCheckTimeStep(c.scene, c.options, c.initial);
+  EXPECT_LE(h, 0.5 * limit);
+  EXPECT_GE(h, 0.45 * limit);
+  EXPECT_DOUBLE_EQ(h, 4.3e-4);
+  c.options.time_step = h;
+  GradCheckOptions check;
+  check.directions = 1;
+  const GradCheckResult r = CheckRolloutGradient(c.scene, c.options, c.initial, 3, check);
+  EXPECT_EQ(GradCheckTable(r).find("# unstable"), std::string::npos) << GradCheckTable(r);
+  EXPECT_EQ(r.verdict, CheckVerdict::kPass) << GradCheckTable(r);
+  c.options.time_step = 1e-4;
+  EXPECT_EQ(RecommendedGradCheckTimeStep(c.scene, c.options, c.initial), 1e-4);
+  c.options.time_step = 0.005;
+  c.options.method = Method::kPdLbfgs;
+  EXPECT_EQ(RecommendedGradCheckTimeStep(c.scene, c.options, c.initial), 0.005);
+}
+
 // Semi-implicit Euler at h = 1e-4 s on starfish-control, which starts at
 // rest in still water: over three tiny steps its faces move at about 1e-4
 // m/s, and the check's force and velocity perturbations reverse some of
