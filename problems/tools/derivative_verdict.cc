@@ -68,7 +68,20 @@ DerivativeJudgement JudgeDerivative(const std::vector<double>& analytic,
     double u = d.noise;
     if (k > 0) {
       const double r = differences[k - 1].step / d.step;
-      u = std::max(u, distance(differences[k - 1].value, d.value) / (r * r - 1));
+      const double inner = distance(differences[k - 1].value, d.value);
+      double divisor = r * r - 1;
+      if (k > 1) {
+        // First-order truncation: a loss that is C1 but not C2 in the input
+        // (|u| u drag on a body starting at rest, whose velocities the
+        // perturbation sets) makes fd(e) - fd(0) ~ e, not e^2. Where the
+        // differences shrink towards e_k as e but not as e^2 (by less than
+        // r^1.5 a step while still shrinking, so not noise, which grows as e
+        // falls), the truncation at e_k is their distance / (r - 1).
+        const double outer = distance(differences[k - 2].value, differences[k - 1].value);
+        const double r_outer = differences[k - 2].step / differences[k - 1].step;
+        if (outer > inner && outer < std::pow(r_outer, 1.5) * inner) divisor = r - 1;
+      }
+      u = std::max(u, inner / divisor);
     } else if (n > 1) {
       // No larger step: the truncation is at most the distance to the next
       // difference plus that difference's own noise (measured from the one

@@ -2,7 +2,7 @@
 // at several steps, each with an estimate of its noise.
 //
 // A central difference fd(e) = (L(+e) - L(-e)) / 2e errs by truncation,
-// O(e^2), and by the noise of the two evaluations of L: rounding (declared
+// O(e^2) (O(e) where L is C1 but not C2), and by the noise of the two evaluations of L: rounding (declared
 // as `noise`), and the residuals an iterative forward solve leaves. The
 // latter's worst case (`bound`, e.g. from the achieved residuals) is far
 // above what is seen, as the two evaluations' solves follow nearly the same
@@ -12,7 +12,13 @@
 //   noise(e_k)                                the declared rounding;
 //   |fd(e_k-1) - fd(e_k)| / (r^2 - 1)         its truncation error, measured
 //                                             Richardson-style from the larger
-//                                             step (for e_0, which has none:
+//                                             step; / (r - 1) where the
+//                                             distances of e_k-2, e_k-1 and
+//                                             e_k shrink by less than r^1.5
+//                                             (first-order truncation of a
+//                                             loss that is C1 but not C2,
+//                                             e.g. |u| u drag from rest)
+//                                             (for e_0, which has none:
 //                                             |fd(e_0) - fd(e_1)| plus the noise
 //                                             of fd(e_1), measured from e_2, as
 //                                             that noise can cancel the

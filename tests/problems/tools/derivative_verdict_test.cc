@@ -48,6 +48,35 @@ TEST(DerivativeVerdictTest, ACorrectDerivativeWithSmallNoisePassesWithItsMarginS
   }
 }
 
+// A loss that is C1 but not C2 (|x| x, as drag |u| u on a body that starts
+// at rest) has central differences that converge as e, not e^2: the floor
+// measured from the larger step must cover that, so the correct derivative
+// never fails, a wrong one still does, and a smooth loss keeps the
+// second-order estimate (its floors are those of r^2 - 1).
+TEST(DerivativeVerdictTest, FirstOrderTruncationIsCoveredByTheFloorAndCannotFailACorrectDerivative) {
+  auto kinked = [](double x) { return 2 * x + 5 * std::abs(x) * x; };  // at x = 0: fd(e) = 2 + 5 e
+  const auto d = Differences(kinked, 0.0, 0.0, 6, 1);
+  for (const double tolerance : {1e-4, 1e-5, 1e-6}) {
+    const DerivativeJudgement right = JudgeDerivative(2.0, d, tolerance);
+    EXPECT_NE(right.verdict, CheckVerdict::kFail) << tolerance << ": " << right.reason;
+    EXPECT_GE(right.floor, 0.9 * right.error) << tolerance;
+  }
+  const DerivativeJudgement wrong = JudgeDerivative(2.0 * (1 + 1e-3), d, 1e-4);
+  EXPECT_EQ(wrong.verdict, CheckVerdict::kFail) << wrong.reason;
+  // Smooth (truncation ~ e^2, no noise): the floor at the chosen step is the
+  // distance to the larger step / 99 or the smaller step's distance / 10.
+  auto smooth = [](double x) { return 2 * x + 5 * x * x * x; };  // fd(e) = 2 + 5 e^2
+  const auto s = Differences(smooth, 0.0, 0.0, 4, 1);
+  const DerivativeJudgement j = JudgeDerivative(2.0, s, 1e-4);
+  size_t k = 0;
+  while (s[k].step != j.step) ++k;
+  ASSERT_GT(k, 0u);
+  const double scale = std::max(std::abs(s[k].value), 2.0);
+  const double expected =
+      std::max(std::abs(s[k - 1].value - s[k].value) / 99, std::abs(s[k + 1].value - s[k].value) / 10);
+  EXPECT_NEAR(j.floor, expected / scale, 1e-3 * expected / scale);
+}
+
 TEST(DerivativeVerdictTest, ACorrectDerivativeUnderLargeNoiseIsUnresolvedWithTheFloor) {
   // Noise 1e-6 per evaluation: the best difference is good to ~1e-4 only.
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {

@@ -261,10 +261,12 @@ TEST(GradCheckTest, SemiImplicitIsCheckedAtHalfItsStabilityLimitWhereTheProblems
 // rest in still water: over three tiny steps its faces move at about 1e-4
 // m/s, and the check's force and velocity perturbations reverse some of
 // them, where the force is continuous but not smooth (|u| u, the angle's
-// jump). Differences across that kink (the external forces' 1.9e-4 against
-// a floor of 1.9e-5 without this rule) cannot fail an input: it is
-// unresolved with the reversing rollouts counted, and the tangent decides;
-// near that kink the differences decide alone only with a margin of 10.
+// jump). Differences across that kink cannot fail an input (the external
+// forces' error of 1.9e-4 against a floor of 1.9e-5 with a second-order
+// truncation estimate; the first-order one now gives 2.1e-4): an input they
+// do not pass is unresolved with the reversing rollouts counted, and the
+// tangent decides; near that kink the differences decide alone only with a
+// margin of 10.
 TEST(GradCheckTest, DifferencesAcrossAFacesZeroRelativeVelocityCannotFailAnInput) {
   const SemiImplicitCase c = SemiImplicit("starfish-control", 1e-4);
   const Scene& scene = c.scene;
