@@ -26,7 +26,7 @@ int GradcheckCommand(const CommandArgs& args, const GradCheckOptions& check) {
   const State initial = problem->InitialState(sim);
   const double problem_time_step = options.time_step;
   if (args.dt <= 0) {
-    options.time_step = RecommendedGradCheckTimeStep(scene, options, initial);
+    options.time_step = RecommendedGradCheckTimeStep(scene, sim, initial);
     if (options.time_step != problem_time_step)
       std::fprintf(stderr,
                    "gradcheck %s: %s is unstable at the problem's step %g s (above half its stability limit at the "

@@ -97,9 +97,9 @@ double RecommendedGradCheckRelTolerance(Method method) {
   return method == Method::kPd ? 1e-10 : 1e-11;
 }
 
-double RecommendedGradCheckTimeStep(const Scene& scene, const SolverOptions& options, const State& initial) {
+double RecommendedGradCheckTimeStep(const Scene& scene, Simulator& sim, const State& initial) {
+  const SolverOptions& options = sim.options();
   if (options.method != Method::kSemiImplicit) return options.time_step;
-  Simulator sim(scene, options);
   const double half_limit =
       0.5 *
       sim.ExplicitStableTimeStep(initial.x, VectorXd::Constant(static_cast<Eigen::Index>(scene.muscles.size()), 0.9));

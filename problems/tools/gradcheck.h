@@ -94,6 +94,7 @@
 
 #include "diffpd/rollout.h"
 #include "diffpd/scene.h"
+#include "diffpd/simulator.h"
 #include "diffpd/solver_options.h"
 #include "tools/derivative_verdict.h"
 
@@ -227,14 +228,15 @@ GradCheckResult CheckRolloutGradientAtReachableTolerance(const Scene& scene, con
 // The solve tolerance `diffpd gradcheck` recommends for a method: tight enough
 // that the differences resolve the gradient to well within 1e-4.
 double RecommendedGradCheckRelTolerance(Method method);
-// The time step `diffpd gradcheck` checks a method at, given the problem's
-// own in options.time_step (s): that step, except for semi-implicit Euler
+// The time step `diffpd gradcheck` checks a method at, given a simulator of
+// `scene` with the problem's own step in its options (s): that step, except
+// for semi-implicit Euler
 // where it is above half the stability limit at `initial`
 // (Simulator::ExplicitStableTimeStep with the muscles at 0.9, the check's
 // baseline): there half that limit, rounded down to two significant digits.
 // Above the limit the rollout grows without bound, and the limit ignores
 // damping, the state forces and the motion, hence the half.
-double RecommendedGradCheckTimeStep(const Scene& scene, const SolverOptions& options, const State& initial);
+double RecommendedGradCheckTimeStep(const Scene& scene, Simulator& sim, const State& initial);
 // The iteration limit per step `diffpd gradcheck` gives a method's solves:
 // 10000 for pd, whose local-global iteration converges linearly (the
 // library's default of 1000 stops it short of 1e-10 on the routing tendon,
