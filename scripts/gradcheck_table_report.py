@@ -26,6 +26,9 @@ def cell(e):
         return f"tangent {number(e['tangent_error'])} (floor {number(e['floor'])})"
     by_tangent = e.get("tangent_directions", 0)
     mixed = f" ({by_tangent}/{e['directions']} by tangent)" if 0 < by_tangent < e["directions"] else ""
+    extrapolated = e.get("extrapolated_directions", 0)
+    if extrapolated > 0:
+        mixed += f" ({extrapolated}/{e['directions']} extrapolated)"
     return f"{e['verdict']} {number(e['error'])} / {number(e['floor'])}{mixed}"
 
 

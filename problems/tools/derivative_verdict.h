@@ -41,6 +41,17 @@
 //              tolerance (floor > tolerance); `reason` gives the floor.
 // margin = tolerance / max(error, floor): how many times over the check
 // would still pass; >= 1 for every pass.
+//
+// With three or more differences the same is done once more on their
+// Richardson extrapolations x_k = fd(e_k) + (fd(e_k) - fd(e_k-1)) / d_k (d_k
+// the divisor above, r^2 - 1 or r - 1), which cancel the leading truncation
+// term; x_k's own truncation is |x_k-1 - x_k| / d_k, an over-estimate
+// wherever x converges faster than fd. The extrapolated judgement is taken
+// only where it passes with a larger margin than the differences' own and
+// its error is at most 3x its floor (a larger error says the floor is not
+// to be trusted: the loss is not smooth across the steps): it can confirm a
+// derivative whose differences are truncation-limited, never fail one or
+// leave it unresolved.
 #pragma once
 
 #include <string>
@@ -73,12 +84,14 @@ struct DerivativeJudgement {
   double tolerance = 0;  // the relative tolerance judged against
   double margin = 0;     // tolerance / max(error, floor); infinite when both are 0
   std::string reason;    // empty for a pass; why it failed or is unresolved
+  bool extrapolated = false;  // judged on the Richardson extrapolations (see above)
 };
 
 // `differences` in decreasing step order (at least one). tolerance > 0.
+// extrapolate: also judge the Richardson extrapolations (see above).
 // Throws std::invalid_argument on an empty list or a tolerance <= 0.
 DerivativeJudgement JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences,
-                                    double tolerance);
+                                    double tolerance, bool extrapolate = true);
 
 // The same for a vector-valued derivative (a Jacobian-vector product, a
 // whole Jacobian flattened): every |.| above is a 2-norm. Throws
@@ -90,6 +103,7 @@ struct FiniteDifferenceVector {
   double bound = 0;
 };
 DerivativeJudgement JudgeDerivative(const std::vector<double>& analytic,
-                                    const std::vector<FiniteDifferenceVector>& differences, double tolerance);
+                                    const std::vector<FiniteDifferenceVector>& differences, double tolerance,
+                                    bool extrapolate = true);
 
 }  // namespace diffpd::problems

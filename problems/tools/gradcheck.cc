@@ -338,8 +338,13 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     };
     const bool may_stop_early = check.early_stop_margin > 0 && kEarlyStopSteps < check.step_count;
     DerivativeJudgement j = take_steps(may_stop_early ? kEarlyStopSteps : check.step_count);
-    if (may_stop_early && !(j.verdict == CheckVerdict::kPass && j.margin >= check.early_stop_margin))
-      j = take_steps(check.step_count);
+    if (may_stop_early) {
+      // Decided on the differences themselves: an extrapolation from the
+      // first steps alone is less certain than the smaller steps would be.
+      const DerivativeJudgement first = JudgeDerivative(analytic, differences, check.tolerance, /*extrapolate=*/false);
+      if (!(first.verdict == CheckVerdict::kPass && first.margin >= check.early_stop_margin))
+        j = take_steps(check.step_count);
+    }
     const bool weak_pass = j.verdict == CheckVerdict::kPass && j.margin < check.widen_below_margin;
     if ((j.verdict == CheckVerdict::kUnresolved || weak_pass) && check.widen_steps) {
       // Larger steps, where the perturbed input may leave the scene's valid
@@ -439,6 +444,7 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     // or over all where the tangent decided every one.
     const bool by_tangent = basis == "tangent";
     entry->tangent_directions += by_tangent;
+    entry->extrapolated_directions += !by_tangent && j.extrapolated;
     const int by_differences = entry->directions - entry->tangent_directions;
     if (!by_tangent && by_differences == 1) {
       entry->error = j.error;
@@ -660,10 +666,13 @@ std::string GradCheckTable(const GradCheckResult& r) {
     cell(ref, e.reference_error);
     cell(tangent, e.tangent_error);
     // Where the tangent decided some directions but not all: how many.
-    const std::string basis = e.tangent_directions > 0 && e.tangent_directions < e.directions
-                                  ? e.basis + " (" + std::to_string(e.tangent_directions) + "/" +
-                                        std::to_string(e.directions) + " by tangent)"
-                                  : e.basis;
+    std::string basis = e.tangent_directions > 0 && e.tangent_directions < e.directions
+                            ? e.basis + " (" + std::to_string(e.tangent_directions) + "/" +
+                                  std::to_string(e.directions) + " by tangent)"
+                            : e.basis;
+    if (e.extrapolated_directions > 0)
+      basis += " (" + std::to_string(e.extrapolated_directions) + "/" + std::to_string(e.directions) +
+               " extrapolated)";
     std::snprintf(line, sizeof(line), "%-16s %10.2e %10.2e %10.3g %9.0e %10.2e %s %s %-11s %-11s %s\n", e.input.c_str(),
                   e.error, e.floor, e.margin, e.step, e.bound, ref, tangent, ToString(e.verdict), basis.c_str(),
                   e.reason.c_str());
@@ -702,6 +711,7 @@ nlohmann::json GradCheckToJson(const GradCheckResult& r) {
                        {"tangent_error", number(e.tangent_error)},
                        {"basis", e.basis},
                        {"tangent_directions", e.tangent_directions},
+                       {"extrapolated_directions", e.extrapolated_directions},
                        {"reason", e.reason},
                        {"entries", e.entries},
                        {"directions", e.directions}};

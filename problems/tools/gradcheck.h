@@ -23,8 +23,9 @@
 // difference's truncation and noise from its neighbours (Richardson-style),
 // adds the loss's rounding eps |(c_x,i x_i, |c_v,i| (|v_i| + |x_i| / h))|_2 / e
 // (rounding errors of independent sign), picks the step of least
-// uncertainty and gives the
-// verdict. The forward's achieved residuals r_k give the worst case of the
+// uncertainty and gives the verdict; where the differences are
+// truncation-limited, their Richardson extrapolations may confirm the
+// derivative with a larger margin (`extrapolated_directions` counts them). The forward's achieved residuals r_k give the worst case of the
 // differences' error,
 //   (|c_x| + |c_v| / h) sum_k r_k h^2 / m_min / e
 // (a residual r moves x by at most r h^2 / m_min); a disagreement within it
@@ -118,7 +119,8 @@ struct GradCheckOptions {
   double largest_step = 1e-2;  // first step e, in units of the input's scale; > 0
   int step_count = 6;          // steps e, each a tenth of the one before; >= 2
   // Stop taking smaller steps once the differences at the first three (or
-  // all, if fewer) pass with at least this margin: the remaining steps
+  // all, if fewer) pass with at least this margin on their own (not
+  // extrapolated, see derivative_verdict.h): the remaining steps
   // could only lower the floor of a derivative already resolved (its
   // reported margin is then a lower bound). Halves the rollouts of a clean
   // check. 0: always take all step_count steps.
@@ -143,7 +145,8 @@ struct GradCheckOptions {
   bool tangent = true;
   // Differences that pass with at least this margin decide alone; below it,
   // or unresolved, the tangent decides where it gives the larger margin.
-  double decisive_margin = 3;
+  // Finite and >= 1.
+  double decisive_margin = 10;
   // Perturbed rollouts simulated at once, in [1, MaxSolverThreads()]. 1:
   // one after the other on the checked rollout's simulator, with the
   // options' num_threads. Above 1: each on a simulator of its own (one per
@@ -183,6 +186,9 @@ struct GradCheckInput {
   // differences could not resolve some direction (worst direction's basis).
   std::string basis = "differences";
   int tangent_directions = 0;  // directions the tangent decided
+  // Directions the differences decided on their Richardson extrapolations
+  // (DerivativeJudgement::extrapolated).
+  int extrapolated_directions = 0;
   std::string reason;          // empty for a pass: why the worst direction failed or is unresolved
 };
 

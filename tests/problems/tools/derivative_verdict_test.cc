@@ -57,7 +57,7 @@ TEST(DerivativeVerdictTest, FirstOrderTruncationIsCoveredByTheFloorAndCannotFail
   auto kinked = [](double x) { return 2 * x + 5 * std::abs(x) * x; };  // at x = 0: fd(e) = 2 + 5 e
   const auto d = Differences(kinked, 0.0, 0.0, 6, 1);
   for (const double tolerance : {1e-4, 1e-5, 1e-6}) {
-    const DerivativeJudgement right = JudgeDerivative(2.0, d, tolerance);
+    const DerivativeJudgement right = JudgeDerivative(2.0, d, tolerance, /*extrapolate=*/false);
     EXPECT_NE(right.verdict, CheckVerdict::kFail) << tolerance << ": " << right.reason;
     EXPECT_GE(right.floor, 0.9 * right.error) << tolerance;
   }
@@ -67,7 +67,7 @@ TEST(DerivativeVerdictTest, FirstOrderTruncationIsCoveredByTheFloorAndCannotFail
   // distance to the larger step / 99 or the smaller step's distance / 10.
   auto smooth = [](double x) { return 2 * x + 5 * x * x * x; };  // fd(e) = 2 + 5 e^2
   const auto s = Differences(smooth, 0.0, 0.0, 4, 1);
-  const DerivativeJudgement j = JudgeDerivative(2.0, s, 1e-4);
+  const DerivativeJudgement j = JudgeDerivative(2.0, s, 1e-4, /*extrapolate=*/false);
   size_t k = 0;
   while (s[k].step != j.step) ++k;
   ASSERT_GT(k, 0u);
@@ -75,6 +75,54 @@ TEST(DerivativeVerdictTest, FirstOrderTruncationIsCoveredByTheFloorAndCannotFail
   const double expected =
       std::max(std::abs(s[k - 1].value - s[k].value) / 99, std::abs(s[k + 1].value - s[k].value) / 10);
   EXPECT_NEAR(j.floor, expected / scale, 1e-3 * expected / scale);
+}
+
+// Truncation-limited differences (a large e^2 term, noise that rules out the
+// smaller steps; shaped like the measured density derivative of the
+// calibrate-plant check with semi-implicit Euler) pass by a small margin on
+// their own; their Richardson extrapolations confirm the derivative with a
+// much larger one. The extrapolation cannot pass a wrong derivative, nor
+// replace the differences' own verdict where it is the less certain.
+TEST(DerivativeVerdictTest, RichardsonExtrapolationConfirmsATruncationLimitedDerivativeWithALargerMargin) {
+  // fd(e) = 3 + 42 e^2 + 3 e^4: 1.4e-5 relative truncation at e = 1e-3; the
+  // noise, 7.5e-9 per evaluation, up to 2.5e-5 relative at e = 1e-4.
+  auto curved = [](double x) { return 3 * x + 42 * x * x * x + 3 * std::pow(x, 5) + 1; };
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const auto d = Differences(curved, 0.0, 7.5e-9, 5, seed);
+    const DerivativeJudgement plain = JudgeDerivative(3.0, d, 1e-4, /*extrapolate=*/false);
+    ASSERT_EQ(plain.verdict, CheckVerdict::kPass) << plain.reason;
+    EXPECT_LT(plain.margin, 10.0);
+    EXPECT_FALSE(plain.extrapolated);
+    const DerivativeJudgement x = JudgeDerivative(3.0, d, 1e-4);
+    EXPECT_EQ(x.verdict, CheckVerdict::kPass) << x.reason;
+    EXPECT_TRUE(x.extrapolated);
+    EXPECT_GT(x.margin, 3 * plain.margin);
+    EXPECT_GE(x.floor, x.error);  // the extrapolation's own noise and truncation are measured
+    // 1e-3 off: the differences resolve it and fail it; the extrapolations
+    // do not pass it, so the failure stands.
+    const DerivativeJudgement wrong = JudgeDerivative(3.0 * (1 + 1e-3), d, 1e-4);
+    EXPECT_EQ(wrong.verdict, CheckVerdict::kFail) << wrong.reason;
+    EXPECT_FALSE(wrong.extrapolated);
+    // 3e-5 off: the differences pass it at the margin their truncation
+    // allows; the extrapolations resolve the offset and give a smaller
+    // margin, so the verdict and margin are the differences' own.
+    const DerivativeJudgement near = JudgeDerivative(3.0 * (1 + 3e-5), d, 1e-4);
+    const DerivativeJudgement near_plain = JudgeDerivative(3.0 * (1 + 3e-5), d, 1e-4, /*extrapolate=*/false);
+    EXPECT_FALSE(near.extrapolated);
+    EXPECT_EQ(near.verdict, near_plain.verdict);
+    EXPECT_EQ(near.margin, near_plain.margin);
+  }
+  // First-order truncation (|x| x): the extrapolation with the divisor
+  // r - 1 confirms the derivative, and still not a wrong one.
+  auto kinked = [](double x) { return 2 * x + 5 * std::abs(x) * x + 7 * x * x * x; };
+  const auto k = Differences(kinked, 0.0, 1e-16, 6, 1);
+  const DerivativeJudgement right = JudgeDerivative(2.0, k, 1e-6);
+  EXPECT_EQ(right.verdict, CheckVerdict::kPass) << right.reason;
+  EXPECT_TRUE(right.extrapolated);
+  EXPECT_NE(JudgeDerivative(2.0, k, 1e-6, /*extrapolate=*/false).verdict, CheckVerdict::kPass);
+  EXPECT_NE(JudgeDerivative(2.0 * (1 + 1e-4), k, 1e-6).verdict, CheckVerdict::kPass);
+  // Two differences: nothing to extrapolate from.
+  EXPECT_FALSE(JudgeDerivative(3.0, Differences(curved, 0.0, 1e-16, 2, 1), 1e-1).extrapolated);
 }
 
 TEST(DerivativeVerdictTest, ACorrectDerivativeUnderLargeNoiseIsUnresolvedWithTheFloor) {
