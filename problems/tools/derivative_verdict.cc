@@ -33,8 +33,8 @@ const char* ToString(CheckVerdict verdict) {
 
 CheckVerdict Worse(CheckVerdict a, CheckVerdict b) { return Rank(a) >= Rank(b) ? a : b; }
 
-DerivativeJudgement JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences,
-                                    double tolerance, bool extrapolate) {
+DerivativeJudgement JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences, double tolerance,
+                                    bool extrapolate) {
   std::vector<FiniteDifferenceVector> vectors;
   vectors.reserve(differences.size());
   for (const FiniteDifference& d : differences) vectors.push_back({d.step, {d.value}, d.noise, d.bound});
@@ -78,8 +78,7 @@ double Uncertainty(const Estimates& s, size_t k) {
     // estimate plus that one's own noise (measured from the one after it),
     // which can hide the truncation by cancelling it.
     double next_noise = s.at[1].noise;
-    if (n > 2)
-      next_noise = std::max(next_noise, Distance(s.at[2].value, s.at[1].value) * s.at[2].step / s.at[1].step);
+    if (n > 2) next_noise = std::max(next_noise, Distance(s.at[2].value, s.at[1].value) * s.at[2].step / s.at[1].step);
     u = std::max(u, Distance(s.at[1].value, d.value) + next_noise);
   }
   if (k + 1 < n) u = std::max(u, Distance(s.at[k + 1].value, d.value) * s.at[k + 1].step / d.step);

@@ -77,21 +77,21 @@ struct FiniteDifference {
 
 struct DerivativeJudgement {
   CheckVerdict verdict = CheckVerdict::kUnresolved;
-  double error = 0;      // relative, at the chosen step (see above)
-  double floor = 0;      // relative uncertainty of the difference there (measured)
-  double bound = 0;      // relative worst-case error from the solves there
-  double step = 0;       // the chosen step
-  double tolerance = 0;  // the relative tolerance judged against
-  double margin = 0;     // tolerance / max(error, floor); infinite when both are 0
-  std::string reason;    // empty for a pass; why it failed or is unresolved
+  double error = 0;           // relative, at the chosen step (see above)
+  double floor = 0;           // relative uncertainty of the difference there (measured)
+  double bound = 0;           // relative worst-case error from the solves there
+  double step = 0;            // the chosen step
+  double tolerance = 0;       // the relative tolerance judged against
+  double margin = 0;          // tolerance / max(error, floor); infinite when both are 0
+  std::string reason;         // empty for a pass; why it failed or is unresolved
   bool extrapolated = false;  // judged on the Richardson extrapolations (see above)
 };
 
 // `differences` in decreasing step order (at least one). tolerance > 0.
 // extrapolate: also judge the Richardson extrapolations (see above).
 // Throws std::invalid_argument on an empty list or a tolerance <= 0.
-DerivativeJudgement JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences,
-                                    double tolerance, bool extrapolate = true);
+DerivativeJudgement JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences, double tolerance,
+                                    bool extrapolate = true);
 
 // The same for a vector-valued derivative (a Jacobian-vector product, a
 // whole Jacobian flattened): every |.| above is a 2-norm. Throws

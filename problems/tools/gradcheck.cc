@@ -671,8 +671,7 @@ std::string GradCheckTable(const GradCheckResult& r) {
                                   std::to_string(e.directions) + " by tangent)"
                             : e.basis;
     if (e.extrapolated_directions > 0)
-      basis += " (" + std::to_string(e.extrapolated_directions) + "/" + std::to_string(e.directions) +
-               " extrapolated)";
+      basis += " (" + std::to_string(e.extrapolated_directions) + "/" + std::to_string(e.directions) + " extrapolated)";
     std::snprintf(line, sizeof(line), "%-16s %10.2e %10.2e %10.3g %9.0e %10.2e %s %s %-11s %-11s %s\n", e.input.c_str(),
                   e.error, e.floor, e.margin, e.step, e.bound, ref, tangent, ToString(e.verdict), basis.c_str(),
                   e.reason.c_str());

@@ -25,8 +25,8 @@
 // (rounding errors of independent sign), picks the step of least
 // uncertainty and gives the verdict; where the differences are
 // truncation-limited, their Richardson extrapolations may confirm the
-// derivative with a larger margin (`extrapolated_directions` counts them). The forward's achieved residuals r_k give the worst case of the
-// differences' error,
+// derivative with a larger margin (`extrapolated_directions` counts them). The forward's achieved residuals r_k give
+// the worst case of the differences' error,
 //   (|c_x| + |c_v| / h) sum_k r_k h^2 / m_min / e
 // (a residual r moves x by at most r h^2 / m_min); a disagreement within it
 // is unresolved, never a failure. An input kind's verdict is the worst over
@@ -189,7 +189,7 @@ struct GradCheckInput {
   // Directions the differences decided on their Richardson extrapolations
   // (DerivativeJudgement::extrapolated).
   int extrapolated_directions = 0;
-  std::string reason;          // empty for a pass: why the worst direction failed or is unresolved
+  std::string reason;  // empty for a pass: why the worst direction failed or is unresolved
 };
 
 struct GradCheckResult {
