@@ -2,10 +2,12 @@
 # The whole `diffpd stress` grid in parallel shards (one per problem, method
 # and Young's modulus: 80 by default), then one summary.
 #
-#   scripts/stress_grid.sh [-j JOBS] [-o DIR] [-b DIFFPD] [-p PROBLEMS] [-l STEPS] [-- extra stress options]
+#   scripts/stress_grid.sh [-j JOBS] [-o DIR] [-b DIFFPD] [-p PROBLEMS] [-m METHODS] [-l STEPS]
+#                          [-- extra stress options]
 #
 # PROBLEMS: comma-separated (default cantilever,falling-cube,bouncing-ball,
-# rolling-sphere). -l STEPS adds one shard per problem and method with the
+# rolling-sphere); METHODS likewise (default newton-cholesky,pd,newton-pcg,
+# pd-lbfgs). -l STEPS adds one shard per problem and method with the
 # long cases (`diffpd stress --long-steps STEPS --long-only`: the grid's
 # extreme corners for STEPS steps), run first.
 # JOBS shards run at a time (default: the number of processors), each on one
@@ -20,11 +22,13 @@ jobs=$(nproc)
 out=out/stress
 diffpd=build/bin/diffpd
 problems=cantilever,falling-cube,bouncing-ball,rolling-sphere
+methods=newton-cholesky,pd,newton-pcg,pd-lbfgs
 long_steps=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     -j) jobs="$2"; shift 2 ;;
     -p) problems="$2"; shift 2 ;;
+    -m) methods="$2"; shift 2 ;;
     -l) long_steps="$2"; shift 2 ;;
     -o) out="$2"; shift 2 ;;
     -b) diffpd="$2"; shift 2 ;;
@@ -37,13 +41,14 @@ mkdir -p "$out"
 
 shards=()
 IFS=, read -r -a problem_list <<<"$problems"
+IFS=, read -r -a method_list <<<"$methods"
 if [[ "$long_steps" -gt 0 ]]; then
   for problem in "${problem_list[@]}"; do
-    for method in newton-cholesky pd newton-pcg pd-lbfgs; do shards+=("$problem $method long"); done
+    for method in "${method_list[@]}"; do shards+=("$problem $method long"); done
   done
 fi
 for problem in "${problem_list[@]}"; do
-  for method in newton-cholesky pd newton-pcg pd-lbfgs; do
+  for method in "${method_list[@]}"; do
     for e in 1e10 1e8 1e6 1e4 1e2; do shards+=("$problem $method $e"); done
   done
 done

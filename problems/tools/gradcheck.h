@@ -81,7 +81,10 @@
 // they did not, the method's gradient is that of its own inexact trajectory
 // (e.g. solves stopped at their rounding floor): the tangent decides as
 // above and the reason gives the reference error, which says how far that
-// trajectory's gradient is from the converged one.
+// trajectory's gradient is from the converged one. A reference that
+// converges to another solution of the implicit steps (a node farther than
+// reference_trajectory_tolerance x the body's size from the checked
+// rollout's at some step) is not compared; reference_failure says so.
 #pragma once
 
 #include <cstdint>
@@ -130,6 +133,11 @@ struct GradCheckOptions {
   // discretisation differs).
   std::optional<bool> reference;
   double reference_rel_tolerance = 1e-12;  // of the reference's forward and adjoint solves
+  // The reference is not compared where any of its steps puts a node
+  // farther than this (units of the body's size, the bounding-box diagonal)
+  // from the checked rollout's: the implicit steps have another solution
+  // there (reference_failure says so). Finite and > 0.
+  double reference_trajectory_tolerance = 1e-2;
   // Where the differences leave an input unresolved, also take them at two
   // larger steps (3 and 30 x largest_step), evaluations that fail counting
   // as non-finite: noise falls as 1/e, and the Richardson estimate tells
