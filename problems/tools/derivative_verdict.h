@@ -4,9 +4,10 @@
 // A central difference fd(e) = (L(+e) - L(-e)) / 2e errs by truncation,
 // O(e^2) (O(e) where L is C1 but not C2), and by the noise of the two
 // evaluations of L: rounding (declared as `noise`), and the residuals an
-// iterative forward solve leaves. The latter's worst case (`bound`, e.g. from the achieved residuals) is far
-// above what is seen, as the two evaluations' solves follow nearly the same
-// path and their errors mostly cancel; so it is measured instead.
+// iterative forward solve leaves. The latter's worst case (`bound`, e.g.
+// from the achieved residuals) is far above what is seen, as the two
+// evaluations' solves follow nearly the same path and their errors mostly
+// cancel; so it is measured instead.
 // From differences at steps e_0 > e_1 > ... (ratio r = e_k-1 / e_k, 10 in
 // the checks), the uncertainty of fd(e_k) is the largest of
 //   noise(e_k)                                the declared rounding;

@@ -25,8 +25,9 @@
 // (rounding errors of independent sign), picks the step of least
 // uncertainty and gives the verdict; where the differences are
 // truncation-limited, their Richardson extrapolations may confirm the
-// derivative with a larger margin (`extrapolated_directions` counts them). The forward's achieved residuals r_k give
-// the worst case of the differences' error,
+// derivative with a larger margin (`extrapolated_directions` counts them).
+// The forward's achieved residuals r_k give the worst case of the
+// differences' error,
 //   (|c_x| + |c_v| / h) sum_k r_k h^2 / m_min / e
 // (a residual r moves x by at most r h^2 / m_min); a disagreement within it
 // is unresolved, never a failure. An input kind's verdict is the worst over
@@ -244,12 +245,11 @@ GradCheckResult CheckRolloutGradientAtReachableTolerance(const Scene& scene, con
 double RecommendedGradCheckRelTolerance(Method method);
 // The time step `diffpd gradcheck` checks a method at, given a simulator of
 // `scene` with the problem's own step in its options (s): that step, except
-// for semi-implicit Euler
-// where it is above half the stability limit at `initial`
-// (Simulator::ExplicitStableTimeStep with the muscles at 0.9, the check's
-// baseline): there half that limit, rounded down to two significant digits.
-// Above the limit the rollout grows without bound, and the limit ignores
-// damping, the state forces and the motion, hence the half.
+// for semi-implicit Euler where it is above half the stability limit at
+// `initial` (Simulator::ExplicitStableTimeStep with the muscles at 0.9, the
+// check's baseline): there half that limit, rounded down to two
+// significant digits. Above the limit the rollout grows without bound, and
+// the limit ignores damping, the state forces and the motion, hence the half.
 double RecommendedGradCheckTimeStep(const Scene& scene, Simulator& sim, const State& initial);
 // The iteration limit per step `diffpd gradcheck` gives a method's solves:
 // 10000 for pd, whose local-global iteration converges linearly (the
