@@ -221,6 +221,11 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
         return finish("failed", msg.str());
       }
       c.gradcheck_run = true;
+      c.gradcheck_reference = check.reference;
+      c.gradcheck_reference_failure = check.reference_failure;
+      if (progress && !check.reference_failure.empty())
+        *progress << "  gradient check: the Newton-Cholesky reference is not compared: " << check.reference_failure
+                  << std::endl;
       c.gradcheck_margin = std::numeric_limits<double>::infinity();
       for (const auto& input : check.inputs) {
         if (input.verdict == CheckVerdict::kUnresolved) {
@@ -347,6 +352,8 @@ nlohmann::json StressToJson(const std::vector<StressCase>& cases) {
                    {"gradcheck_margin", number(c.gradcheck_margin)},
                    {"gradcheck_unresolved", c.gradcheck_unresolved},
                    {"gradcheck_tangent", c.gradcheck_tangent},
+                   {"gradcheck_reference", c.gradcheck_reference},
+                   {"gradcheck_reference_failure", c.gradcheck_reference_failure},
                    {"seconds", c.seconds}});
   return out;
 }

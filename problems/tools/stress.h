@@ -122,13 +122,17 @@ struct StressCase {
   // differences, or the forward-mode tangent where it decided) and the
   // largest noise floor of the differences, the smallest margin over the
   // resolved inputs (infinite when none), the inputs it could not resolve
-  // and those the tangent decided (the differences could not).
+  // and those the tangent decided (the differences could not). Whether the
+  // Newton-Cholesky reference was compared (iterative methods), and why not
+  // where its rollout failed or reached another solution.
   bool gradcheck_run = false;
   double gradcheck_error = 0;
   double gradcheck_floor = 0;
   double gradcheck_margin = 0;
   std::vector<std::string> gradcheck_unresolved;
   std::vector<std::string> gradcheck_tangent;
+  bool gradcheck_reference = false;
+  std::string gradcheck_reference_failure;
   double seconds = 0;
 };
 

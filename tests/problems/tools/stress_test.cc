@@ -137,6 +137,14 @@ TEST(StressTest, ContactScenesAtTheExtremesAreOkOrAClearSolverError) {
         EXPECT_TRUE(c.gradcheck_run);
         EXPECT_GE(c.gradcheck_margin, 3.0) << "every resolved input at least 3x inside the tolerance";
         EXPECT_TRUE(c.gradcheck_unresolved.empty());
+        // PD-LBFGS is iterative: its check compares the Newton-Cholesky
+        // reference, or says why not; Newton-Cholesky is its own reference.
+        if (m == Method::kPdLbfgs) {
+          EXPECT_NE(c.gradcheck_reference, !c.gradcheck_reference_failure.empty());
+        } else {
+          EXPECT_FALSE(c.gradcheck_reference);
+          EXPECT_EQ(c.gradcheck_reference_failure, "");
+        }
       }
   EXPECT_GE(ok, 8);
   EXPECT_GE(in_contact, 6);
@@ -294,6 +302,8 @@ TEST(StressTest, RunStressCoversTheGridAndWritesJson) {
   EXPECT_TRUE(rows[0].at("gradcheck_unresolved").is_array());
   EXPECT_EQ(rows[0].at("gradcheck_run"), true);
   EXPECT_GE(rows[0].at("gradcheck_margin").get<double>(), 3.0);
+  EXPECT_EQ(rows[0].at("gradcheck_reference"), false) << "Newton-Cholesky is not checked against itself";
+  EXPECT_EQ(rows[0].at("gradcheck_reference_failure"), "");
   const StressSummary summary = SummarizeStress(cases);
   EXPECT_EQ(summary.cases, 2);
   EXPECT_EQ(summary.gradchecks, 2);
