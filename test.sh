@@ -1,21 +1,24 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds Release into build/ and runs the whole test
 # suite with CTest; then every file reader's fuzz harness for a fixed time
-# (scripts/fuzz.sh, in build-fuzz/; DIFFPD_EDGE_CHECKS=0 skips it); then a
-# chosen third of the core tests (the library's, the rollout core's and the
-# optimiser adapters') again under AddressSanitizer and
-# UndefinedBehaviorSanitizer (scripts/sanitize.sh's scope `ci`, in
-# build-sanitize/; DIFFPD_SANITIZE_SCOPE=core runs all core tests there,
-# =all the whole suite, a second full build).
+# (scripts/fuzz.sh, in build-fuzz/; DIFFPD_EDGE_CHECKS=0 skips it); then the
+# core tests (the library's, the rollout core's and the optimiser adapters')
+# again under AddressSanitizer and UndefinedBehaviorSanitizer
+# (scripts/sanitize.sh, in build-sanitize/), in two tiers: first the chosen
+# third of them that covers every library area (scope `ci`), then the rest
+# (scope `core-rest`). DIFFPD_SANITIZE_SCOPE=core or =all instead runs that
+# scope in one go (all: the whole suite, a second full build).
 #
-# The sanitized tests are a second build and take about 0.45 times as long as
-# everything before them (the scope `core` took 1.25 times, measured with
-# Makefiles and a static library). DIFFPD_SANITIZE chooses:
-#   auto (default)  run them when the time so far times 1.45 (times 2.3 for
-#                   the scope core or all) fits within
-#                   DIFFPD_TIME_BUDGET_MINUTES (default 45); otherwise say so
-#                   and skip them, so that the command ends within the budget
-#                   on a slow machine;
+# Each tier is a second build and a slow run; DIFFPD_SANITIZE chooses:
+#   auto (default)  run a tier when the time so far times its factor fits
+#                   within DIFFPD_TIME_BUDGET_MINUTES (default 45), and
+#                   otherwise say so and skip it (and the tiers after it),
+#                   so that the command ends within the budget on a slow
+#                   machine. The factors, measured on a clean clone without
+#                   a compiler cache on 2 cores: `ci` took 0.45 times the
+#                   phases before it, `core-rest` 0.30 times the phases
+#                   before it (ci included), and `core` or `all` are
+#                   projected at 1.3 times;
 #   1               always run them;  0  never.
 # Extra arguments go to the Release suite's ctest.
 set -euo pipefail
@@ -35,6 +38,14 @@ if ! [[ "$budget_min" =~ ^[1-9][0-9]*$ ]]; then
   exit 2
 fi
 
+case "${DIFFPD_SANITIZE_SCOPE:-}" in
+  "" | core | ci | core-rest | all) ;;
+  *)
+    echo "test.sh: DIFFPD_SANITIZE_SCOPE = '$DIFFPD_SANITIZE_SCOPE' is invalid: must be core, ci, core-rest or all" >&2
+    exit 2
+    ;;
+esac
+
 start=$SECONDS
 ./scripts/setup.sh
 (cd build && ctest --output-on-failure -j "${DIFFPD_TEST_JOBS:-$(nproc)}" "$@")
@@ -42,25 +53,37 @@ if [ "${DIFFPD_EDGE_CHECKS:-1}" != 0 ]; then
   ./scripts/fuzz.sh
 fi
 
-scope="${DIFFPD_SANITIZE_SCOPE:-ci}"
-if [ "$sanitize" = auto ]; then
-  # Measured on a clean clone without a compiler cache on a 2-core machine:
-  # the sanitized tier took 0.44 (scope ci) and 1.25 (scope core, before the
-  # build used Ninja) times the phases before it.
+# Whether a sanitized tier fits: the time so far times (1 + factor/100)
+# within the budget. Says why where it does not.
+fits() {
+  local tier=$1 factor=$2 so_far projected
   so_far=$((SECONDS - start))
-  factor=145
-  [ "$scope" = ci ] || factor=230
-  projected=$((so_far * factor / 100))
+  projected=$((so_far * (100 + factor) / 100))
   if [ "$projected" -le $((budget_min * 60)) ]; then
-    sanitize=1
-  else
-    echo "test.sh: the sanitized tests (scope $scope) are skipped: the checks so far took $((so_far / 60)) min," \
-      "and with the sanitized build and run the command would take about" \
-      "$((projected / 60)) min, past the budget of $budget_min min (DIFFPD_TIME_BUDGET_MINUTES)." \
-      "DIFFPD_SANITIZE=1 runs them regardless." >&2
-    sanitize=0
+    return 0
   fi
-fi
-if [ "$sanitize" = 1 ]; then
-  DIFFPD_SANITIZE_SCOPE="$scope" ./scripts/sanitize.sh
+  echo "test.sh: the sanitized tests (scope $tier) are skipped: the checks so far took $((so_far / 60)) min," \
+    "and with this scope's sanitized build and run the command would take about" \
+    "$((projected / 60)) min, past the budget of $budget_min min (DIFFPD_TIME_BUDGET_MINUTES)." \
+    "DIFFPD_SANITIZE=1 runs them regardless." >&2
+  return 1
+}
+
+# wanted <scope> <factor>: whether DIFFPD_SANITIZE asks for the scope. The
+# scope itself runs outside any condition, so that its failure fails the
+# command.
+wanted() {
+  [ "$sanitize" = 1 ] || { [ "$sanitize" = auto ] && fits "$1" "$2"; }
+}
+
+scope="${DIFFPD_SANITIZE_SCOPE:-}"
+if [ -n "$scope" ]; then
+  if wanted "$scope" 130; then
+    DIFFPD_SANITIZE_SCOPE="$scope" ./scripts/sanitize.sh
+  fi
+elif wanted ci 45; then
+  DIFFPD_SANITIZE_SCOPE=ci ./scripts/sanitize.sh
+  if wanted core-rest 30; then
+    DIFFPD_SANITIZE_SCOPE=core-rest ./scripts/sanitize.sh
+  fi
 fi

@@ -16,8 +16,9 @@ namespace {
 
 // Springs between the 4 corners of a tetrahedron, rest lengths those of
 // `rest`: E = sum (k/2)(|x_i - x_j| - L_ij)^2.
+constexpr double kRestCorners[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
 struct Springs {
-  VectorXd rest = (VectorXd(12) << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1).finished();
+  VectorXd rest = Eigen::Map<const Eigen::Matrix<double, 12, 1>>(kRestCorners);
   double k = 3.0;
   template <class Visit>
   void ForEach(const VectorXd& x, Visit&& visit) const {

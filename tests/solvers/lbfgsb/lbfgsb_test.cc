@@ -59,7 +59,7 @@ MatrixXd SpdMatrix(int n, unsigned seed) {
 TEST(LbfgsbTest, BoundedRosenbrockStopsAtTheBoundWhereItsKktConditionsHold) {
   // min (1 - x)^2 + 100 (y - x^2)^2 with x <= 0.5: x = 0.5 (df/dx = -1 < 0
   // there, the bound active), y = x^2 = 0.25.
-  const VectorXd lower = (VectorXd(2) << -2, -1).finished(), upper = (VectorXd(2) << 0.5, 2).finished();
+  const VectorXd lower = Eigen::Vector2d(-2, -1), upper = Eigen::Vector2d(0.5, 2);
   LbfgsbOptions o;
   o.pgtol = 1e-9;
   o.ftol = 0;
