@@ -16,7 +16,7 @@
 #                   so that the command ends within the budget on a slow
 #                   machine. The factors, measured on a clean clone without
 #                   a compiler cache on 2 cores: `ci` took 0.45 times the
-#                   phases before it, `core-rest` 0.30 times the phases
+#                   phases before it, `core-rest` 0.45 times the phases
 #                   before it (ci included), and `core` or `all` are
 #                   projected at 1.3 times;
 #   1               always run them;  0  never.
@@ -83,7 +83,7 @@ if [ -n "$scope" ]; then
   fi
 elif wanted ci 45; then
   DIFFPD_SANITIZE_SCOPE=ci ./scripts/sanitize.sh
-  if wanted core-rest 30; then
+  if wanted core-rest 45; then
     DIFFPD_SANITIZE_SCOPE=core-rest ./scripts/sanitize.sh
   fi
 fi
