@@ -78,7 +78,9 @@ wanted() {
 
 scope="${DIFFPD_SANITIZE_SCOPE:-}"
 if [ -n "$scope" ]; then
-  if wanted "$scope" 130; then
+  factor=130
+  case "$scope" in ci | core-rest) factor=45 ;; esac
+  if wanted "$scope" "$factor"; then
     DIFFPD_SANITIZE_SCOPE="$scope" ./scripts/sanitize.sh
   fi
 elif wanted ci 45; then
