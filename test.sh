@@ -15,10 +15,10 @@
 #                   otherwise say so and skip it (and the tiers after it),
 #                   so that the command ends within the budget on a slow
 #                   machine. The factors, measured on a clean clone without
-#                   a compiler cache on 2 cores: `ci` took 0.45 times the
-#                   phases before it, `core-rest` 0.45 times the phases
-#                   before it (ci included), and `core` or `all` are
-#                   projected at 1.3 times;
+#                   a compiler cache on 2 cores: `ci` took 0.49 times the
+#                   phases before it, `core-rest` 0.47 times the phases
+#                   before it (ci included), both projected at 0.5 times,
+#                   and `core` or `all` at 1.3 times;
 #   1               always run them;  0  never.
 # Extra arguments go to the Release suite's ctest.
 set -euo pipefail
@@ -53,12 +53,15 @@ if [ "${DIFFPD_EDGE_CHECKS:-1}" != 0 ]; then
   ./scripts/fuzz.sh
 fi
 
-# Whether a sanitized tier fits: the time so far times (1 + factor/100)
+# Each scope's time as a percentage of the time before it (see above).
+declare -A factor=([ci]=50 [core-rest]=50 [core]=130 [all]=130)
+
+# Whether a sanitized scope fits: the time so far times (1 + its factor)
 # within the budget. Says why where it does not.
 fits() {
-  local tier=$1 factor=$2 so_far projected
+  local tier=$1 so_far projected
   so_far=$((SECONDS - start))
-  projected=$((so_far * (100 + factor) / 100))
+  projected=$((so_far * (100 + factor[$tier]) / 100))
   if [ "$projected" -le $((budget_min * 60)) ]; then
     return 0
   fi
@@ -69,23 +72,20 @@ fits() {
   return 1
 }
 
-# wanted <scope> <factor>: whether DIFFPD_SANITIZE asks for the scope. The
-# scope itself runs outside any condition, so that its failure fails the
-# command.
+# wanted <scope>: whether DIFFPD_SANITIZE asks for the scope. The scope
+# itself runs outside any condition, so that its failure fails the command.
 wanted() {
-  [ "$sanitize" = 1 ] || { [ "$sanitize" = auto ] && fits "$1" "$2"; }
+  [ "$sanitize" = 1 ] || { [ "$sanitize" = auto ] && fits "$1"; }
 }
 
 scope="${DIFFPD_SANITIZE_SCOPE:-}"
 if [ -n "$scope" ]; then
-  factor=130
-  case "$scope" in ci | core-rest) factor=45 ;; esac
-  if wanted "$scope" "$factor"; then
+  if wanted "$scope"; then
     DIFFPD_SANITIZE_SCOPE="$scope" ./scripts/sanitize.sh
   fi
-elif wanted ci 45; then
+elif wanted ci; then
   DIFFPD_SANITIZE_SCOPE=ci ./scripts/sanitize.sh
-  if wanted core-rest 45; then
+  if wanted core-rest; then
     DIFFPD_SANITIZE_SCOPE=core-rest ./scripts/sanitize.sh
   fi
 fi
