@@ -78,7 +78,13 @@
 // default, the same loss's gradient from a Newton-Cholesky rollout at
 // rel_tolerance reference_rel_tolerance is compared too, per direction:
 // a reference error above the tolerance fails the input where the
-// differences decided (the adjoint, not the differences, is wrong). Where
+// differences decided (the adjoint, not the differences, is wrong), unless
+// they passed with a margin of at least decisive_margin and the method's
+// gradient at rel_tolerance / 100 agrees with the reference within the
+// tolerance, and better: the disagreement is then the forward's tolerance
+// (the gradient is that of the method's own loss, which the differences
+// confirm), the margin is the smaller of the differences' and the
+// tightened agreement's, and the reason gives both errors. Where
 // they did not, the method's gradient is that of its own inexact trajectory
 // (e.g. solves stopped at their rounding floor): the tangent decides as
 // above and the reason gives the reference error, which says how far that
@@ -188,6 +194,11 @@ struct GradCheckInput {
   double step = 0;    // the step of the worst direction (units of the scale)
   // Largest relative difference from the reference gradient; NaN: not compared.
   double reference_error = 0;
+  // Where the differences passed decisively but the reference disagreed:
+  // the largest relative difference from the reference of the method's
+  // gradient with its forward solves at rel_tolerance / 100; NaN: not
+  // computed.
+  double tightened_reference_error = std::numeric_limits<double>::quiet_NaN();
   // Largest relative difference from the forward-mode tangent; NaN: not
   // compared (or its pass failed).
   double tangent_error = 0;
