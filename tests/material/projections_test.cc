@@ -128,17 +128,22 @@ double BruteForceDistance(const Vec3& sigma) {
     for (int a = -375; a <= 375; ++a) values.push_back(std::pow(10.0, a / 25.0));
     return values;
   }();
-  double best = std::numeric_limits<double>::infinity();
-  const std::vector<Vec3> signs = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
-  for (const Vec3& sign : signs) {
-    for (double d0 : grid) {
-      for (double d1 : grid) {
-        const Vec3 d = sign.cwiseProduct(Vec3(d0, d1, 1.0 / (d0 * d1)));
-        best = std::min(best, (d - sigma).norm());
+  // Plain scalars: 2.3 million points per spectrum, which unoptimised and
+  // sanitized builds of this file evaluate 20-50x faster than with Eigen's
+  // expression templates.
+  double best_squared = std::numeric_limits<double>::infinity();
+  const double signs[4][3] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
+  const double s0 = sigma(0), s1 = sigma(1), s2 = sigma(2);
+  for (const auto& sign : signs) {
+    for (const double d0 : grid) {
+      const double e0 = sign[0] * d0 - s0;
+      for (const double d1 : grid) {
+        const double e1 = sign[1] * d1 - s1, e2 = sign[2] / (d0 * d1) - s2;
+        best_squared = std::min(best_squared, e0 * e0 + e1 * e1 + e2 * e2);
       }
     }
   }
-  return best;
+  return std::sqrt(best_squared);
 }
 
 TEST(VolumeProjectionTest, IsTheGlobalMinimiserOnHardSpectra) {
