@@ -39,10 +39,14 @@ youngs_modulus, poissons_ratio, time_step, steps, long_case, outcome,
 message, steps_completed, rounding_floor_steps, newton_fallback_steps,
 contact_steps, max_contact_nodes, max_energy_excess,
 gradcheck_run, gradcheck_error, gradcheck_floor, gradcheck_margin,
-gradcheck_unresolved, gradcheck_tangent, seconds}; the error is on each
+gradcheck_unresolved, gradcheck_tangent, gradcheck_tightened, gradcheck_reference,
+gradcheck_reference_failure, seconds}; the error is on each
 input's basis (the differences, or the forward-mode tangent where the
 differences could not decide: gradcheck_tangent), the margin tolerance /
-max(error, floor) over the resolved inputs. The table ends with the number
+max(error, floor) over the resolved inputs; gradcheck_tightened lists the
+inputs that passed although the Newton-Cholesky reference disagreed,
+because the method's gradient with its forward 100x tighter agrees with it.
+The table ends with the number
 of cases with unresolved inputs and the smallest margin.
 Solves stop at |grad g| <= --abs-tol + --rtol |grad g(x0)|; by default
 --abs-tol is 10x an estimate of the rounding floor of |grad g| (never below
@@ -92,6 +96,11 @@ int RunStressArgs(const StressArgs& args) {
         message += message.empty() ? "" : "; ";
         message += "decided by the tangent:";
         for (const auto& input : c.gradcheck_tangent) message += " " + input;
+      }
+      if (!c.gradcheck_tightened.empty()) {
+        message += message.empty() ? "" : "; ";
+        message += "agree with the reference at a 100x tighter forward:";
+        for (const auto& input : c.gradcheck_tightened) message += " " + input;
       }
       if (!c.gradcheck_unresolved.empty()) {
         message += message.empty() ? "" : "; ";

@@ -236,6 +236,8 @@ StressCase RunStressCase(const StressProblem& problem, Method method, double you
         }
         const bool by_tangent = input.basis == "tangent";
         if (by_tangent) c.gradcheck_tangent.push_back(input.input);
+        if (input.verdict == CheckVerdict::kPass && !std::isnan(input.tightened_reference_error))
+          c.gradcheck_tightened.push_back(input.input);
         c.gradcheck_error = std::max(c.gradcheck_error, by_tangent ? input.tangent_error : input.error);
         c.gradcheck_floor = std::max(c.gradcheck_floor, input.floor);
         c.gradcheck_margin = std::min(c.gradcheck_margin, input.margin);
@@ -352,6 +354,7 @@ nlohmann::json StressToJson(const std::vector<StressCase>& cases) {
                    {"gradcheck_margin", number(c.gradcheck_margin)},
                    {"gradcheck_unresolved", c.gradcheck_unresolved},
                    {"gradcheck_tangent", c.gradcheck_tangent},
+                   {"gradcheck_tightened", c.gradcheck_tightened},
                    {"gradcheck_reference", c.gradcheck_reference},
                    {"gradcheck_reference_failure", c.gradcheck_reference_failure},
                    {"seconds", c.seconds}});
