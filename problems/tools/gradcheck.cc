@@ -38,6 +38,12 @@ constexpr int kEarlyStopSteps = 3;
 
 bool UsesReferenceByDefault(Method m) { return m == Method::kPd || m == Method::kPdLbfgs || m == Method::kNewtonPcg; }
 // Newton with a direct solve: its adjoint is exact for its own trajectory.
+// |a - b| / max(|a|, |b|); 0 where both are 0.
+double RelativeDifference(double a, double b) {
+  const double scale = std::max(std::abs(a), std::abs(b));
+  return scale > 0 ? std::abs(a - b) / scale : 0.0;
+}
+
 bool IsDirectNewton(Method m) { return m == Method::kNewtonCholesky || m == Method::kNewtonLdlt; }
 
 std::string Format(double v) {
@@ -425,8 +431,7 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
     double margin = j.margin;
     double tangent_error = std::numeric_limits<double>::quiet_NaN();
     if (result.tangent && std::isfinite(tangent_value)) {
-      const double scale = std::max(std::abs(analytic), std::abs(tangent_value));
-      tangent_error = scale > 0 ? std::abs(analytic - tangent_value) / scale : 0.0;
+      tangent_error = RelativeDifference(analytic, tangent_value);
       entry->tangent_error = std::max(entry->tangent_error, tangent_error);
     }
     const bool weak = verdict == CheckVerdict::kUnresolved || (verdict == CheckVerdict::kPass && j.margin < decisive);
@@ -452,8 +457,7 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
                 Format(tangent_error);
     }
     if (result.reference) {
-      const double scale = std::max(std::abs(analytic), std::abs(reference_value));
-      const double ref_error = scale > 0 ? std::abs(analytic - reference_value) / scale : 0.0;
+      const double ref_error = RelativeDifference(analytic, reference_value);
       entry->reference_error = std::max(entry->reference_error, ref_error);
       if (!(ref_error <= check.tolerance) && basis == "tangent") {
         // The differences did not decide: the gradient is the adjoint of the
@@ -467,12 +471,9 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
         double tight_error = std::numeric_limits<double>::quiet_NaN();
         if (verdict == CheckVerdict::kPass && basis == "differences" && j.margin >= decisive)
           if (const std::optional<RolloutGradient>& t = tightened_gradient()) {
-            const double value = along(*t);
-            const double tight_scale = std::max(std::abs(value), std::abs(reference_value));
-            tight_error = tight_scale > 0 ? std::abs(value - reference_value) / tight_scale : 0.0;
-            entry->tightened_reference_error = std::isnan(entry->tightened_reference_error)
-                                                   ? tight_error
-                                                   : std::max(entry->tightened_reference_error, tight_error);
+            tight_error = RelativeDifference(along(*t), reference_value);
+            entry->tightened_reference_error =
+                std::fmax(entry->tightened_reference_error, tight_error);  // NaN: none yet
           }
         if (tight_error <= check.tolerance && tight_error < ref_error) {
           margin = std::min(margin,
