@@ -34,7 +34,8 @@ Every run starts from the problem's own settings ('default'); sweeps:
  time_step  : forward scenes: h = dt / 2^k, k < --dt-levels, fixed duration
  resolution : cantilever, falling-cube: 3 fewer doublings per level
 Problems: every registered problem (small instances of the optimisation and
-control problems), the paper's rows as paper-<row> (small), the calibrations.
+control problems), the paper's rows as paper-<row> (small; --paper-size: at
+the paper's size, the Table's instance), the calibrations.
 --all: every problem's small instance, checked rather than measured: the
 tolerance sweep of pd-lbfgs at 1e-2, 1e-4, 1e-6 (unless --methods, --sweeps,
 --tolerances say otherwise), forward scenes at 3 steps on coarse meshes;
@@ -192,7 +193,7 @@ int RunOptimiserTradeoffArgs(const TradeoffArgs& args, const std::vector<std::st
   OptimiserTradeoffOptions options;
   options.max_iterations = args.budget;
   for (const auto& name : problems) {
-    const ProblemObjective objective = MakeProblemObjective(name, args.options.threads);
+    const ProblemObjective objective = MakeProblemObjective(name, args.options.threads, -1, 0, args.options.paper_size);
     if (!objective.optimise) {
       if (args.all) continue;
       throw InvalidInputError("problem '" + name +
@@ -274,6 +275,8 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
       throw InvalidInputError("--plot " + args.plot + " is invalid: directory " + dir.string() + " does not exist");
   }
   if (!args.shard.empty() && !args.all) throw InvalidInputError("--shard needs --all");
+  if (options.paper_size && args.all)
+    throw InvalidInputError("--paper-size is invalid with --all: name one paper row (paper-<row>)");
   const std::vector<std::string> problems =
       args.all ? Shard(ObjectiveProblemNames(), args.shard) : std::vector<std::string>{args.problem};
   if (args.optimiser) return RunOptimiserTradeoffArgs(args, problems);
@@ -293,16 +296,17 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
     monotone = monotone && p.violations.empty();
     const nlohmann::json report = TradeoffReportJson(p.result, p.front, p.violations);
     summary.push_back(report);
+    const std::string title = "diffpd tradeoff: " + name + (o.paper_size ? " (paper size)" : "");
     if (!args.out.empty()) {
       const auto base = std::filesystem::path(args.out) / name;
       std::ofstream(base.string() + ".json") << report.dump(1) << "\n";
       if (GnuplotAvailable()) {
-        WriteTradeoffPlot(p.result.rows, base.string() + ".png", "diffpd tradeoff: " + name);
+        WriteTradeoffPlot(p.result.rows, base.string() + ".png", title);
         std::cerr << "[tradeoff] wrote " << base.string() << ".png" << std::endl;
       }
     }
     if (!args.plot.empty()) {
-      WriteTradeoffPlot(p.result.rows, args.plot, "diffpd tradeoff: " + name);
+      WriteTradeoffPlot(p.result.rows, args.plot, title);
       std::cerr << "[tradeoff] wrote " << args.plot << std::endl;
     }
     if (!args.json) PrintTable(p);
@@ -354,6 +358,7 @@ Subcommand AddTradeoffCommand(CLI::App* parent) {
   cmd->add_option("--refine", o.refine, "cell doublings of the (finest) mesh; cantilever -9 = 4x1x1")
       ->check(IntegerIn("--refine", kMinRefinement, kMaxRefinement))
       ->capture_default_str();
+  cmd->add_flag("--paper-size", o.paper_size, "paper-<row>: the row at the paper's size (the Table's), not reduced");
   cmd->add_option("--threads", o.threads, "threads for element loops (0: OpenMP default)")
       ->check(ThreadCount("--threads"));
   cmd->add_option("--repeats", o.repeats, "timed runs of each setting; each row keeps its fastest")

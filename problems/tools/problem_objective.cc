@@ -103,8 +103,8 @@ void SetScreening(Scene* scene, double screening) {
   if (screening >= 0) scene->frictional_contact_options.screening_rel_tolerance = screening;
 }
 
-ProblemObjective PaperRowObjective(const std::string& name, int threads) {
-  auto row = std::make_shared<PaperRow>(MakePaperRow(name.substr(std::string(kPaperPrefix).size()), RowSize::kSmall));
+ProblemObjective PaperRowObjective(const std::string& name, int threads, RowSize size) {
+  auto row = std::make_shared<PaperRow>(MakePaperRow(name.substr(std::string(kPaperPrefix).size()), size));
   row->Prepare(Converged(row->Options(Method::kNewtonCholesky, threads)));
   ProblemObjective o;
   o.problem = name;
@@ -358,14 +358,17 @@ std::vector<std::string> ObjectiveProblemNames() {
   return names;
 }
 
-ProblemObjective MakeProblemObjective(const std::string& name, int threads, int steps, int refine) {
+ProblemObjective MakeProblemObjective(const std::string& name, int threads, int steps, int refine, bool paper_size) {
   if (name.rfind(kPaperPrefix, 0) == 0) {
     const std::string row = name.substr(std::string(kPaperPrefix).size());
     for (const auto& r : PaperRowNames())
-      if (r == row) return PaperRowObjective(name, threads);
+      if (r == row) return PaperRowObjective(name, threads, paper_size ? RowSize::kPaper : RowSize::kSmall);
   }
   for (auto& p : AllProblems()) {
     if (p->name() != name) continue;
+    if (paper_size)
+      throw InvalidInputError("the paper's size is invalid for " + name +
+                              ": only the paper's rows (paper-<row>) have a paper-size instance");
     if (refine != 0 && name != "cantilever" && name != "falling-cube")
       throw InvalidInputError("refinement = " + std::to_string(refine) + " is invalid for " + name +
                               ": only cantilever and falling-cube have a resolution knob (give 0)");

@@ -7,7 +7,7 @@
 //
 //  - paper-<row> (cantilever, rolling-sphere, plant, bouncing-ball, bunny,
 //    routing-tendon, torus, quadruped, cow): the DiffPD paper's rows at their
-//    reduced size (RowSize::kSmall), loss and variables of the row at its
+//    reduced size (RowSize::kSmall; `paper_size`: the paper's), loss and variables of the row at its
 //    starting point x_init, default method pd-lbfgs (`diffpd table`'s DiffPD
 //    column) with the row's settings; preparatory simulations (plant's initial state,
 //    the target motions) run once with newton-cholesky at rel_tolerance 1e-10.
@@ -103,10 +103,13 @@ std::vector<std::string> ObjectiveProblemNames();
 // The objective of `problem` (a name of ObjectiveProblemNames()) with
 // `threads` element-loop threads (0: OpenMP's default); `steps` > 0 replaces
 // the step count of a forward scene and `refine` the cell doublings of
-// cantilever and falling-cube (MakeRefinedProblem). Builds the instance (reads meshes and
-// recorded data, runs a paper row's preparatory simulations). Throws
-// InvalidInputError for an unknown problem, listing the valid names, and for
-// refine != 0 on a problem without a resolution knob.
-ProblemObjective MakeProblemObjective(const std::string& problem, int threads, int steps = -1, int refine = 0);
+// cantilever and falling-cube (MakeRefinedProblem); `paper_size` builds a
+// paper row at the paper's size (RowSize::kPaper) instead of the reduced one.
+// Builds the instance (reads meshes and recorded data, runs a paper row's
+// preparatory simulations). Throws InvalidInputError for an unknown problem,
+// listing the valid names, for refine != 0 on a problem without a resolution
+// knob and for paper_size on a problem that is not a paper row.
+ProblemObjective MakeProblemObjective(const std::string& problem, int threads, int steps = -1, int refine = 0,
+                                      bool paper_size = false);
 
 }  // namespace diffpd::problems

@@ -346,7 +346,7 @@ std::string ReferenceKey(const std::string& what, const ProblemObjective& object
 TradeoffResult RunTradeoff(const std::string& problem_name, const TradeoffOptions& o, std::ostream* progress) {
   o.Validate();
   TradeoffResult result;
-  const ProblemObjective objective = MakeProblemObjective(problem_name, o.threads, o.steps, o.refine);
+  const ProblemObjective objective = MakeProblemObjective(problem_name, o.threads, o.steps, o.refine, o.paper_size);
   if (o.time_step > 0 && !objective.time_step_knob)
     throw InvalidInputError("--dt is invalid for " + problem_name + ": the problem fixes its time step");
   Progress(progress, "[tradeoff] " + problem_name + ": " + std::to_string(objective.dofs) + " DoFs, " +

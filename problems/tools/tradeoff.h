@@ -70,6 +70,7 @@ struct TradeoffOptions {
   TradeoffClock clock = TradeoffClock::kWall;
   int max_iterations = -1;    // of each step's solve; -1: the problem's (references: at least 1000)
   int refine = 0;             // cantilever, falling-cube: cell doublings (finest mesh of the resolution sweep)
+  bool paper_size = false;    // paper-<row>: the row at the paper's size (RowSize::kPaper), not the reduced one
   int time_step_levels = 4;   // >= 1
   int resolution_levels = 4;  // >= 1
   bool sweep_tolerance = true;

@@ -277,6 +277,13 @@ TEST(CommandLineTest, RefusesBadMeshSizesThreadsAndProblemsOfTheTools) {
       {{"tradeoff", "starfish-control", "--dt", "0.01"},
        2,
        Invalid("--dt is invalid for starfish-control: the problem fixes its time step")},
+      {{"tradeoff", "cantilever", "--paper-size"},
+       2,
+       Invalid("the paper's size is invalid for cantilever: only the paper's rows (paper-<row>) have a paper-size "
+               "instance")},
+      {{"tradeoff", "--all", "--paper-size"},
+       2,
+       Invalid("--paper-size is invalid with --all: name one paper row (paper-<row>)")},
       {{"stress", "--problems", "nosuch"}, 2, Invalid("unknown problem 'nosuch': valid problems are " + problems)},
       {{"stress", "--problems", "starfish-control"},
        2,
