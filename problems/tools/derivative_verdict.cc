@@ -9,12 +9,6 @@
 namespace diffpd::problems {
 namespace {
 
-std::string Format(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.2g", v);
-  return buffer;
-}
-
 int Rank(CheckVerdict v) { return v == CheckVerdict::kPass ? 0 : v == CheckVerdict::kUnresolved ? 1 : 2; }
 
 }  // namespace
@@ -32,6 +26,12 @@ const char* ToString(CheckVerdict verdict) {
 }
 
 CheckVerdict Worse(CheckVerdict a, CheckVerdict b) { return Rank(a) >= Rank(b) ? a : b; }
+
+std::string FormatTwoDigits(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.2g", v);
+  return buffer;
+}
 
 DerivativeJudgement JudgeDerivative(double analytic, const std::vector<FiniteDifference>& differences, double tolerance,
                                     bool extrapolate) {
@@ -120,16 +120,17 @@ DerivativeJudgement Judge(const Vector& analytic, const Estimates& s, double tol
     j.verdict = CheckVerdict::kPass;
   } else if (j.error > tolerance && j.error > 3 * j.floor && j.error > j.bound) {
     j.verdict = CheckVerdict::kFail;
-    j.reason = "differs by " + Format(j.error) + " relative, above the tolerance " + Format(tolerance) +
-               ", 3x the noise floor " + Format(j.floor) + " and the solves' worst case " + Format(j.bound);
+    j.reason = "differs by " + FormatTwoDigits(j.error) + " relative, above the tolerance " +
+               FormatTwoDigits(tolerance) + ", 3x the noise floor " + FormatTwoDigits(j.floor) +
+               " and the solves' worst case " + FormatTwoDigits(j.bound);
   } else if (j.floor <= tolerance) {
     j.verdict = CheckVerdict::kUnresolved;
-    j.reason = "differs by " + Format(j.error) + " relative, within the worst case " + Format(j.bound) +
-               " the solves' residuals allow (tolerance " + Format(tolerance) + ")";
+    j.reason = "differs by " + FormatTwoDigits(j.error) + " relative, within the worst case " +
+               FormatTwoDigits(j.bound) + " the solves' residuals allow (tolerance " + FormatTwoDigits(tolerance) + ")";
   } else {
     j.verdict = CheckVerdict::kUnresolved;
-    j.reason = "the differences resolve the derivative only to " + Format(j.floor) + " relative (tolerance " +
-               Format(tolerance) + "; error " + Format(j.error) + ")";
+    j.reason = "the differences resolve the derivative only to " + FormatTwoDigits(j.floor) + " relative (tolerance " +
+               FormatTwoDigits(tolerance) + "; error " + FormatTwoDigits(j.error) + ")";
   }
   return j;
 }
@@ -140,7 +141,7 @@ DerivativeJudgement JudgeDerivative(const Vector& analytic, const std::vector<Fi
                                     double tolerance, bool extrapolate) {
   if (differences.empty()) throw std::invalid_argument("JudgeDerivative: no differences");
   if (!(tolerance > 0))
-    throw std::invalid_argument("JudgeDerivative: tolerance = " + Format(tolerance) + " must be > 0");
+    throw std::invalid_argument("JudgeDerivative: tolerance = " + FormatTwoDigits(tolerance) + " must be > 0");
   for (const FiniteDifferenceVector& d : differences)
     if (d.value.size() != analytic.size())
       throw std::invalid_argument("JudgeDerivative: a difference has " + std::to_string(d.value.size()) +

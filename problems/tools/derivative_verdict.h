@@ -65,6 +65,9 @@ enum class CheckVerdict { kPass, kFail, kUnresolved };
 const char* ToString(CheckVerdict verdict);
 // The worse of two verdicts: fail over unresolved over pass.
 CheckVerdict Worse(CheckVerdict a, CheckVerdict b);
+// `v` with two significant digits ("%.2g"), as the verdicts' reasons give
+// errors, floors and tolerances.
+std::string FormatTwoDigits(double v);
 
 // One central difference: step e, value (L(+e) - L(-e)) / 2e, the rounding
 // noise of the two evaluations and the worst-case error the forward's solves

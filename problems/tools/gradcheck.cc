@@ -46,12 +46,6 @@ double RelativeDifference(double a, double b) {
 
 bool IsDirectNewton(Method m) { return m == Method::kNewtonCholesky || m == Method::kNewtonLdlt; }
 
-std::string Format(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.2g", v);
-  return buffer;
-}
-
 // Thrown by a perturbed rollout that lies on another piece of a frictional
 // contact trajectory (its active set differs from the checked rollout's).
 struct OtherPiece {};
@@ -219,9 +213,10 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
         if (apart >= 0) {
           result.reference = false;
           result.reference_failure = "its trajectory is another solution of the implicit steps: a node " +
-                                     Format(distance) + " of the body's size from the checked rollout's at step " +
-                                     std::to_string(apart) + " (reference_trajectory_tolerance " +
-                                     Format(check.reference_trajectory_tolerance) + "): not compared";
+                                     FormatTwoDigits(distance) +
+                                     " of the body's size from the checked rollout's at step " + std::to_string(apart) +
+                                     " (reference_trajectory_tolerance " +
+                                     FormatTwoDigits(check.reference_trajectory_tolerance) + "): not compared";
         } else {
           reference = newton.Backward(converged, dl);
         }
@@ -442,19 +437,19 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
       verdict = CheckVerdict::kPass;
       basis = "tangent";
       margin = tangent_margin;
-      reason = (j.verdict == CheckVerdict::kPass ? "differences pass with margin " + Format(j.margin) + " only"
+      reason = (j.verdict == CheckVerdict::kPass ? "differences pass with margin " + FormatTwoDigits(j.margin) + " only"
                                                  : "differences unresolved (" + j.reason + ")") +
                (reversals > 0 ? "; " + kink : "") + "; agrees with the forward-mode tangent to " +
-               Format(tangent_error);
+               FormatTwoDigits(tangent_error);
     } else if (tangent_decides && tangent_error > check.tolerance && verdict == CheckVerdict::kUnresolved &&
                IsDirectNewton(options.method)) {
       verdict = CheckVerdict::kFail;
       basis = "tangent";
-      reason = "differs from the forward-mode tangent by " + Format(tangent_error) + " relative (tolerance " +
-               Format(check.tolerance) + "); differences unresolved: " + reason;
+      reason = "differs from the forward-mode tangent by " + FormatTwoDigits(tangent_error) + " relative (tolerance " +
+               FormatTwoDigits(check.tolerance) + "); differences unresolved: " + reason;
     } else if (tangent_decides && tangent_error > check.tolerance) {
       reason += (reason.empty() ? "" : "; ") + std::string("differs from the forward-mode tangent by ") +
-                Format(tangent_error);
+                FormatTwoDigits(tangent_error);
     }
     if (result.reference) {
       const double ref_error = RelativeDifference(analytic, reference_value);
@@ -462,7 +457,7 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
       if (!(ref_error <= check.tolerance) && basis == "tangent") {
         // The differences did not decide: the gradient is the adjoint of the
         // method's own (inexact) trajectory, which the tangent confirms.
-        reason += "; differs from the Newton-Cholesky reference by " + Format(ref_error) +
+        reason += "; differs from the Newton-Cholesky reference by " + FormatTwoDigits(ref_error) +
                   " (the method's trajectory is not the converged one)";
       } else if (!(ref_error <= check.tolerance) && verdict != CheckVerdict::kUnresolved) {
         // The differences decided. Where they pass decisively the gradient
@@ -478,16 +473,16 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
         if (tight_error <= check.tolerance && tight_error < ref_error) {
           margin = std::min(margin,
                             tight_error > 0 ? check.tolerance / tight_error : std::numeric_limits<double>::infinity());
-          reason = "differs from the Newton-Cholesky reference by " + Format(ref_error) + ", and by " +
-                   Format(tight_error) + " at rel_tolerance " + Format(tightened_rel_tolerance) +
+          reason = "differs from the Newton-Cholesky reference by " + FormatTwoDigits(ref_error) + ", and by " +
+                   FormatTwoDigits(tight_error) + " at rel_tolerance " + FormatTwoDigits(tightened_rel_tolerance) +
                    " (the forward's tolerance, not the adjoint)";
         } else {
           verdict = CheckVerdict::kFail;
-          reason = "differs from the Newton-Cholesky reference by " + Format(ref_error) + " relative (tolerance " +
-                   Format(check.tolerance) + ")" +
-                   (std::isnan(tight_error)
-                        ? ""
-                        : ", and by " + Format(tight_error) + " at rel_tolerance " + Format(tightened_rel_tolerance)) +
+          reason = "differs from the Newton-Cholesky reference by " + FormatTwoDigits(ref_error) +
+                   " relative (tolerance " + FormatTwoDigits(check.tolerance) + ")" +
+                   (std::isnan(tight_error) ? ""
+                                            : ", and by " + FormatTwoDigits(tight_error) + " at rel_tolerance " +
+                                                  FormatTwoDigits(tightened_rel_tolerance)) +
                    (reason.empty() ? "" : "; differences: " + reason);
         }
       } else if (!(ref_error <= check.tolerance)) {
@@ -495,10 +490,10 @@ GradCheckResult CheckRolloutGradient(const Scene& scene, const SolverOptions& op
         // residuals' worst case, covers the disagreement): the method's
         // gradient is that of its inexact trajectory and cannot be held to
         // the converged one's either.
-        reason +=
-            "; differs from the Newton-Cholesky reference by " + Format(ref_error) + ", within the forward's noise";
+        reason += "; differs from the Newton-Cholesky reference by " + FormatTwoDigits(ref_error) +
+                  ", within the forward's noise";
       } else if (verdict == CheckVerdict::kUnresolved) {
-        reason += "; agrees with the Newton-Cholesky reference to " + Format(ref_error);
+        reason += "; agrees with the Newton-Cholesky reference to " + FormatTwoDigits(ref_error);
       }
     }
     const bool first = entry->directions == 0;
