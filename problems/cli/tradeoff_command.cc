@@ -111,6 +111,11 @@ void ReduceToCheck(const std::string& problem, const TradeoffArgs& args, Tradeof
   if (o->refine == 0) o->refine = problem == "cantilever" ? -6 : problem == "falling-cube" ? -3 : 0;
 }
 
+// A front plot's title: the problem and its instance's size.
+std::string FrontTitle(const std::string& problem, int dofs, int steps) {
+  return "diffpd tradeoff: " + problem + " (" + std::to_string(dofs) + " DoFs, " + std::to_string(steps) + " steps)";
+}
+
 // The problems of shard "K/N" of `names`: those at positions i with
 // i mod N = K - 1. Throws InvalidInputError for anything but 1 <= K <= N.
 std::vector<std::string> Shard(const std::vector<std::string>& names, const std::string& shard) {
@@ -234,7 +239,21 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
     } catch (const nlohmann::json::exception& e) {
       throw InvalidInputError("--replot " + args.replot + " is invalid: not JSON (" + e.what() + ")");
     }
-    WriteOptimiserTradeoffPlot(OptimiserTradeoffFromJson(report), args.plot);
+    if (report.is_object() && report.contains("front")) {
+      // A front's report (<problem>.json).
+      try {
+        const std::string title = FrontTitle(report.at("problem").get<std::string>(), report.at("dofs").get<int>(),
+                                             report.at("steps").get<int>());
+        const TradeoffClock clock =
+            report.value("clock", std::string("wall")) == "cpu" ? TradeoffClock::kCpu : TradeoffClock::kWall;
+        WriteTradeoffPlot(TradeoffRowsFromJson(report.at("rows")), args.plot, title, clock);
+      } catch (const nlohmann::json::exception& e) {
+        throw InvalidInputError("--replot " + args.replot + " is invalid: not a report of diffpd tradeoff (" +
+                                e.what() + ")");
+      }
+    } else {
+      WriteOptimiserTradeoffPlot(OptimiserTradeoffFromJson(report), args.plot);
+    }
     std::cerr << "[tradeoff] wrote " << args.plot << std::endl;
     return 0;
   }
@@ -296,17 +315,17 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
     monotone = monotone && p.violations.empty();
     const nlohmann::json report = TradeoffReportJson(p.result, p.front, p.violations);
     summary.push_back(report);
-    const std::string title = "diffpd tradeoff: " + name + (o.paper_size ? " (paper size)" : "");
+    const std::string title = FrontTitle(name, p.result.dofs, p.result.steps);
     if (!args.out.empty()) {
       const auto base = std::filesystem::path(args.out) / name;
       std::ofstream(base.string() + ".json") << report.dump(1) << "\n";
       if (GnuplotAvailable()) {
-        WriteTradeoffPlot(p.result.rows, base.string() + ".png", title);
+        WriteTradeoffPlot(p.result.rows, base.string() + ".png", title, p.result.clock);
         std::cerr << "[tradeoff] wrote " << base.string() << ".png" << std::endl;
       }
     }
     if (!args.plot.empty()) {
-      WriteTradeoffPlot(p.result.rows, args.plot, title);
+      WriteTradeoffPlot(p.result.rows, args.plot, title, p.result.clock);
       std::cerr << "[tradeoff] wrote " << args.plot << std::endl;
     }
     if (!args.json) PrintTable(p);
@@ -374,7 +393,8 @@ Subcommand AddTradeoffCommand(CLI::App* parent) {
   cmd->add_option("--plot", args->plot, "write a log-log PNG of time vs. error (needs gnuplot)");
   cmd->add_flag("--optimiser", args->optimiser,
                 "the problem's own optimiser at each tolerance: wall time and final loss (see below)");
-  cmd->add_option("--replot", args->replot, "--optimiser: draw a saved <problem>_optimiser.json again (with --plot)");
+  cmd->add_option("--replot", args->replot,
+                  "draw a saved report again (with --plot): <problem>.json or <problem>_optimiser.json");
   cmd->add_option("--budget", args->budget, "--optimiser: iterations of each run (0: the problem's own budget)")
       ->check(IntegerAtLeast("--budget", 0))
       ->capture_default_str();

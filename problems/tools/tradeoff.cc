@@ -485,6 +485,54 @@ nlohmann::json TradeoffToJson(const std::vector<TradeoffRow>& rows) {
   return out;
 }
 
+std::vector<TradeoffRow> TradeoffRowsFromJson(const nlohmann::json& rows) {
+  if (!rows.is_array()) throw InvalidInputError("the report's rows are invalid: must be a list");
+  std::vector<TradeoffRow> out;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const nlohmann::json& j = rows[i];
+    std::string field;
+    try {
+      auto text = [&](const char* key) {
+        field = key;
+        return j.at(key).get<std::string>();
+      };
+      auto number = [&](const char* key) {
+        field = key;
+        const nlohmann::json& v = j.at(key);
+        return v.is_null() ? 0.0 : v.get<double>();
+      };
+      TradeoffRow r;
+      r.sweep = text("sweep");
+      r.method = text("method");
+      r.parameter = text("parameter");
+      r.value = number("value");
+      r.setting = text("setting");
+      r.rel_tolerance = number("rel_tolerance");
+      const std::string status = text("status");
+      if (status.rfind("failed: ", 0) == 0) r.failure = status.substr(8);
+      r.seconds = number("seconds");
+      r.state_rel_error = number("state_rel_error");
+      r.loss_rel_error = number("loss_rel_error");
+      r.grad_rel_error = number("grad_rel_error");
+      r.forward_s = number("forward_s");
+      r.backward_s = number("backward_s");
+      r.cpu_s = number("cpu_s");
+      r.iters_per_step = number("iters_per_step");
+      field = "default_settings";
+      r.default_settings = j.at(field).get<bool>();
+      field = "dofs";
+      r.dofs = j.at(field).get<int>();
+      field = "steps";
+      r.steps = j.at(field).get<int>();
+      out.push_back(r);
+    } catch (const nlohmann::json::exception&) {
+      throw InvalidInputError("the report's row " + std::to_string(i) + " is invalid: field '" + field +
+                              "' is missing or has the wrong type");
+    }
+  }
+  return out;
+}
+
 std::string GnuplotQuote(const std::string& s) {
   std::string out = "'";
   for (char c : s) {
@@ -530,7 +578,8 @@ std::string Spaced(std::string s) {
 }
 }  // namespace
 
-void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& png_path, const std::string& title) {
+void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& png_path, const std::string& title,
+                       TradeoffClock clock) {
   if (!GnuplotAvailable())
     throw std::runtime_error(
         "--plot needs the gnuplot program, which is not on PATH (Debian: apt-get install "
@@ -594,12 +643,14 @@ void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& 
   }
   script << "set multiplot layout 3," << present.size() << " title " << GnuplotQuote(title) << "\n";
   const char* what[3] = {"final state", "loss", "gradient"};
+  const char* time_label =
+      clock == TradeoffClock::kCpu ? "CPU time of one evaluation (s)" : "forward + backward wall time (s)";
   for (int row = 0; row < 3; ++row)
     for (const auto& c : present) {
       const std::string label = c == "settings"    ? "method, tolerance and solver options"
                                 : c == "time_step" ? "time-step sweep"
                                                    : "mesh-resolution sweep";
-      script << "set title '" << label << "'\nset xlabel 'forward + backward time (s)'\nset ylabel '" << what[row]
+      script << "set title '" << label << "'\nset xlabel '" << time_label << "'\nset ylabel '" << what[row]
              << " relative error'\nplot ";
       bool first = true;
       for (const auto& [block, label_text] : by_column[c]) {

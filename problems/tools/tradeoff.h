@@ -134,6 +134,10 @@ TradeoffResult RunTradeoff(const std::string& problem, const TradeoffOptions& op
 // dofs, steps}; a failed run
 // has null numbers.
 nlohmann::json TradeoffToJson(const std::vector<TradeoffRow>& rows);
+// The rows of TradeoffToJson's list (a report's "rows"). Throws
+// InvalidInputError naming the row and the field that is missing or has the
+// wrong type.
+std::vector<TradeoffRow> TradeoffRowsFromJson(const nlohmann::json& rows);
 
 // True when a `gnuplot` executable is on PATH.
 bool GnuplotAvailable();
@@ -148,8 +152,10 @@ void RunGnuplot(const std::string& script, const std::string& png_path);
 // (tolerance, time_step, resolution; the solver-option sweeps drawn as points
 // in the tolerance column), top row state error and bottom row gradient
 // error against seconds, log-log, one curve per method (zero errors drawn at
-// 1e-17), the default marked. Throws std::runtime_error when gnuplot is
-// missing or fails, InvalidInputError for a path gnuplot cannot quote.
-void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& png_path, const std::string& title);
+// 1e-17), the default marked; the time axis says what `clock` counted.
+// Throws std::runtime_error when gnuplot is missing or fails,
+// InvalidInputError for a path gnuplot cannot quote.
+void WriteTradeoffPlot(const std::vector<TradeoffRow>& rows, const std::string& png_path, const std::string& title,
+                       TradeoffClock clock = TradeoffClock::kWall);
 
 }  // namespace diffpd::problems

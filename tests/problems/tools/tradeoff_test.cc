@@ -187,6 +187,41 @@ TEST(TradeoffPlotTest, WritesAPngWithGnuplot) {
   EXPECT_GT(std::filesystem::file_size(path), 1000u);
 }
 
+TEST(TradeoffJsonTest, RowsReadBackAsWritten) {
+  std::vector<TradeoffRow> rows = SyntheticRows();
+  rows[1].failure = "rollout failed (maximum number of iterations reached)";
+  rows[2].setting = "direct";
+  rows[2].default_settings = true;
+  rows[3].iters_per_step = 4.5;
+  rows[3].dofs = 243;
+  rows[3].steps = 10;
+  const std::vector<TradeoffRow> back = TradeoffRowsFromJson(TradeoffToJson(rows));
+  ASSERT_EQ(back.size(), rows.size());
+  for (size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(back[i].sweep, rows[i].sweep) << i;
+    EXPECT_EQ(back[i].method, rows[i].method) << i;
+    EXPECT_EQ(back[i].setting, rows[i].setting) << i;
+    EXPECT_EQ(back[i].failure, rows[i].failure) << i;
+    EXPECT_EQ(back[i].default_settings, rows[i].default_settings) << i;
+    EXPECT_EQ(back[i].dofs, rows[i].dofs) << i;
+    EXPECT_EQ(back[i].steps, rows[i].steps) << i;
+    if (!rows[i].ok()) continue;  // a failed run's numbers are written as null
+    EXPECT_EQ(back[i].seconds, rows[i].seconds) << i;
+    EXPECT_EQ(back[i].state_rel_error, rows[i].state_rel_error) << i;
+    EXPECT_EQ(back[i].grad_rel_error, rows[i].grad_rel_error) << i;
+    EXPECT_EQ(back[i].iters_per_step, rows[i].iters_per_step) << i;
+  }
+}
+
+TEST(TradeoffJsonTest, AMissingFieldNamesTheRowAndTheField) {
+  nlohmann::json rows = TradeoffToJson(SyntheticRows());
+  rows[2].erase("grad_rel_error");
+  EXPECT_THROW_MESSAGE(TradeoffRowsFromJson(rows), InvalidInputError,
+                       "the report's row 2 is invalid: field 'grad_rel_error' is missing or has the wrong type");
+  EXPECT_THROW_MESSAGE(TradeoffRowsFromJson(nlohmann::json::object()), InvalidInputError,
+                       "the report's rows are invalid: must be a list");
+}
+
 TEST(TradeoffPlotTest, MissingGnuplotIsAClearError) {
   const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
   setenv("PATH", "/nonexistent-diffpd-test-dir", 1);
