@@ -24,7 +24,8 @@ constexpr const char* kTradeoffFooter = R"(
 Time (forward + backward seconds of one evaluation) against the error of the
 problem's own loss and of its gradient with respect to the problem's own
 optimisation variables, against newton-cholesky converged to rel_tolerance
-1e-10 (adjoint 1e-12), cached in --cache (default <out>/reference_cache).
+1e-10 (adjoint 1e-12; no contact screening, the contact energy guard at
+1e-2), cached in --cache (default <out>/reference_cache).
 Every run starts from the problem's own settings ('default'); sweeps:
  tolerance  : each --methods at each --tolerances value
  options    : the other tolerance reference (start residual / inertia) per

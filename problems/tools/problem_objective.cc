@@ -99,8 +99,10 @@ OptimiserOutcome Guarded(const std::function<void(OptimiserOutcome*)>& body) {
 
 bool HasFrictionalContact(const Scene& scene) { return !scene.frictional_contacts.empty(); }
 
-void SetScreening(Scene* scene, double screening) {
-  if (screening >= 0) scene->frictional_contact_options.screening_rel_tolerance = screening;
+void ApplyContactOverrides(Scene* scene, const ContactOverrides& contact) {
+  if (contact.screening_rel_tolerance >= 0)
+    scene->frictional_contact_options.screening_rel_tolerance = contact.screening_rel_tolerance;
+  if (contact.max_energy_gain >= 0) scene->frictional_contact_options.max_energy_gain = contact.max_energy_gain;
 }
 
 ProblemObjective PaperRowObjective(const std::string& name, int threads, RowSize size) {
@@ -115,11 +117,11 @@ ProblemObjective PaperRowObjective(const std::string& name, int threads, RowSize
   o.steps = row->steps;
   o.frictional_contact = HasFrictionalContact(row->scene);
   o.screening_knob = true;
-  o.measure = [row](const SolverOptions& options_in, double screening) {
+  o.measure = [row](const SolverOptions& options_in, const ContactOverrides& contact) {
     SolverOptions options = options_in;
     options.time_step = row->time_step;
     PaperRow copy = *row;
-    SetScreening(&copy.scene, screening);
+    ApplyContactOverrides(&copy.scene, contact);
     RowRolloutFunction f = MakeRowRolloutFunction(copy, options);
     return MeasureFunction(f.function.get(), row->initial(), f.loss_rows, f.loss_weights, false);
   };
@@ -164,7 +166,7 @@ ProblemObjective SwimmerObjective(const SwimmerControl& problem, int threads) {
     const auto f = MakeSwimmerFunction(*swimmer, o.defaults, kSwimmerSeed);
     o.variables = "the controller's weights (" + std::to_string(f->num_parameters()) + ")";
   }
-  o.measure = [swimmer](const SolverOptions& options, double) {
+  o.measure = [swimmer](const SolverOptions& options, const ContactOverrides&) {
     const auto f = MakeSwimmerFunction(*swimmer, options, kSwimmerSeed);
     const std::vector<int> rows = f->RowsOf(0);
     return MeasureFunction(f.get(), f->initial_parameters(), rows, std::vector<double>(rows.size(), 1.0), false);
@@ -208,7 +210,7 @@ ProblemObjective CalibrationObjective(std::shared_ptr<const CalibrationProblem> 
     o.steps = f->num_steps();
     o.variables = "the fitted material fields (" + std::to_string(f->num_parameters()) + ")";
   }
-  o.measure = [problem, motion](const SolverOptions& options_in, double) {
+  o.measure = [problem, motion](const SolverOptions& options_in, const ContactOverrides&) {
     SolverOptions options = options_in;
     options.time_step = problem->default_time_step();
     const auto f = problem->MakeModel(*motion, options);
@@ -256,7 +258,7 @@ ProblemObjective NlpObjective(std::shared_ptr<const TrajectoryOptimizationProble
     const auto nlp = problem->MakeNlp(o.defaults, kSize);
     o.variables = "the NLP's variables (" + std::to_string(nlp->num_variables()) + ")";
   }
-  o.measure = [problem](const SolverOptions& options_in, double) {
+  o.measure = [problem](const SolverOptions& options_in, const ContactOverrides&) {
     SolverOptions options = options_in;
     options.time_step = problem->time_step(kSize);
     Ipopt::SmartPtr<solvers::RolloutNlp> nlp = problem->MakeNlp(options, kSize);
@@ -321,11 +323,11 @@ ProblemObjective SceneObjective(std::shared_ptr<const Problem> problem, int thre
   o.time_step_knob = true;
   o.resolution_knob = o.problem == "cantilever" || o.problem == "falling-cube";
   const int steps = o.steps;
-  o.measure = [problem, scene, steps](const SolverOptions& options_in, double screening) {
+  o.measure = [problem, scene, steps](const SolverOptions& options_in, const ContactOverrides& contact) {
     SolverOptions options = options_in;
     options.time_step = problem->default_time_step();
     Scene s = *scene;
-    SetScreening(&s, screening);
+    ApplyContactOverrides(&s, contact);
     Simulator sim(s, options);
     const LinearLoss loss = LinearLoss::Random(sim.num_dofs(), 20211);
     const RolloutMeasurement r =

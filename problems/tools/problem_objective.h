@@ -37,6 +37,13 @@
 
 namespace diffpd::problems {
 
+// Changes to a scene's FrictionalContactOptions that an objective with a
+// screening knob makes before it measures; a negative value keeps the scene's.
+struct ContactOverrides {
+  double screening_rel_tolerance = -1;  // the screening solves' tolerance (0: none)
+  double max_energy_gain = -1;          // the contact energy guard (contact.h)
+};
+
 // One evaluation: loss, gradient and final state at the objective's point.
 struct ObjectiveMeasurement {
   std::string failure;                   // "" on success, else why the rollout or its gradient failed
@@ -75,7 +82,7 @@ struct ProblemObjective {
   SolverOptions defaults;
   int dofs = 0, steps = 0;
   // Whether the scene has frictional contact (a screening tolerance to trade)
-  // and whether Measure can change it (screening >= 0 below).
+  // and whether Measure can change its options (ContactOverrides).
   bool frictional_contact = false;
   bool screening_knob = false;
   // A forward scene (time-step sweep with bench.h's linear loss), and one
@@ -83,11 +90,11 @@ struct ProblemObjective {
   bool time_step_knob = false;
   bool resolution_knob = false;
   // Evaluates the loss and its gradient with `options` (the time step is the
-  // problem's: options.time_step is ignored) and, where screening_knob,
-  // FrictionalContactOptions::screening_rel_tolerance = screening (< 0: the
-  // scene's). Never throws for a failed rollout (see failure); throws
-  // InvalidInputError for invalid options.
-  std::function<ObjectiveMeasurement(const SolverOptions& options, double screening)> measure;
+  // problem's: options.time_step is ignored) and, where screening_knob, the
+  // scene's frictional contact changed as `contact` says. Never throws for a
+  // failed rollout (see failure); throws InvalidInputError for invalid
+  // options.
+  std::function<ObjectiveMeasurement(const SolverOptions& options, const ContactOverrides& contact)> measure;
   // The problem's own optimiser (in words; "" for a forward scene) and one
   // run of it from the problem's start with `options` for every evaluation,
   // stopped after `max_iterations` iterations (<= 0: the problem's own

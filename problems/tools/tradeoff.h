@@ -1,7 +1,8 @@
 // `diffpd tradeoff`: time against error of a problem's own loss and its
 // gradient with respect to the problem's own optimisation variables
 // (problem_objective.h), for every problem, against a converged reference of
-// the same problem (newton-cholesky, rel_tolerance 1e-10, adjoint 1e-12,
+// the same problem (newton-cholesky, rel_tolerance 1e-10, adjoint 1e-12, no
+// contact screening, the contact energy guard at kReferenceMaxEnergyGain;
 // cached on disk by reference_cache.h). Every run starts from the problem's
 // own settings (ProblemObjective::defaults) and changes what its sweep
 // names:
@@ -43,6 +44,12 @@
 #include "diffpd/solver_options.h"
 
 namespace diffpd::problems {
+
+// The converged reference's contact energy guard
+// (FrictionalContactOptions::max_energy_gain; the scenes' default is 1e-4):
+// a step solved to rel_tolerance 1e-10 keeps none of the solve slack that
+// lets looser solves of the same step pass the guard.
+inline constexpr double kReferenceMaxEnergyGain = 1e-2;
 
 // What a row's `seconds` counts: wall-clock seconds of the forward and
 // backward passes, or the process's CPU seconds of the whole evaluation
