@@ -496,43 +496,38 @@ nlohmann::json TradeoffToJson(const std::vector<TradeoffRow>& rows) {
 
 std::vector<TradeoffRow> TradeoffRowsFromJson(const nlohmann::json& rows) {
   if (!rows.is_array()) throw InvalidInputError("the report's rows are invalid: must be a list");
+  // TradeoffToJson's fields; a failed run's numbers are null (read as 0).
+  static const std::pair<const char*, std::string TradeoffRow::*> kTexts[] = {{"sweep", &TradeoffRow::sweep},
+                                                                              {"method", &TradeoffRow::method},
+                                                                              {"parameter", &TradeoffRow::parameter},
+                                                                              {"setting", &TradeoffRow::setting}};
+  static const std::pair<const char*, double TradeoffRow::*> kNumbers[] = {
+      {"value", &TradeoffRow::value},
+      {"rel_tolerance", &TradeoffRow::rel_tolerance},
+      {"seconds", &TradeoffRow::seconds},
+      {"state_rel_error", &TradeoffRow::state_rel_error},
+      {"loss_rel_error", &TradeoffRow::loss_rel_error},
+      {"grad_rel_error", &TradeoffRow::grad_rel_error},
+      {"forward_s", &TradeoffRow::forward_s},
+      {"backward_s", &TradeoffRow::backward_s},
+      {"cpu_s", &TradeoffRow::cpu_s},
+      {"iters_per_step", &TradeoffRow::iters_per_step}};
   std::vector<TradeoffRow> out;
   for (size_t i = 0; i < rows.size(); ++i) {
     const nlohmann::json& j = rows[i];
     std::string field;
     try {
-      auto text = [&](const char* key) {
-        field = key;
-        return j.at(key).get<std::string>();
-      };
-      auto number = [&](const char* key) {
-        field = key;
-        const nlohmann::json& v = j.at(key);
-        return v.is_null() ? 0.0 : v.get<double>();
-      };
       TradeoffRow r;
-      r.sweep = text("sweep");
-      r.method = text("method");
-      r.parameter = text("parameter");
-      r.value = number("value");
-      r.setting = text("setting");
-      r.rel_tolerance = number("rel_tolerance");
-      const std::string status = text("status");
+      for (const auto& [key, member] : kTexts) r.*member = j.at(field = key).get<std::string>();
+      for (const auto& [key, member] : kNumbers) {
+        const nlohmann::json& v = j.at(field = key);
+        r.*member = v.is_null() ? 0.0 : v.get<double>();
+      }
+      const std::string status = j.at(field = "status").get<std::string>();
       if (status.rfind("failed: ", 0) == 0) r.failure = status.substr(8);
-      r.seconds = number("seconds");
-      r.state_rel_error = number("state_rel_error");
-      r.loss_rel_error = number("loss_rel_error");
-      r.grad_rel_error = number("grad_rel_error");
-      r.forward_s = number("forward_s");
-      r.backward_s = number("backward_s");
-      r.cpu_s = number("cpu_s");
-      r.iters_per_step = number("iters_per_step");
-      field = "default_settings";
-      r.default_settings = j.at(field).get<bool>();
-      field = "dofs";
-      r.dofs = j.at(field).get<int>();
-      field = "steps";
-      r.steps = j.at(field).get<int>();
+      r.default_settings = j.at(field = "default_settings").get<bool>();
+      r.dofs = j.at(field = "dofs").get<int>();
+      r.steps = j.at(field = "steps").get<int>();
       out.push_back(r);
     } catch (const nlohmann::json::exception&) {
       throw InvalidInputError("the report's row " + std::to_string(i) + " is invalid: field '" + field +
