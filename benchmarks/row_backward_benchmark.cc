@@ -21,7 +21,9 @@
 //
 // Usage: row_backward_benchmark [--rows plant,routing-tendon] [--threads 1]
 //   [--evaluations 3] [--settings row,iterative,direct,...] [--clock wall|cpu]
-//   [--masses equal-nodes|lumped] [--json]
+//   [--masses equal-nodes|lumped] [--rtol R] [--json]
+// --rtol: every setting's forward rel_tolerance, and its adjoint's where the
+// row ties them (default: the row's own).
 // --masses: the rows' masses, as `diffpd table --masses` (default: the
 // original code's, equal-nodes).
 // --clock cpu: the process's CPU seconds instead of wall seconds (steadier
@@ -114,6 +116,7 @@ RowEvaluation Evaluate(const PaperRow& row, Simulator* sim, const VectorXd& x, b
   out.backward_s = CpuSeconds() - start;
   out.backward_iterations_per_step = double(g.report.linear_iterations) / rollout.num_steps();
   out.backward_fallbacks = g.report.fallbacks;
+  out.backward_indefinite_steps = g.report.indefinite_steps;
   return out;
 }
 
@@ -134,6 +137,7 @@ int Main(int argc, char** argv) {
   std::vector<std::string> names;
   int threads = 1, evaluations = 3;
   bool json = false, cpu = false;
+  double rel_tolerance = -1;                      // <= 0: the row's
   MassLumping masses = MassLumping::kEqualNodes;  // the table's default
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -155,6 +159,10 @@ int Main(int argc, char** argv) {
       const std::string c = next();
       if (c != "cpu" && c != "wall") throw InvalidInputError("--clock " + c + " is invalid: must be cpu or wall");
       cpu = c == "cpu";
+    } else if (a == "--rtol") {
+      rel_tolerance = std::stod(next());
+      if (!(rel_tolerance > 0 && rel_tolerance < 1))
+        throw InvalidInputError("--rtol " + std::to_string(rel_tolerance) + " is invalid: must be in (0, 1)");
     } else if (a == "--json") {
       json = true;
     } else {
@@ -189,6 +197,10 @@ int Main(int argc, char** argv) {
     std::vector<std::unique_ptr<Simulator>> sims;
     for (const Setting& s : settings) {
       SolverOptions o = row.Options(Method::kPdLbfgs, threads);
+      if (rel_tolerance > 0) {
+        if (o.backward_rel_tolerance == o.rel_tolerance) o.backward_rel_tolerance = rel_tolerance;
+        o.rel_tolerance = rel_tolerance;
+      }
       s.change(&o);
       sims.push_back(std::make_unique<Simulator>(row.scene, o));
     }
@@ -198,7 +210,8 @@ int Main(int argc, char** argv) {
         runs[c].push_back(Evaluate(row, sims[c].get(), x, cpu));
         const RowEvaluation& e = runs[c].back();
         std::cerr << "[row-backward] " << name << " " << settings[c].name << " run " << r + 1 << ": " << e.forward_s
-                  << " s + " << e.backward_s << " s, " << e.backward_iterations_per_step << " adjoint its/step"
+                  << " s + " << e.backward_s << " s, " << e.backward_iterations_per_step << " adjoint its/step, "
+                  << e.backward_indefinite_steps << " steps with an indefinite Hessian, |dL/dx| " << e.gradient.norm()
                   << std::endl;
       }
     int reference = -1;  // no error without the direct setting

@@ -125,6 +125,11 @@ def num(x):
     return "%.2g" % x
 
 
+def tolerance(x):
+    """A swept tolerance, or "none" where no swept tolerance met the bound (0)."""
+    return "%g" % x if x else "none"
+
+
 def fronts_table(fronts):
     print("| problem | DoFs | steps | variables | default | s | grad err | slowdown | loosest rtol for 1e-3 / 1e-2 / "
           "1e-1 | fastest below 1e-3 | pd-lbfgs rtol | pd-lbfgs s / best Newton s | non-monotone | failed runs |")
@@ -135,13 +140,14 @@ def fronts_table(fronts):
         variables = r["variables"].rsplit("(", 1)[-1].rstrip(")")
         b3 = r["bounds"][0]
         failed = sum(1 for row in rows if row["status"] != "ok")
-        print("| %s | %d | %d | %s | %s %g | %s | %.2g | %.2f | %s | %s | %g | %s / %s | %d | %d/%d |" %
+        met = b3["fastest_method"] != ""
+        print("| %s | %d | %d | %s | %s %g | %s | %.2g | %.2f | %s | %s | %s | %s / %s | %d | %d/%d |" %
               (name, r["dofs"], r["steps"], variables, d["method"], d["rel_tolerance"], num(d["seconds"]),
                d["grad_rel_error"], d["slowdown_over_front"],
-               " / ".join("%g" % b["default_method_loosest_tolerance"] for b in r["bounds"]),
-               "%s %g" % (b3["fastest_method"], b3["fastest_rel_tolerance"]), b3["pd_lbfgs_loosest_tolerance"],
-               num(b3["pd_lbfgs_seconds"]), num(b3["best_newton_seconds"]), len(r["monotonicity_violations"]), failed,
-               len(rows)))
+               " / ".join(tolerance(b["default_method_loosest_tolerance"]) for b in r["bounds"]),
+               "%s %g" % (b3["fastest_method"], b3["fastest_rel_tolerance"]) if met else "none",
+               tolerance(b3["pd_lbfgs_loosest_tolerance"]), num(b3["pd_lbfgs_seconds"]) if met else "-",
+               num(b3["best_newton_seconds"]) if met else "-", len(r["monotonicity_violations"]), failed, len(rows)))
 
 
 def main(argv):

@@ -42,6 +42,7 @@ RowEvaluation EvaluateRow(const PaperRow& row, Simulator* simulator, const Vecto
     out.backward_iterations_per_step =
         rollout.num_steps() > 0 ? double(g.report.linear_iterations) / rollout.num_steps() : 0;
     out.backward_fallbacks = g.report.fallbacks;
+    out.backward_indefinite_steps = g.report.indefinite_steps;
   }
   return out;
 }

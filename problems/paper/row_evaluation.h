@@ -18,6 +18,7 @@ struct RowEvaluation {
   int newton_fallback_steps = 0;            // PD-LBFGS steps finished by Newton
   double backward_iterations_per_step = 0;  // adjoint solver iterations per step (0: direct solves)
   int backward_fallbacks = 0;               // adjoint solves that fell back to a direct solve
+  int backward_indefinite_steps = 0;        // steps whose Hessian was indefinite (BackwardReport)
 };
 
 // Simulates the row at variables x with `simulator` (made from row.scene; its

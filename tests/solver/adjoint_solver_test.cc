@@ -274,6 +274,46 @@ TEST(AdjointSolverTest, DirectSolvesAnalyseTheHessianPatternOncePerSimulator) {
   EXPECT_EQ(sim.hessian_factorization().num_analyses(), 1);
 }
 
+// The smallest eigenvalue of H on the free DoFs, from H's columns.
+double SmallestFreeEigenvalue(internal::SimulatorImpl& sim, internal::StepLinearization* lin) {
+  std::vector<int> free;
+  for (int d = 0; d < sim.num_dofs(); ++d)
+    if (!sim.fixed[d]) free.push_back(d);
+  MatrixXd h(free.size(), free.size());
+  for (size_t j = 0; j < free.size(); ++j) {
+    VectorXd e = VectorXd::Zero(sim.num_dofs());
+    e(free[j]) = 1;
+    const VectorXd column = lin->Apply(e);
+    for (size_t i = 0; i < free.size(); ++i) h(i, j) = column(free[i]);
+  }
+  return Eigen::SelfAdjointEigenSolver<MatrixXd>(0.5 * (h + h.transpose())).eigenvalues().minCoeff();
+}
+
+TEST(AdjointSolverTest, AnIndefiniteStepHessianIsCountedAndAPositiveDefiniteOneIsNot) {
+  SolverOptions o = testing::TightOptions(Method::kPdLbfgs);
+  o.adjoint_solver = AdjointSolver::kDirect;
+  o.time_step = 0.1;  // a small inertial term M/h^2
+  const Scene scene = testing::SmallBeamScene();
+  internal::SimulatorImpl sim(scene, o);
+  const VectorXd rest = Simulator(scene, o).RestState().x;
+  VectorXd squashed = rest;  // the beam compressed to a third of its length: no minimum of the step's energy
+  for (int i = 0; i < squashed.size() / 3; ++i) squashed(3 * i) *= 1.0 / 3.0;
+  const VectorXd b = VectorXd::LinSpaced(sim.num_dofs(), -1, 1);
+  for (const bool compressed : {false, true}) {
+    internal::StepLinearization lin(sim, compressed ? squashed : rest);
+    const double smallest = SmallestFreeEigenvalue(sim, &lin);
+    ASSERT_EQ(smallest < 0, compressed) << "smallest eigenvalue of H " << smallest;
+    BackwardReport report;
+    const VectorXd z = lin.Solve(b, &report);
+    VectorXd free_b = b;
+    sim.ZeroFixed(&free_b);
+    EXPECT_LT((lin.Apply(z) - free_b).norm(), 1e-8 * free_b.norm()) << compressed;
+    EXPECT_EQ(report.indefinite_steps, compressed ? 1 : 0);
+    lin.Solve(b, &report);  // a second solve at the same step counts no second step
+    EXPECT_EQ(report.indefinite_steps, compressed ? 1 : 0);
+  }
+}
+
 TEST(AdjointSolverTest, EveryMethodReportsWhichSolverItsBackwardStepsUsed) {
   const Scene scene = MuscleBeam();
   for (const Method m : {Method::kNewtonCholesky, Method::kNewtonLdlt, Method::kNewtonPcg, Method::kPd}) {

@@ -112,6 +112,13 @@ struct BackwardReport {
   // and the PD methods' direct adjoint: SolverOptions::adjoint_solver).
   int iterative_steps = 0;
   int direct_steps = 0;
+  // Steps whose exact step Hessian H a Cholesky factorisation found not
+  // positive definite (then solved by sparse LU). The forward stopped such a
+  // step away from a minimum of its energy (e.g. a loose tolerance), and the
+  // gradient through it can differ from the converged rollout's by orders of
+  // magnitude: tighten rel_tolerance. (newton-ldlt's LDL^T factorises an
+  // indefinite H without noticing: not counted there.)
+  int indefinite_steps = 0;
   double seconds = 0;
   // Backward over a checkpointed rollout (checkpointed_rollout.h): forward
   // steps it recomputed, and the most states (2 x 3n doubles each) held at

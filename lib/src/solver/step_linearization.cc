@@ -320,6 +320,10 @@ MatrixXd StepLinearization::SolveSystem(const MatrixXd& b, AdjointCostModel* mod
                                                                 ": the step Hessian is singular; no " +
                                                                 (tangent ? "derivative" : "gradient") + " exists here");
     for (size_t j = 0; j < rest.size(); ++j) z.col(rest[j]) = solved.col(j);
+    if (lu_ && report && !indefinite_reported_) {
+      ++report->indefinite_steps;
+      indefinite_reported_ = true;
+    }
   }
   if (report) ++(iterative ? report->iterative_steps : report->direct_steps);
   if (recycling_) recycling_->Push(z);
