@@ -36,7 +36,8 @@ Every run starts from the problem's own settings ('default'); sweeps:
  resolution : cantilever, falling-cube: 3 fewer doublings per level
 Problems: every registered problem (small instances of the optimisation and
 control problems), the paper's rows as paper-<row> (small; --paper-size: at
-the paper's size, the Table's instance), the calibrations.
+the paper's size, the Table's mesh and steps; this library's lumped masses
+where the Table uses the original's by default), the calibrations.
 --all: every problem's small instance, checked rather than measured: the
 tolerance sweep of pd-lbfgs at 1e-2, 1e-4, 1e-6 (unless --methods, --sweeps,
 --tolerances say otherwise), forward scenes at 3 steps on coarse meshes;
@@ -378,7 +379,8 @@ Subcommand AddTradeoffCommand(CLI::App* parent) {
   cmd->add_option("--refine", o.refine, "cell doublings of the (finest) mesh; cantilever -9 = 4x1x1")
       ->check(IntegerIn("--refine", kMinRefinement, kMaxRefinement))
       ->capture_default_str();
-  cmd->add_flag("--paper-size", o.paper_size, "paper-<row>: the row at the paper's size (the Table's), not reduced");
+  cmd->add_flag("--paper-size", o.paper_size,
+                "paper-<row>: the row at the paper's size (the Table's mesh and steps), not reduced");
   cmd->add_option("--threads", o.threads, "threads for element loops (0: OpenMP default)")
       ->check(ThreadCount("--threads"));
   cmd->add_option("--repeats", o.repeats, "timed runs of each setting; each row keeps its fastest")
