@@ -147,7 +147,8 @@ def fronts_table(fronts):
                " / ".join(tolerance(b["default_method_loosest_tolerance"]) for b in r["bounds"]),
                "%s %g" % (b3["fastest_method"], b3["fastest_rel_tolerance"]) if met else "none",
                tolerance(b3["pd_lbfgs_loosest_tolerance"]), num(b3["pd_lbfgs_seconds"]) if met else "-",
-               num(b3["best_newton_seconds"]) if met else "-", len(r["monotonicity_violations"]), failed, len(rows)))
+               num(b3["best_newton_seconds"]) if met and b3["best_newton_seconds"] else "none",
+               len(r["monotonicity_violations"]), failed, len(rows)))
 
 
 def main(argv):
