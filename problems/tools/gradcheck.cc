@@ -37,13 +37,13 @@ VectorXd Direction(std::mt19937_64* rng, Eigen::Index n) {
 constexpr int kEarlyStopSteps = 3;
 
 bool UsesReferenceByDefault(Method m) { return m == Method::kPd || m == Method::kPdLbfgs || m == Method::kNewtonPcg; }
-// Newton with a direct solve: its adjoint is exact for its own trajectory.
 // |a - b| / max(|a|, |b|); 0 where both are 0.
 double RelativeDifference(double a, double b) {
   const double scale = std::max(std::abs(a), std::abs(b));
   return scale > 0 ? std::abs(a - b) / scale : 0.0;
 }
 
+// Newton with a direct solve: its adjoint is exact for its own trajectory.
 bool IsDirectNewton(Method m) { return m == Method::kNewtonCholesky || m == Method::kNewtonLdlt; }
 
 // Thrown by a perturbed rollout that lies on another piece of a frictional

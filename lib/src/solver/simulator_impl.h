@@ -310,7 +310,6 @@ class StepLinearization {
   int hessian_products_ = 0;  // products with H so far (Apply, ApplyUnmasked)
   int pd_solves_ = 0;         // single-vector solves with A's factors so far
   std::unique_ptr<Eigen::SparseLU<SparseMatrix>> lu_;
-  bool indefinite_reported_ = false;  // BackwardReport::indefinite_steps counts this step
 };
 
 // Forward solvers of one implicit step. Each returns x_{i+1} and fills the

@@ -315,15 +315,13 @@ MatrixXd StepLinearization::SolveSystem(const MatrixXd& b, AdjointCostModel* mod
     MatrixXd rhs(b.rows(), static_cast<Eigen::Index>(rest.size()));
     for (size_t j = 0; j < rest.size(); ++j) rhs.col(j) = b.col(rest[j]);
     MatrixXd solved;
+    const bool indefinite_before = lu_ != nullptr;  // DirectSolve makes lu_ once, for an indefinite H
     if (!DirectSolve(rhs, &solved))
       throw SolverError(SolverStatus::kFactorizationFailed, std::string(ToString(m)) + " " + pass +
                                                                 ": the step Hessian is singular; no " +
                                                                 (tangent ? "derivative" : "gradient") + " exists here");
     for (size_t j = 0; j < rest.size(); ++j) z.col(rest[j]) = solved.col(j);
-    if (lu_ && report && !indefinite_reported_) {
-      ++report->indefinite_steps;
-      indefinite_reported_ = true;
-    }
+    if (report && lu_ && !indefinite_before) ++report->indefinite_steps;
   }
   if (report) ++(iterative ? report->iterative_steps : report->direct_steps);
   if (recycling_) recycling_->Push(z);
