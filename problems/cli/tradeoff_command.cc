@@ -36,8 +36,8 @@ Every run starts from the problem's own settings ('default'); sweeps:
  resolution : cantilever, falling-cube: 3 fewer doublings per level
 Problems: every registered problem (small instances of the optimisation and
 control problems), the paper's rows as paper-<row> (small; --paper-size: at
-the paper's size, the Table's mesh and steps; this library's lumped masses
-where the Table uses the original's by default), the calibrations.
+the paper's size, the Table's mesh and steps; the Table's masses, the
+original code's equal node masses, unless --masses lumped), the calibrations.
 --all: every problem's small instance, checked rather than measured: the
 tolerance sweep of pd-lbfgs at 1e-2, 1e-4, 1e-6 (unless --methods, --sweeps,
 --tolerances say otherwise), forward scenes at 3 steps on coarse meshes;
@@ -82,6 +82,7 @@ struct TradeoffArgs {
   std::string out;
   std::string plot;
   std::string clock = "wall";
+  std::string masses;  // "": a paper row's default (the Table's)
   bool optimiser = false;
   int budget = 0;
   std::string replot;
@@ -140,8 +141,9 @@ struct ProblemReport {
 
 void PrintTable(const ProblemReport& p) {
   const TradeoffResult& r = p.result;
-  std::printf("== %s: %d DoFs, %d steps, h = %g s; gradient w.r.t. %s; loss %s\n", r.problem.c_str(), r.dofs, r.steps,
-              r.time_step, r.variables.c_str(), r.loss.c_str());
+  const std::string masses = r.masses.empty() ? "" : ", " + r.masses + " masses";
+  std::printf("== %s: %d DoFs, %d steps, h = %g s%s; gradient w.r.t. %s; loss %s\n", r.problem.c_str(), r.dofs, r.steps,
+              r.time_step, masses.c_str(), r.variables.c_str(), r.loss.c_str());
   std::printf("%-19s %-16s %-25s %10s %-14s %10s %11s %11s %11s %8s\n", "sweep", "method", "parameter", "value",
               "setting", "seconds", "state_err", "loss_err", "grad_err", "it/step");
   for (const auto& row : r.rows) {
@@ -200,7 +202,10 @@ int RunOptimiserTradeoffArgs(const TradeoffArgs& args, const std::vector<std::st
   OptimiserTradeoffOptions options;
   options.max_iterations = args.budget;
   for (const auto& name : problems) {
-    const ProblemObjective objective = MakeProblemObjective(name, args.options.threads, -1, 0, args.options.paper_size);
+    ObjectiveInstance instance;
+    instance.paper_size = args.options.paper_size;
+    instance.paper_masses = args.options.paper_masses;
+    const ProblemObjective objective = MakeProblemObjective(name, args.options.threads, instance);
     if (!objective.optimise) {
       if (args.all) continue;
       throw InvalidInputError("problem '" + name +
@@ -266,6 +271,7 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
     throw InvalidInputError("--clock " + args.clock + " is invalid: valid clocks are wall, cpu");
   options.clock = args.clock == "cpu" ? TradeoffClock::kCpu : TradeoffClock::kWall;
   options.methods = ParseMethods(args.methods);
+  if (!args.masses.empty()) options.paper_masses = ParseMassLumping(args.masses);
   options.sweep_tolerance = options.sweep_solver_options = options.sweep_time_step = options.sweep_resolution = false;
   for (const auto& s : args.sweeps) {
     if (s == "tolerance")
@@ -298,6 +304,8 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
   if (!args.shard.empty() && !args.all) throw InvalidInputError("--shard needs --all");
   if (options.paper_size && args.all)
     throw InvalidInputError("--paper-size is invalid with --all: name one paper row (paper-<row>)");
+  if (options.paper_masses && args.all)
+    throw InvalidInputError("--masses is invalid with --all: name one paper row (paper-<row>)");
   const std::vector<std::string> problems =
       args.all ? Shard(ObjectiveProblemNames(), args.shard) : std::vector<std::string>{args.problem};
   if (args.optimiser) return RunOptimiserTradeoffArgs(args, problems);
@@ -381,6 +389,9 @@ Subcommand AddTradeoffCommand(CLI::App* parent) {
       ->capture_default_str();
   cmd->add_flag("--paper-size", o.paper_size,
                 "paper-<row>: the row at the paper's size (the Table's mesh and steps), not reduced");
+  cmd->add_option("--masses", args->masses,
+                  "paper-<row>: equal-nodes (the original code's, as `diffpd table`: the default) or lumped (this "
+                  "library's)");
   cmd->add_option("--threads", o.threads, "threads for element loops (0: OpenMP default)")
       ->check(ThreadCount("--threads"));
   cmd->add_option("--repeats", o.repeats, "timed runs of each setting; each row keeps its fastest")

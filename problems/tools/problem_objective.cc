@@ -105,8 +105,9 @@ void ApplyContactOverrides(Scene* scene, const ContactOverrides& contact) {
   if (contact.max_energy_gain >= 0) scene->frictional_contact_options.max_energy_gain = contact.max_energy_gain;
 }
 
-ProblemObjective PaperRowObjective(const std::string& name, int threads, RowSize size) {
+ProblemObjective PaperRowObjective(const std::string& name, int threads, RowSize size, MassLumping masses) {
   auto row = std::make_shared<PaperRow>(MakePaperRow(name.substr(std::string(kPaperPrefix).size()), size));
+  SetRowMasses(row.get(), masses);
   row->Prepare(Converged(row->Options(Method::kNewtonCholesky, threads)));
   ProblemObjective o;
   o.problem = name;
@@ -115,6 +116,7 @@ ProblemObjective PaperRowObjective(const std::string& name, int threads, RowSize
   o.defaults = row->Options(Method::kPdLbfgs, threads);  // the method of `diffpd table`'s DiffPD column
   o.dofs = row->scene.mesh.num_dofs();
   o.steps = row->steps;
+  o.masses = ToString(masses);
   o.frictional_contact = HasFrictionalContact(row->scene);
   o.screening_knob = true;
   o.measure = [row](const SolverOptions& options_in, const ContactOverrides& contact) {
@@ -360,17 +362,23 @@ std::vector<std::string> ObjectiveProblemNames() {
   return names;
 }
 
-ProblemObjective MakeProblemObjective(const std::string& name, int threads, int steps, int refine, bool paper_size) {
+ProblemObjective MakeProblemObjective(const std::string& name, int threads, const ObjectiveInstance& instance) {
+  const int steps = instance.steps, refine = instance.refine;
   if (name.rfind(kPaperPrefix, 0) == 0) {
     const std::string row = name.substr(std::string(kPaperPrefix).size());
     for (const auto& r : PaperRowNames())
-      if (r == row) return PaperRowObjective(name, threads, paper_size ? RowSize::kPaper : RowSize::kSmall);
+      if (r == row)
+        return PaperRowObjective(name, threads, instance.paper_size ? RowSize::kPaper : RowSize::kSmall,
+                                 instance.paper_masses.value_or(MassLumping::kEqualNodes));
   }
   for (auto& p : AllProblems()) {
     if (p->name() != name) continue;
-    if (paper_size)
+    if (instance.paper_size)
       throw InvalidInputError("the paper's size is invalid for " + name +
                               ": only the paper's rows (paper-<row>) have a paper-size instance");
+    if (instance.paper_masses)
+      throw InvalidInputError("masses '" + std::string(ToString(*instance.paper_masses)) + "' are invalid for " + name +
+                              ": only the paper's rows (paper-<row>) choose their masses");
     if (refine != 0 && name != "cantilever" && name != "falling-cube")
       throw InvalidInputError("refinement = " + std::to_string(refine) + " is invalid for " + name +
                               ": only cantilever and falling-cube have a resolution knob (give 0)");

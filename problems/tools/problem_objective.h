@@ -7,10 +7,11 @@
 //
 //  - paper-<row> (cantilever, rolling-sphere, plant, bouncing-ball, bunny,
 //    routing-tendon, torus, quadruped, cow): the DiffPD paper's rows at their
-//    reduced size (RowSize::kSmall; `paper_size`: the paper's), loss and variables of the row at its
-//    starting point x_init, default method pd-lbfgs (`diffpd table`'s DiffPD
-//    column) with the row's settings; preparatory simulations (plant's initial state,
-//    the target motions) run once with newton-cholesky at rel_tolerance 1e-10.
+//    reduced size (RowSize::kSmall; `paper_size`: the paper's) with the
+//    Table's masses (the original code's equal node masses; `paper_masses`
+//    chooses), loss and variables of the row at its starting point x_init, default method pd-lbfgs (`diffpd table`'s
+//    DiffPD column) with the row's settings; preparatory simulations (plant's initial state, the target motions) run
+//    once with newton-cholesky at rel_tolerance 1e-10.
 //  - routing-tendon, bunny, torus, quadruped, cow (Ipopt problems): the small
 //    instance's objective (RolloutNlp::Objective) at its starting point, with
 //    the problem's settings and `diffpd run`'s method, pd-lbfgs.
@@ -29,6 +30,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -81,6 +83,9 @@ struct ProblemObjective {
   // gets without choosing.
   SolverOptions defaults;
   int dofs = 0, steps = 0;
+  // A paper row's masses ("equal-nodes" or "lumped"); "" for the other
+  // problems (their scenes' own).
+  std::string masses;
   // Whether the scene has frictional contact (a screening tolerance to trade)
   // and whether Measure can change its options (ContactOverrides).
   bool frictional_contact = false;
@@ -107,16 +112,24 @@ struct ProblemObjective {
 // this build) and the paper rows (paper-<row>).
 std::vector<std::string> ObjectiveProblemNames();
 
+// Which instance of a problem MakeProblemObjective builds.
+struct ObjectiveInstance {
+  int steps = -1;           // > 0: replaces the step count of a forward scene
+  int refine = 0;           // cantilever, falling-cube: cell doublings (MakeRefinedProblem)
+  bool paper_size = false;  // paper-<row>: the row at the paper's size (RowSize::kPaper), not the reduced one
+  // paper-<row>: the body's masses; unset: the Table's (`diffpd table`'s
+  // default, kEqualNodes: the original code's), so that a paper row's front
+  // is that of the Table's instance.
+  std::optional<MassLumping> paper_masses;
+};
+
 // The objective of `problem` (a name of ObjectiveProblemNames()) with
-// `threads` element-loop threads (0: OpenMP's default); `steps` > 0 replaces
-// the step count of a forward scene and `refine` the cell doublings of
-// cantilever and falling-cube (MakeRefinedProblem); `paper_size` builds a
-// paper row at the paper's size (RowSize::kPaper) instead of the reduced one.
-// Builds the instance (reads meshes and recorded data, runs a paper row's
-// preparatory simulations). Throws InvalidInputError for an unknown problem,
-// listing the valid names, for refine != 0 on a problem without a resolution
-// knob and for paper_size on a problem that is not a paper row.
-ProblemObjective MakeProblemObjective(const std::string& problem, int threads, int steps = -1, int refine = 0,
-                                      bool paper_size = false);
+// `threads` element-loop threads (0: OpenMP's default), of the instance
+// `instance` says. Builds the instance (reads meshes and recorded data, runs
+// a paper row's preparatory simulations). Throws InvalidInputError for an
+// unknown problem, listing the valid names, for refine != 0 on a problem
+// without a resolution knob, and for paper_size or paper_masses on a problem
+// that is not a paper row.
+ProblemObjective MakeProblemObjective(const std::string& problem, int threads, const ObjectiveInstance& instance = {});
 
 }  // namespace diffpd::problems

@@ -334,10 +334,10 @@ bool SameSettings(const SolverOptions& a, const SolverOptions& b) {
 std::string ReferenceKey(const std::string& what, const ProblemObjective& objective, const TradeoffOptions& o) {
   std::ostringstream key;
   key.precision(17);
-  key << "tradeoff reference v2|" << what << "|" << objective.problem << "|steps " << objective.steps << "|dofs "
-      << objective.dofs << "|h " << objective.defaults.time_step << "|refine " << o.refine << "|max_iterations "
-      << o.max_iterations << "|seed " << o.seed << "|rtol " << kReferenceRelTolerance << "|btol "
-      << kReferenceBackwardRelTolerance << "|max_energy_gain " << kReferenceMaxEnergyGain;
+  key << "tradeoff reference v3|" << what << "|" << objective.problem << "|masses " << objective.masses << "|steps "
+      << objective.steps << "|dofs " << objective.dofs << "|h " << objective.defaults.time_step << "|refine "
+      << o.refine << "|max_iterations " << o.max_iterations << "|seed " << o.seed << "|rtol " << kReferenceRelTolerance
+      << "|btol " << kReferenceBackwardRelTolerance << "|max_energy_gain " << kReferenceMaxEnergyGain;
   return key.str();
 }
 
@@ -346,11 +346,18 @@ std::string ReferenceKey(const std::string& what, const ProblemObjective& object
 TradeoffResult RunTradeoff(const std::string& problem_name, const TradeoffOptions& o, std::ostream* progress) {
   o.Validate();
   TradeoffResult result;
-  const ProblemObjective objective = MakeProblemObjective(problem_name, o.threads, o.steps, o.refine, o.paper_size);
+  ObjectiveInstance instance;
+  instance.steps = o.steps;
+  instance.refine = o.refine;
+  instance.paper_size = o.paper_size;
+  instance.paper_masses = o.paper_masses;
+  const ProblemObjective objective = MakeProblemObjective(problem_name, o.threads, instance);
   if (o.time_step > 0 && !objective.time_step_knob)
     throw InvalidInputError("--dt is invalid for " + problem_name + ": the problem fixes its time step");
   Progress(progress, "[tradeoff] " + problem_name + ": " + std::to_string(objective.dofs) + " DoFs, " +
-                         std::to_string(objective.steps) + " steps, gradient w.r.t. " + objective.variables);
+                         std::to_string(objective.steps) + " steps" +
+                         (objective.masses.empty() ? "" : ", " + objective.masses + " masses") + ", gradient w.r.t. " +
+                         objective.variables);
   SolverOptions defaults = objective.defaults;
   defaults.num_threads = o.threads;
   if (o.max_iterations > 0) defaults.max_iterations = o.max_iterations;
@@ -362,6 +369,7 @@ TradeoffResult RunTradeoff(const std::string& problem_name, const TradeoffOption
   result.dofs = objective.dofs;
   result.steps = objective.steps;
   result.time_step = defaults.time_step;
+  result.masses = objective.masses;
   result.default_method = ToString(defaults.method);
   result.default_rel_tolerance = defaults.rel_tolerance;
   result.repeats = o.repeats;

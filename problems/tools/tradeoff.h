@@ -35,12 +35,14 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "diffpd/scene.h"
 #include "diffpd/solver_options.h"
 
 namespace diffpd::problems {
@@ -75,9 +77,11 @@ struct TradeoffOptions {
   // (adjoint_solver auto's choice is deterministic).
   int repeats = 1;
   TradeoffClock clock = TradeoffClock::kWall;
-  int max_iterations = -1;    // of each step's solve; -1: the problem's (references: at least 1000)
-  int refine = 0;             // cantilever, falling-cube: cell doublings (finest mesh of the resolution sweep)
-  bool paper_size = false;    // paper-<row>: the row at the paper's size (RowSize::kPaper), not the reduced one
+  int max_iterations = -1;  // of each step's solve; -1: the problem's (references: at least 1000)
+  int refine = 0;           // cantilever, falling-cube: cell doublings (finest mesh of the resolution sweep)
+  bool paper_size = false;  // paper-<row>: the row at the paper's size (RowSize::kPaper), not the reduced one
+  // paper-<row>: the body's masses; unset: the Table's (ObjectiveInstance).
+  std::optional<MassLumping> paper_masses;
   int time_step_levels = 4;   // >= 1
   int resolution_levels = 4;  // >= 1
   bool sweep_tolerance = true;
@@ -118,6 +122,7 @@ struct TradeoffResult {
   std::string problem, variables, loss;
   int dofs = 0, steps = 0;
   double time_step = 0;
+  std::string masses;  // a paper row's masses ("equal-nodes", "lumped"); "" for the other problems
   std::string default_method;
   double default_rel_tolerance = 0;
   bool reference_cached = false;  // the tolerance-sweep reference came from the cache

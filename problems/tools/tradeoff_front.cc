@@ -155,6 +155,7 @@ nlohmann::json TradeoffReportJson(const TradeoffResult& result, const TradeoffFr
           {"dofs", result.dofs},
           {"steps", result.steps},
           {"time_step", result.time_step},
+          {"masses", result.masses},
           {"reference_seconds", result.reference_s},
           {"reference_cached", result.reference_cached},
           {"repeats", result.repeats},

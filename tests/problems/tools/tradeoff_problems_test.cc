@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "diffpd/error.h"
@@ -99,6 +100,37 @@ TEST(ProblemObjectiveTest, UnknownProblemListsTheValidOnes) {
     EXPECT_EQ(m.rfind("problem 'no-such-problem' has no trade-off objective: valid problems are cantilever, ", 0), 0u)
         << m;
     EXPECT_NE(m.find("paper-cow"), std::string::npos) << m;
+  }
+}
+
+// A paper row's front is that of the Table's instance: the original code's
+// equal node masses unless lumped ones are asked for, and the choice reaches
+// the simulated body (the loss changes with it).
+TEST(ProblemObjectiveTest, APaperRowHasTheTablesMassesUnlessAskedForLumpedOnes) {
+  const ProblemObjective table = MakeProblemObjective("paper-cantilever", 1);
+  ObjectiveInstance lumped_instance;
+  lumped_instance.paper_masses = MassLumping::kLumped;
+  const ProblemObjective lumped = MakeProblemObjective("paper-cantilever", 1, lumped_instance);
+  EXPECT_EQ(table.masses, "equal-nodes");
+  EXPECT_EQ(lumped.masses, "lumped");
+  const ObjectiveMeasurement a = table.measure(table.defaults, {});
+  const ObjectiveMeasurement b = lumped.measure(lumped.defaults, {});
+  ASSERT_TRUE(a.ok()) << a.failure;
+  ASSERT_TRUE(b.ok()) << b.failure;
+  EXPECT_GT(std::abs(a.loss - b.loss), 1e-6 * std::abs(a.loss)) << a.loss << " " << b.loss;
+  EXPECT_TRUE(MakeProblemObjective("cantilever", 1).masses.empty());
+}
+
+TEST(ProblemObjectiveTest, MassesAreRefusedForAProblemThatIsNotAPaperRow) {
+  ObjectiveInstance instance;
+  instance.paper_masses = MassLumping::kEqualNodes;
+  try {
+    MakeProblemObjective("cantilever", 1, instance);
+    FAIL() << "no exception";
+  } catch (const InvalidInputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "masses 'equal-nodes' are invalid for cantilever: only the paper's rows (paper-<row>) choose their "
+                 "masses");
   }
 }
 
