@@ -59,6 +59,12 @@ PaperRow MakeBunnyRow(RowSize size) {
   row.paper.speedup = 9;
   row.notes = CommonRowNotes();
   row.notes.push_back(FrictionalContactNote());
+  // The bunny falls from 0.2 m: the inertial term grows with the distance
+  // from the origin, and the original's test stops each step far from its
+  // minimum.
+  UseStartResidualTest(&row,
+                       "at the paper's size that test at 1e-4 leaves the gradient at x_init 0.1 off the converged "
+                       "one, where this test is both faster and more accurate at 1e-2 (docs/benchmarks.md)");
   return row;
 }
 

@@ -103,7 +103,7 @@ SolverOptions PaperRow::Options(Method method, int threads) const {
   o.time_step = time_step;
   o.rel_tolerance = solver.rel_tolerance;
   o.abs_tolerance = solver.abs_tolerance;
-  o.tolerance_reference = ToleranceReference::kInertia;  // the original's step test
+  o.tolerance_reference = solver.tolerance_reference;
   o.backward_rel_tolerance = solver.rel_tolerance;
   o.max_iterations = solver.max_iterations;
   o.max_line_search_steps = solver.max_line_search_steps;
@@ -120,6 +120,10 @@ void PaperRow::Prepare(const SolverOptions& options) {
 }
 
 namespace {
+constexpr const char* kOriginalTestNote =
+    "step tolerance: the original's test, |grad g| <= abs_tol + rel_tol |(M / h^2)(x_i + h v_i) + f| on the free "
+    "DoFs (relative to the inertial term; this library's default is relative to the step's first residual, a far "
+    "tighter test), with this library's masses M";
 constexpr const char* kLumpedMassNote =
     "masses: lumped (each element's rho V shared by its 8 corners), where the original gives every node rho dx^3 "
     "(heavier surface nodes there, and more total mass)";
@@ -135,14 +139,22 @@ void SetRowMasses(PaperRow* row, MassLumping masses) {
 std::vector<std::string> CommonRowNotes() {
   return {
       kLumpedMassNote,
-      "step tolerance: the original's test, |grad g| <= abs_tol + rel_tol |(M / h^2)(x_i + h v_i) + f| on the free "
-      "DoFs (relative to the inertial term; this library's default is relative to the step's first residual, a far "
-      "tighter test), with this library's masses M",
+      kOriginalTestNote,
       "pd-lbfgs: this library's preconditioner (the PD matrix with its elastic weights scaled by 0.3, and a coarse "
       "correction of the rigid modes of bodies without Dirichlet nodes) where DiffPD uses the PD matrix itself",
       "newton-pcg: CG with incomplete Cholesky stopped at relative residual 1e-8, where the original uses Eigen's "
       "default (machine precision)",
   };
+}
+
+void UseStartResidualTest(PaperRow* row, const std::string& why) {
+  row->solver.tolerance_reference = ToleranceReference::kStartResidual;
+  auto& notes = row->notes;
+  notes.erase(std::remove(notes.begin(), notes.end(), std::string(kOriginalTestNote)), notes.end());
+  notes.push_back("step tolerance: this library's test for every method, |grad g| <= abs_tol + rel_tol |grad g(x_i + "
+                  "h v_i)| (relative to the step's first residual), where the original's test is relative to the "
+                  "inertial term: " +
+                  why);
 }
 
 std::string FrictionalContactNote() {

@@ -65,6 +65,10 @@ enum class InitialGuess { kGiven, kBestRandomDraw };
 // The solver settings the paper's script passes to every method.
 struct RowSolverSettings {
   double rel_tolerance = 1e-4;
+  // What rel_tolerance is relative to: the original's test (kInertia), or,
+  // on a row where that test at the paper's size leaves gradients too
+  // inaccurate for their cost (UseStartResidualTest), this library's.
+  ToleranceReference tolerance_reference = ToleranceReference::kInertia;
   double abs_tolerance = 1e-9;  // N
   int max_iterations = 500;     // per step
   int max_line_search_steps = 10;
@@ -130,10 +134,9 @@ struct PaperRow {
   // for the rollout's steps).
   double Loss(const Rollout& rollout, LossGradient* gradient) const;
   // The simulator options of `method` with the row's settings: time step,
-  // tolerances (the step test relative to the inertial term, as the original
-  // code's: ToleranceReference::kInertia; the adjoint's relative tolerance =
-  // rel_tolerance), iteration and line-search limits, L-BFGS history,
-  // `threads` threads.
+  // tolerances (the step test of solver.tolerance_reference; the adjoint's
+  // relative tolerance = rel_tolerance), iteration and line-search limits,
+  // L-BFGS history, `threads` threads.
   SolverOptions Options(Method method, int threads) const;
   // Runs `prepare` once with `options` (nothing if empty).
   void Prepare(const SolverOptions& options);
@@ -148,5 +151,9 @@ std::vector<std::string> CommonRowNotes();
 // differs from the original).
 void SetRowMasses(PaperRow* row, MassLumping masses);
 std::string FrictionalContactNote();
+// Gives the row this library's step test (ToleranceReference::kStartResidual)
+// for every method, and replaces the note on the original's test by one that
+// says so and why: `why`, what the original's test costs on this row.
+void UseStartResidualTest(PaperRow* row, const std::string& why);
 
 }  // namespace diffpd::problems

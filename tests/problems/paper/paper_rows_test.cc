@@ -180,5 +180,28 @@ TEST(PaperRowsTest, VariablesOfTheWrongSizeAreRefused) {
   }
 }
 
+int StepTestNotes(const PaperRow& row, const std::string& start) {
+  int n = 0;
+  for (const std::string& note : row.notes) n += note.rfind(start, 0) == 0;
+  return n;
+}
+
+// Every method of a row runs the row's step test, and the row's notes state
+// which test it is, once: the original's, or this library's where the
+// original's is off the row's measured front (bunny, bouncing ball).
+TEST(PaperRowsTest, EachRowsMethodsRunItsStepTestAndItsNotesSayWhich) {
+  for (const std::string& name : PaperRowNames()) {
+    const PaperRow row = MakePaperRow(name, RowSize::kSmall);
+    const bool start_residual = name == "bunny" || name == "bouncing-ball";
+    const ToleranceReference expected =
+        start_residual ? ToleranceReference::kStartResidual : ToleranceReference::kInertia;
+    for (Method m : {Method::kPdLbfgs, Method::kNewtonCholesky, Method::kNewtonPcg})
+      EXPECT_EQ(row.Options(m, 1).tolerance_reference, expected) << name;
+    EXPECT_EQ(StepTestNotes(row, "step tolerance: "), 1) << name;
+    EXPECT_EQ(StepTestNotes(row, "step tolerance: this library's test for every method"), start_residual ? 1 : 0)
+        << name;
+  }
+}
+
 }  // namespace
 }  // namespace diffpd::problems
