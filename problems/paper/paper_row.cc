@@ -151,10 +151,11 @@ void UseStartResidualTest(PaperRow* row, const std::string& why) {
   row->solver.tolerance_reference = ToleranceReference::kStartResidual;
   auto& notes = row->notes;
   notes.erase(std::remove(notes.begin(), notes.end(), std::string(kOriginalTestNote)), notes.end());
-  notes.push_back("step tolerance: this library's test for every method, |grad g| <= abs_tol + rel_tol |grad g(x_i + "
-                  "h v_i)| (relative to the step's first residual), where the original's test is relative to the "
-                  "inertial term: " +
-                  why);
+  notes.push_back(
+      "step tolerance: this library's test for every method, |grad g| <= abs_tol + rel_tol |grad g(x_i + "
+      "h v_i)| (relative to the step's first residual), where the original's test is relative to the "
+      "inertial term: " +
+      why);
 }
 
 std::string FrictionalContactNote() {

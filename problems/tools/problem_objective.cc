@@ -119,6 +119,7 @@ ProblemObjective PaperRowObjective(const std::string& name, int threads, RowSize
   o.masses = ToString(masses);
   o.frictional_contact = HasFrictionalContact(row->scene);
   o.screening_knob = true;
+  o.screening = row->scene.frictional_contact_options.screening_rel_tolerance;
   o.measure = [row](const SolverOptions& options_in, const ContactOverrides& contact) {
     SolverOptions options = options_in;
     options.time_step = row->time_step;
@@ -322,6 +323,7 @@ ProblemObjective SceneObjective(std::shared_ptr<const Problem> problem, int thre
   o.variables += " (" + std::to_string(2 * o.dofs + 3) + ")";
   o.frictional_contact = HasFrictionalContact(*scene);
   o.screening_knob = true;
+  o.screening = scene->frictional_contact_options.screening_rel_tolerance;
   o.time_step_knob = true;
   o.resolution_knob = o.problem == "cantilever" || o.problem == "falling-cube";
   const int steps = o.steps;

@@ -90,6 +90,7 @@ struct ProblemObjective {
   // and whether Measure can change its options (ContactOverrides).
   bool frictional_contact = false;
   bool screening_knob = false;
+  double screening = 0;  // the scene's own screening_rel_tolerance (where screening_knob)
   // A forward scene (time-step sweep with bench.h's linear loss), and one
   // with a mesh-resolution knob (MakeRefinedProblem).
   bool time_step_knob = false;

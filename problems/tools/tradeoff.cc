@@ -419,7 +419,9 @@ TradeoffResult RunTradeoff(const std::string& problem_name, const TradeoffOption
     const auto timed = Fastest(o.repeats, o.clock, [&] { return objective.measure(so, contact); });
     TradeoffRow row = ObjectiveRow(sweep, so, parameter, value, setting, timed.m, ref, objective);
     SetTimes(timed, &row);
-    row.default_settings = screening < 0 && SameSettings(so, defaults);
+    // A screening run at the scene's own screening tolerance repeats the
+    // default's settings.
+    row.default_settings = SameSettings(so, defaults) && (screening < 0 || screening == objective.screening);
     Progress(progress, Describe(row));
     result.rows.push_back(row);
   };

@@ -63,6 +63,26 @@ TEST(TradeoffTest, ErrorsFallAsTheToleranceTightens) {
   }
 }
 
+// The rolling sphere screens its contact solves at 0.1 (its own setting): the
+// screening sweep's run at 0.1 repeats the default's settings, and counts
+// as the default's when the front takes the fastest run of those settings.
+TEST(TradeoffTest, AScreeningRunAtTheScenesOwnToleranceHasTheDefaultsSettings) {
+  TradeoffOptions o;
+  o.steps = 2;
+  o.threads = 1;
+  o.methods = {Method::kPdLbfgs};
+  o.tolerances = {1e-4};
+  o.backward_factors = {1};
+  o.sweep_tolerance = o.sweep_time_step = o.sweep_resolution = false;
+  int screening_runs = 0;
+  for (const auto& r : RunTradeoff("rolling-sphere", o).rows) {
+    if (r.sweep != "screening") continue;
+    ++screening_runs;
+    EXPECT_EQ(r.default_settings, r.value == 0.1) << r.value;
+  }
+  EXPECT_EQ(screening_runs, 3);
+}
+
 TEST(TradeoffTest, StateErrorFallsWithTheTimeStepAtFixedDuration) {
   TradeoffOptions o = Tiny();
   o.sweep_time_step = true;
