@@ -97,8 +97,8 @@ void Reduce(const std::string& problem, TradeoffOptions* o) {
   o->screenings = {0, 1e-1};
   o->time_step_levels = 2;
   o->resolution_levels = 2;
-  if (o->steps <= 0) o->steps = 10;
-  if (o->refine == 0) o->refine = problem == "cantilever" ? -6 : problem == "falling-cube" ? -3 : 0;
+  if (o->instance.steps <= 0) o->instance.steps = 10;
+  if (o->instance.refine == 0) o->instance.refine = problem == "cantilever" ? -6 : problem == "falling-cube" ? -3 : 0;
 }
 
 // The check of --all: the tolerance sweep of pd-lbfgs (every problem's
@@ -110,8 +110,8 @@ void ReduceToCheck(const std::string& problem, const TradeoffArgs& args, Tradeof
   if (!args.sweeps_given) o->sweep_solver_options = o->sweep_time_step = o->sweep_resolution = false;
   o->time_step_levels = std::min(o->time_step_levels, 2);
   o->resolution_levels = std::min(o->resolution_levels, 2);
-  if (o->steps <= 0) o->steps = 3;
-  if (o->refine == 0) o->refine = problem == "cantilever" ? -6 : problem == "falling-cube" ? -3 : 0;
+  if (o->instance.steps <= 0) o->instance.steps = 3;
+  if (o->instance.refine == 0) o->instance.refine = problem == "cantilever" ? -6 : problem == "falling-cube" ? -3 : 0;
 }
 
 // A front plot's title: the problem and its instance's size.
@@ -202,10 +202,7 @@ int RunOptimiserTradeoffArgs(const TradeoffArgs& args, const std::vector<std::st
   OptimiserTradeoffOptions options;
   options.max_iterations = args.budget;
   for (const auto& name : problems) {
-    ObjectiveInstance instance;
-    instance.paper_size = args.options.paper_size;
-    instance.paper_masses = args.options.paper_masses;
-    const ProblemObjective objective = MakeProblemObjective(name, args.options.threads, instance);
+    const ProblemObjective objective = MakeProblemObjective(name, args.options.threads, args.options.instance);
     if (!objective.optimise) {
       if (args.all) continue;
       throw InvalidInputError("problem '" + name +
@@ -271,7 +268,7 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
     throw InvalidInputError("--clock " + args.clock + " is invalid: valid clocks are wall, cpu");
   options.clock = args.clock == "cpu" ? TradeoffClock::kCpu : TradeoffClock::kWall;
   options.methods = ParseMethods(args.methods);
-  if (!args.masses.empty()) options.paper_masses = ParseMassLumping(args.masses);
+  if (!args.masses.empty()) options.instance.paper_masses = ParseMassLumping(args.masses);
   options.sweep_tolerance = options.sweep_solver_options = options.sweep_time_step = options.sweep_resolution = false;
   for (const auto& s : args.sweeps) {
     if (s == "tolerance")
@@ -302,9 +299,9 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
       throw InvalidInputError("--plot " + args.plot + " is invalid: directory " + dir.string() + " does not exist");
   }
   if (!args.shard.empty() && !args.all) throw InvalidInputError("--shard needs --all");
-  if (options.paper_size && args.all)
+  if (options.instance.paper_size && args.all)
     throw InvalidInputError("--paper-size is invalid with --all: name one paper row (paper-<row>)");
-  if (options.paper_masses && args.all)
+  if (options.instance.paper_masses && args.all)
     throw InvalidInputError("--masses is invalid with --all: name one paper row (paper-<row>)");
   const std::vector<std::string> problems =
       args.all ? Shard(ObjectiveProblemNames(), args.shard) : std::vector<std::string>{args.problem};
@@ -374,7 +371,7 @@ Subcommand AddTradeoffCommand(CLI::App* parent) {
       ->check(Fraction("--rtol"));
   cmd->add_option("--max-iterations", o.max_iterations, "iteration limit of each step's solve (default: the problem's)")
       ->check(IntegerAtLeast("--max-iterations", 1));
-  cmd->add_option("--steps", o.steps, "forward scenes: number of time steps at --dt (default: the problem's)")
+  cmd->add_option("--steps", o.instance.steps, "forward scenes: number of time steps at --dt (default: the problem's)")
       ->check(IntegerAtLeast("--steps", 1));
   cmd->add_option("--dt", o.time_step, "forward scenes: coarsest time step in seconds (default: the problem's)")
       ->check(Positive("--dt", "s"));
@@ -384,10 +381,10 @@ Subcommand AddTradeoffCommand(CLI::App* parent) {
   cmd->add_option("--resolution-levels", o.resolution_levels, "meshes, each halving the cells per axis")
       ->check(IntegerAtLeast("--resolution-levels", 1))
       ->capture_default_str();
-  cmd->add_option("--refine", o.refine, "cell doublings of the (finest) mesh; cantilever -9 = 4x1x1")
+  cmd->add_option("--refine", o.instance.refine, "cell doublings of the (finest) mesh; cantilever -9 = 4x1x1")
       ->check(IntegerIn("--refine", kMinRefinement, kMaxRefinement))
       ->capture_default_str();
-  cmd->add_flag("--paper-size", o.paper_size,
+  cmd->add_flag("--paper-size", o.instance.paper_size,
                 "paper-<row>: the row at the paper's size (the Table's mesh and steps), not reduced");
   cmd->add_option("--masses", args->masses,
                   "paper-<row>: equal-nodes (the original code's, as `diffpd table`: the default) or lumped (this "

@@ -9,9 +9,10 @@
 //    routing-tendon, torus, quadruped, cow): the DiffPD paper's rows at their
 //    reduced size (RowSize::kSmall; `paper_size`: the paper's) with the
 //    Table's masses (the original code's equal node masses; `paper_masses`
-//    chooses), loss and variables of the row at its starting point x_init, default method pd-lbfgs (`diffpd table`'s
-//    DiffPD column) with the row's settings; preparatory simulations (plant's initial state, the target motions) run
-//    once with newton-cholesky at rel_tolerance 1e-10.
+//    chooses), loss and variables of the row at its starting point x_init,
+//    default method pd-lbfgs (`diffpd table`'s DiffPD column) with the row's
+//    settings; preparatory simulations (plant's initial state, the target
+//    motions) run once with newton-cholesky at rel_tolerance 1e-10.
 //  - routing-tendon, bunny, torus, quadruped, cow (Ipopt problems): the small
 //    instance's objective (RolloutNlp::Objective) at its starting point, with
 //    the problem's settings and `diffpd run`'s method, pd-lbfgs.

@@ -181,9 +181,9 @@ SolverOptions ConvergedOptions(const SolverOptions& defaults, double h) {
 
 void RunTimeStepSweep(const std::string& problem_name, const TradeoffOptions& o, const SolverOptions& defaults,
                       double tolerance, std::ostream* progress, std::vector<TradeoffRow>* rows) {
-  const auto problem = MakeRefinedProblem(problem_name, o.refine);
+  const auto problem = MakeRefinedProblem(problem_name, o.instance.refine);
   const Scene scene = problem->MakeScene();
-  const int steps = o.steps > 0 ? o.steps : problem->default_steps();
+  const int steps = o.instance.steps > 0 ? o.instance.steps : problem->default_steps();
   const double h0 = defaults.time_step;
   State initial;
   LinearLoss loss;
@@ -202,7 +202,7 @@ void RunTimeStepSweep(const std::string& problem_name, const TradeoffOptions& o,
   std::ostringstream key;
   key.precision(17);
   key << "tradeoff time-step reference v1|" << problem_name << "|steps " << ref_steps << "|h " << ref_h << "|refine "
-      << o.refine << "|seed " << o.seed << "|max_iterations " << o.max_iterations;
+      << o.instance.refine << "|seed " << o.seed << "|max_iterations " << o.max_iterations;
   const ReferenceValues ref = CachedReference(o.cache_dir, problem_name, key.str(), [&] {
     Progress(progress, "[tradeoff] time-step sweep: reference at h = " + std::to_string(ref_h) + " s (" +
                            std::to_string(ref_steps) + " steps) ...");
@@ -246,13 +246,13 @@ void RunResolutionSweep(const std::string& problem_name, const TradeoffOptions& 
   const VectorXd corner_weights = LinearLoss::Random(24, o.seed + 1).cx;  // one per corner DoF
   Progress(progress, "[tradeoff] resolution sweep: reference on the finest mesh ...");
   const CornerMeasurement ref =
-      MeasureCorners(problem_name, o.refine, ConvergedOptions(defaults, h0), o.steps, corner_weights);
+      MeasureCorners(problem_name, o.instance.refine, ConvergedOptions(defaults, h0), o.instance.steps, corner_weights);
   MustSucceed(ref.m, "resolution sweep");
   for (Method method : o.methods)
     for (int j = o.resolution_levels - 1; j >= 0; --j) {
       const SolverOptions so = SweepOptions(defaults, method, tolerance, h0);
       const auto timed = Fastest(o.repeats, o.clock, [&] {
-        return MeasureCorners(problem_name, o.refine - 3 * j, so, o.steps, corner_weights);
+        return MeasureCorners(problem_name, o.instance.refine - 3 * j, so, o.instance.steps, corner_weights);
       });
       const CornerMeasurement& c = timed.m;
       TradeoffRow row = MakeRow("resolution", method, "elements", c.elements, c.m, c.dofs, c.steps);
@@ -336,8 +336,9 @@ std::string ReferenceKey(const std::string& what, const ProblemObjective& object
   key.precision(17);
   key << "tradeoff reference v3|" << what << "|" << objective.problem << "|masses " << objective.masses << "|steps "
       << objective.steps << "|dofs " << objective.dofs << "|h " << objective.defaults.time_step << "|refine "
-      << o.refine << "|max_iterations " << o.max_iterations << "|seed " << o.seed << "|rtol " << kReferenceRelTolerance
-      << "|btol " << kReferenceBackwardRelTolerance << "|max_energy_gain " << kReferenceMaxEnergyGain;
+      << o.instance.refine << "|max_iterations " << o.max_iterations << "|seed " << o.seed << "|rtol "
+      << kReferenceRelTolerance << "|btol " << kReferenceBackwardRelTolerance << "|max_energy_gain "
+      << kReferenceMaxEnergyGain;
   return key.str();
 }
 
@@ -346,12 +347,7 @@ std::string ReferenceKey(const std::string& what, const ProblemObjective& object
 TradeoffResult RunTradeoff(const std::string& problem_name, const TradeoffOptions& o, std::ostream* progress) {
   o.Validate();
   TradeoffResult result;
-  ObjectiveInstance instance;
-  instance.steps = o.steps;
-  instance.refine = o.refine;
-  instance.paper_size = o.paper_size;
-  instance.paper_masses = o.paper_masses;
-  const ProblemObjective objective = MakeProblemObjective(problem_name, o.threads, instance);
+  const ProblemObjective objective = MakeProblemObjective(problem_name, o.threads, o.instance);
   if (o.time_step > 0 && !objective.time_step_knob)
     throw InvalidInputError("--dt is invalid for " + problem_name + ": the problem fixes its time step");
   Progress(progress, "[tradeoff] " + problem_name + ": " + std::to_string(objective.dofs) + " DoFs, " +

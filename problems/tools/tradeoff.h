@@ -35,15 +35,14 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "diffpd/scene.h"
 #include "diffpd/solver_options.h"
+#include "tools/problem_objective.h"
 
 namespace diffpd::problems {
 
@@ -68,7 +67,6 @@ struct TradeoffOptions {
   std::vector<double> screenings = {0, 1e-1, 1e-2};
   // Tolerance of the time-step and resolution sweeps; <= 0: the problem's.
   double rel_tolerance = -1;
-  int steps = -1;         // forward scenes: <= 0 the problem's default
   double time_step = -1;  // forward scenes' h0; <= 0: the problem's default (s)
   int threads = 0;
   // Timed runs of each setting (>= 1); a row keeps its fastest run (on a
@@ -78,10 +76,10 @@ struct TradeoffOptions {
   int repeats = 1;
   TradeoffClock clock = TradeoffClock::kWall;
   int max_iterations = -1;  // of each step's solve; -1: the problem's (references: at least 1000)
-  int refine = 0;           // cantilever, falling-cube: cell doublings (finest mesh of the resolution sweep)
-  bool paper_size = false;  // paper-<row>: the row at the paper's size (RowSize::kPaper), not the reduced one
-  // paper-<row>: the body's masses; unset: the Table's (ObjectiveInstance).
-  std::optional<MassLumping> paper_masses;
+  // The problem's instance: forward scenes' steps (<= 0: the problem's),
+  // cantilever's and falling-cube's cell doublings (the finest mesh of the
+  // resolution sweep), a paper row's size and masses.
+  ObjectiveInstance instance;
   int time_step_levels = 4;   // >= 1
   int resolution_levels = 4;  // >= 1
   bool sweep_tolerance = true;

@@ -25,9 +25,9 @@ TradeoffOptions Reduced(const std::string& problem, const std::string& cache) {
   o.methods = {Method::kPd, Method::kPdLbfgs, Method::kNewtonCholesky};
   o.tolerances = {1e-2, 1e-4, 1e-6, 1e-8};
   o.threads = 1;
-  o.steps = 5;
+  o.instance.steps = 5;
   if (problem == "cantilever") {
-    o.refine = -6;             // 8 x 2 x 2 cells
+    o.instance.refine = -6;    // 8 x 2 x 2 cells
     o.max_iterations = 10000;  // plain PD needs thousands of iterations per step at 1e-8 on the stiff beam
   }
   o.sweep_solver_options = o.sweep_time_step = o.sweep_resolution = false;

@@ -20,8 +20,8 @@ namespace {
 
 TradeoffOptions Tiny() {
   TradeoffOptions o;
-  o.refine = -9;  // 4 x 1 x 1 cells
-  o.steps = 3;
+  o.instance.refine = -9;  // 4 x 1 x 1 cells
+  o.instance.steps = 3;
   o.threads = 1;
   o.max_iterations = 10000;  // plain PD needs ~2500 iterations per step at 1e-8 here
   o.sweep_tolerance = o.sweep_solver_options = o.sweep_time_step = o.sweep_resolution = false;
@@ -68,7 +68,7 @@ TEST(TradeoffTest, ErrorsFallAsTheToleranceTightens) {
 // as the default's when the front takes the fastest run of those settings.
 TEST(TradeoffTest, AScreeningRunAtTheScenesOwnToleranceHasTheDefaultsSettings) {
   TradeoffOptions o;
-  o.steps = 2;
+  o.instance.steps = 2;
   o.threads = 1;
   o.methods = {Method::kPdLbfgs};
   o.tolerances = {1e-4};
@@ -104,7 +104,7 @@ TEST(TradeoffTest, StateErrorFallsWithTheTimeStepAtFixedDuration) {
 
 TEST(TradeoffTest, CornerErrorIsSmallOnTheReferenceMeshAndLargerOnACoarserOne) {
   TradeoffOptions o = Tiny();
-  o.refine = -6;  // finest mesh 8 x 2 x 2; coarser 4 x 1 x 1
+  o.instance.refine = -6;  // finest mesh 8 x 2 x 2; coarser 4 x 1 x 1
   o.sweep_resolution = true;
   o.methods = {Method::kNewtonCholesky};
   o.resolution_levels = 2;
