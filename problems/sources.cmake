@@ -40,6 +40,7 @@ set(DIFFPD_PROBLEMS_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/paper/torus_row.cc
   ${CMAKE_CURRENT_LIST_DIR}/paper/quadruped_row.cc
   ${CMAKE_CURRENT_LIST_DIR}/paper/cow_row.cc
+  ${CMAKE_CURRENT_LIST_DIR}/paper/swimmer_rows.cc
   ${CMAKE_CURRENT_LIST_DIR}/paper/row_evaluation.cc
   ${CMAKE_CURRENT_LIST_DIR}/paper/row_rollout_function.cc
   ${CMAKE_CURRENT_LIST_DIR}/paper/row_optimisation.cc

@@ -21,8 +21,9 @@ namespace {
 
 constexpr const char* kTableFooter = R"(
 Rows: cantilever, rolling-sphere, plant, bouncing-ball, bunny, routing-tendon,
-torus, quadruped, cow (the DiffPD paper's Table, built as PROBLEMS.md states,
-at the paper's size unless --small). Per row: the preparatory simulations
+torus, quadruped, cow, starfish, shark (the DiffPD paper's Table, built as
+PROBLEMS.md states, at the paper's size unless --small; the swimmers are
+starfish-control's and shark-control's, timed at the initial controller). Per row: the preparatory simulations
 (targets) and the 16 random draws' losses (pd-lbfgs, forward only: the
 normalisation), then per method --evaluations (Newton: --newton-evaluations)
 evaluations of the loss and its gradient at x_init on a fresh simulator.
@@ -142,7 +143,7 @@ Subcommand AddTableCommand(CLI::App* parent, const std::vector<std::string>& arg
   auto args = std::make_shared<TableArgs>();
   args->options.command = ShellLine(argv);
   CLI::App* cmd =
-      parent->add_subcommand("table", "the DiffPD paper's table (rows 1-9) measured here, beside the paper's numbers");
+      parent->add_subcommand("table", "the DiffPD paper's table (rows 1-11) measured here, beside the paper's numbers");
   cmd->footer(kTableFooter);
   cmd->add_option("--rows", args->rows, "comma-separated rows, in the order to run them")
       ->delimiter(',')

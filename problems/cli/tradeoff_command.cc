@@ -38,8 +38,9 @@ Problems: every registered problem (small instances of the optimisation and
 control problems), the paper's rows as paper-<row> (small; --paper-size: at
 the paper's size, the Table's mesh and steps; the Table's masses, the
 original code's equal node masses, unless --masses lumped), the calibrations.
---all: every problem's small instance, checked rather than measured: the
-tolerance sweep of pd-lbfgs at 1e-2, 1e-4, 1e-6 (unless --methods, --sweeps,
+--all: every problem's small instance (but paper-starfish and paper-shark,
+whose small instances are starfish-control's and shark-control's), checked
+rather than measured: the tolerance sweep of pd-lbfgs at 1e-2, 1e-4, 1e-6 (unless --methods, --sweeps,
 --tolerances say otherwise), forward scenes at 3 steps on coarse meshes;
 with --check a few minutes on 2 cores in all (--shard K/N splits it).
 --quick: four tolerances (1e-2 to 1e-8), every --methods, the solver-option
@@ -304,7 +305,7 @@ int RunTradeoffArgs(const TradeoffArgs& args) {
   if (options.instance.paper_masses && args.all)
     throw InvalidInputError("--masses is invalid with --all: name one paper row (paper-<row>)");
   const std::vector<std::string> problems =
-      args.all ? Shard(ObjectiveProblemNames(), args.shard) : std::vector<std::string>{args.problem};
+      args.all ? Shard(AllSweepProblemNames(), args.shard) : std::vector<std::string>{args.problem};
   if (args.optimiser) return RunOptimiserTradeoffArgs(args, problems);
   std::vector<ProblemReport> reports;
   nlohmann::json summary = nlohmann::json::array();

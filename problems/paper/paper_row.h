@@ -1,4 +1,4 @@
-// One row of the DiffPD paper's results table (PROBLEMS.md, rows 1-9) as
+// One row of the DiffPD paper's results table (PROBLEMS.md, rows 1-11) as
 // data: the scene at the paper's size (or a reduced one for tests), the
 // rollout it starts from, the optimisation variables and how they map to the
 // rollout's inputs (solvers::ParameterBlock blocks), the loss as weighted
@@ -86,7 +86,7 @@ struct LossTerm {
 struct PaperRow {
   std::string name;     // "plant", "bunny", ...
   std::string title;    // "Plant (material identification)"
-  int table_index = 0;  // the row's number in PROBLEMS.md (1-9)
+  int table_index = 0;  // the row's number in PROBLEMS.md (1-11)
   RowSize size = RowSize::kPaper;
   Scene scene;
   double time_step = 0;  // s

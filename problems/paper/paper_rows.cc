@@ -6,7 +6,7 @@ namespace diffpd::problems {
 
 std::vector<std::string> PaperRowNames() {
   return {"cantilever", "rolling-sphere", "plant", "bouncing-ball", "bunny", "routing-tendon",
-          "torus",      "quadruped",      "cow"};
+          "torus",      "quadruped",      "cow",   "starfish",      "shark"};
 }
 
 PaperRow MakePaperRow(const std::string& name, RowSize size) {
@@ -19,6 +19,8 @@ PaperRow MakePaperRow(const std::string& name, RowSize size) {
   if (name == "torus") return MakeTorusRow(size);
   if (name == "quadruped") return MakeQuadrupedRow(size);
   if (name == "cow") return MakeCowRow(size);
+  if (name == "starfish") return MakeStarfishRow(size);
+  if (name == "shark") return MakeSharkRow(size);
   std::string valid;
   for (const std::string& n : PaperRowNames()) valid += (valid.empty() ? "" : ", ") + n;
   throw InvalidInputError("unknown table row '" + name + "': valid rows are " + valid);

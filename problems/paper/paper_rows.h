@@ -1,4 +1,4 @@
-// The paper's application rows 1-9 (PROBLEMS.md), each built exactly as the
+// The paper's application rows 1-11 (PROBLEMS.md), each built exactly as the
 // fact sheet states at the paper's size (RowSize::kPaper) or reduced for
 // tests (kSmall). Building a row reads its mesh and draws its random numbers
 // but runs no simulation (see PaperRow::prepare).
@@ -21,9 +21,15 @@ PaperRow MakeRoutingTendonRow(RowSize size);  // 6: static activation
 PaperRow MakeTorusRow(RowSize size);          // 7: open-loop rolling
 PaperRow MakeQuadrupedRow(RowSize size);      // 8: gait parameters
 PaperRow MakeCowRow(RowSize size);            // 9: gait parameters
+// 10 and 11, closed-loop swimming: the network's weights of starfish-control
+// and shark-control (the original shark is not public), timed at the
+// initial controller (not optimised here: `diffpd run` trains them).
+PaperRow MakeStarfishRow(RowSize size);
+PaperRow MakeSharkRow(RowSize size);
 
 // "cantilever", "rolling-sphere", "plant", "bouncing-ball", "bunny",
-// "routing-tendon", "torus", "quadruped", "cow", in the Table's order.
+// "routing-tendon", "torus", "quadruped", "cow", "starfish", "shark", in the
+// Table's order.
 std::vector<std::string> PaperRowNames();
 // The row called `name`; throws InvalidInputError listing the valid names.
 PaperRow MakePaperRow(const std::string& name, RowSize size);

@@ -24,7 +24,10 @@ RowEvaluation EvaluateRow(const PaperRow& row, Simulator* simulator, const Vecto
   if (!SameMaterial(setup.material, simulator->scene().material)) simulator->SetMaterial(setup.material);
   RowEvaluation out;
   auto start = Clock::now();
-  const Rollout rollout = simulator->Simulate(setup.initial, setup.inputs);
+  // A closed-loop row (a controller block): the controller chooses every
+  // step's action, for as many steps as the row has inputs.
+  const Rollout rollout = setup.controller ? simulator->Simulate(setup.initial, *setup.controller, row.steps)
+                                           : simulator->Simulate(setup.initial, setup.inputs);
   out.forward_s = SecondsSince(start);
   long iterations = 0;
   for (const StepReport& r : rollout.reports) {
@@ -36,7 +39,8 @@ RowEvaluation EvaluateRow(const PaperRow& row, Simulator* simulator, const Vecto
   out.loss = row.Loss(rollout, gradient ? &dl : nullptr);
   if (gradient) {
     start = Clock::now();
-    const RolloutGradient g = simulator->Backward(rollout, dl);
+    const RolloutGradient g =
+        setup.controller ? simulator->Backward(rollout, dl, *setup.controller) : simulator->Backward(rollout, dl);
     out.gradient = row.PullBack(x, g);
     out.backward_s = SecondsSince(start);
     out.backward_iterations_per_step =

@@ -364,6 +364,13 @@ std::vector<std::string> ObjectiveProblemNames() {
   return names;
 }
 
+std::vector<std::string> AllSweepProblemNames() {
+  std::vector<std::string> names;
+  for (const auto& n : ObjectiveProblemNames())
+    if (n != std::string(kPaperPrefix) + "starfish" && n != std::string(kPaperPrefix) + "shark") names.push_back(n);
+  return names;
+}
+
 ProblemObjective MakeProblemObjective(const std::string& name, int threads, const ObjectiveInstance& instance) {
   const int steps = instance.steps, refine = instance.refine;
   if (name.rfind(kPaperPrefix, 0) == 0) {

@@ -6,7 +6,7 @@
 // code the problem's optimiser calls.
 //
 //  - paper-<row> (cantilever, rolling-sphere, plant, bouncing-ball, bunny,
-//    routing-tendon, torus, quadruped, cow): the DiffPD paper's rows at their
+//    routing-tendon, torus, quadruped, cow, starfish, shark): the DiffPD paper's rows at their
 //    reduced size (RowSize::kSmall; `paper_size`: the paper's) with the
 //    Table's masses (the original code's equal node masses; `paper_masses`
 //    chooses), loss and variables of the row at its starting point x_init,
@@ -113,6 +113,11 @@ struct ProblemObjective {
 // The problems that have an objective here: the registered problems (those of
 // this build) and the paper rows (paper-<row>).
 std::vector<std::string> ObjectiveProblemNames();
+// What `diffpd tradeoff --all` sweeps: ObjectiveProblemNames() without the
+// closed-loop paper rows (paper-starfish, paper-shark), whose small instances
+// are the bodies, controllers and losses of starfish-control and
+// shark-control, which it sweeps already.
+std::vector<std::string> AllSweepProblemNames();
 
 // Which instance of a problem MakeProblemObjective builds.
 struct ObjectiveInstance {

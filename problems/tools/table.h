@@ -1,4 +1,4 @@
-// `diffpd table`: the DiffPD paper's results table (PROBLEMS.md rows 1-9)
+// `diffpd table`: the DiffPD paper's results table (PROBLEMS.md rows 1-11)
 // measured here, beside the paper's numbers.
 //
 // Per row: the row is built at the paper's size (or small), its preparatory

@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "control/starfish_control.h"
 #include "diffpd/error.h"
 #include "paper/activation_variables.h"
 #include "paper/row_evaluation.h"
@@ -148,14 +149,65 @@ TEST(PaperRowsTest, CowHasTheSheetsLegGroupsAnd32ContactNodes) {
   EXPECT_EQ(row.steps, 575);
 }
 
+// Rows 10 and 11 are the control problems' swimmers, their network's
+// weights the variables, at the control problems' sizes and steps.
+TEST(PaperRowsTest, StarfishAndSharkRowsAreTheControlProblemsSwimmersWithTheirWeightsAsVariables) {
+  const PaperRow starfish = MakeStarfishRow(RowSize::kPaper);
+  ExpectSizes(starfish, 387, 1161, 168);
+  EXPECT_EQ(starfish.steps, 200);
+  EXPECT_EQ(starfish.scene.muscles.size(), 160u);
+  // 243-64-64-4: (243 + 1) 64 + (64 + 1) 64 + (64 + 1) 4.
+  EXPECT_EQ(starfish.num_variables(), 244 * 64 + 65 * 64 + 65 * 4);
+  EXPECT_EQ(starfish.table_index, 10);
+  EXPECT_FALSE(starfish.budget.optimised);
+  const PaperRow shark = MakeSharkRow(RowSize::kPaper);
+  ExpectSizes(shark, 1324, 3972, 832);
+  EXPECT_EQ(shark.steps, 200);
+  EXPECT_EQ(shark.scene.muscles.size(), 8u * 28);
+  EXPECT_EQ(shark.num_variables(), 250 * 64 + 65 * 64 + 65 * 2);
+  EXPECT_EQ(shark.table_index, 11);
+  for (const PaperRow* row : {&starfish, &shark}) {
+    EXPECT_EQ(row->solver.rel_tolerance, 1e-3) << row->name;
+    EXPECT_EQ(row->solver.abs_tolerance, 1e-4) << row->name;
+    EXPECT_TRUE(row->Setup(row->initial()).controller) << row->name;
+  }
+}
+
+// A closed-loop row evaluates the rollout its controller drives: the loss and
+// gradient are those of the swimmer's own rollout function at the same
+// weights (an open-loop rollout of the row's empty inputs would not move).
+// The closed-loop gradient itself is checked against central differences in
+// closed_loop_gradient_test; the starfish's one-sided faces (a face's force
+// jumps where it turns away from the flow) make differences of its whole
+// rollout depend on the step (1e-4 to 1e-6 of the weights: 0.48, 0.11, 0.547
+// against the adjoint's 0.547), so no row gradient test differences it.
+TEST(PaperRowsTest, AStarfishRowEvaluationIsTheSwimmersClosedLoopRollout) {
+  const PaperRow row = MakeStarfishRow(RowSize::kSmall);
+  const SolverOptions options = row.Options(Method::kPdLbfgs, 1);
+  Simulator sim(row.scene, options);
+  const RowEvaluation e = EvaluateRow(row, &sim, row.initial(), true);
+  const Swimmer swimmer = StarfishControl().MakeSwimmer(true);
+  Swimmer same_masses = swimmer;
+  same_masses.scene.mass_lumping = row.scene.mass_lumping;
+  const auto f = MakeSwimmerFunction(same_masses, options, 42);
+  ASSERT_EQ(f->num_parameters(), row.num_variables());
+  EXPECT_EQ(f->initial_parameters(), row.initial());
+  VectorXd gradient;
+  double value = 0;
+  ASSERT_TRUE(f->Gradient(row.initial(), VectorXd::Ones(1), &gradient, &value)) << f->statistics().last_error;
+  EXPECT_NEAR(e.loss, value, 1e-12 * std::abs(value));
+  EXPECT_GT(std::abs(e.loss), 1e-3);
+  EXPECT_LE((e.gradient - gradient).norm(), 1e-10 * gradient.norm());
+}
+
 TEST(PaperRowsTest, UnknownRowNameListsTheValidOnes) {
   try {
-    MakePaperRow("starfish", RowSize::kSmall);
+    MakePaperRow("water-snake", RowSize::kSmall);
     FAIL() << "expected InvalidInputError";
   } catch (const InvalidInputError& e) {
     EXPECT_STREQ(e.what(),
-                 "unknown table row 'starfish': valid rows are cantilever, rolling-sphere, plant, bouncing-ball, "
-                 "bunny, routing-tendon, torus, quadruped, cow");
+                 "unknown table row 'water-snake': valid rows are cantilever, rolling-sphere, plant, bouncing-ball, "
+                 "bunny, routing-tendon, torus, quadruped, cow, starfish, shark");
   }
 }
 
