@@ -28,7 +28,6 @@
 // original code's, equal-nodes).
 // --clock cpu: the process's CPU seconds instead of wall seconds (steadier
 // on a loaded machine with --threads 1; includes OpenMP's spinning with more).
-#include <time.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -85,39 +84,11 @@ std::vector<std::string> Split(const std::string& s) {
   return out;
 }
 
-// Seconds of CPU time this process has used (all threads): on a loaded
-// machine a 1-thread run's CPU time is far steadier than its wall time.
-double CpuSeconds() {
-  timespec t;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return t.tv_sec + 1e-9 * t.tv_nsec;
-}
-
-// EvaluateRow with CPU seconds (--clock cpu) in place of wall seconds.
+// EvaluateRow with the process's CPU seconds (--clock cpu: on a loaded
+// machine a 1-thread run's CPU time is far steadier than its wall time) or
+// wall seconds.
 RowEvaluation Evaluate(const PaperRow& row, Simulator* sim, const VectorXd& x, bool cpu) {
-  if (!cpu) return problems::EvaluateRow(row, sim, x, true);
-  const solvers::RolloutSetup setup = row.Setup(x);
-  const MaterialParameters& m = sim->scene().material;
-  if (m.youngs_modulus != setup.material.youngs_modulus || m.poissons_ratio != setup.material.poissons_ratio ||
-      m.density != setup.material.density)
-    sim->SetMaterial(setup.material);
-  RowEvaluation out;
-  double start = CpuSeconds();
-  const Rollout rollout = sim->Simulate(setup.initial, setup.inputs);
-  out.forward_s = CpuSeconds() - start;
-  long iterations = 0;
-  for (const StepReport& r : rollout.reports) iterations += r.iterations;
-  out.iterations_per_step = double(iterations) / rollout.num_steps();
-  LossGradient dl;
-  out.loss = row.Loss(rollout, &dl);
-  start = CpuSeconds();
-  const RolloutGradient g = sim->Backward(rollout, dl);
-  out.gradient = row.PullBack(x, g);
-  out.backward_s = CpuSeconds() - start;
-  out.backward_iterations_per_step = double(g.report.linear_iterations) / rollout.num_steps();
-  out.backward_fallbacks = g.report.fallbacks;
-  out.backward_indefinite_steps = g.report.indefinite_steps;
-  return out;
+  return problems::EvaluateRow(row, sim, x, true, cpu ? problems::RowClock::kCpu : problems::RowClock::kWall);
 }
 
 double Median(std::vector<double> v) {

@@ -9,11 +9,16 @@
 
 namespace diffpd::problems {
 
+// What RowEvaluation's seconds count: wall time, or the process's CPU time
+// (steadier on a loaded machine with one thread; with more it includes
+// OpenMP's spinning).
+enum class RowClock { kWall, kCpu };
+
 struct RowEvaluation {
   double loss = 0;
   VectorXd gradient;                        // dL/dx (num_variables); empty when not requested
-  double forward_s = 0;                     // wall seconds of Simulator::Simulate (a material change refactorises here)
-  double backward_s = 0;                    // wall seconds of Simulator::Backward and the pull-back
+  double forward_s = 0;                     // seconds of Simulator::Simulate (a material change refactorises here)
+  double backward_s = 0;                    // seconds of Simulator::Backward and the pull-back
   double iterations_per_step = 0;           // forward solver iterations per step
   int newton_fallback_steps = 0;            // PD-LBFGS steps finished by Newton
   double backward_iterations_per_step = 0;  // adjoint solver iterations per step (0: direct solves)
@@ -23,10 +28,12 @@ struct RowEvaluation {
 
 // Simulates the row at variables x with `simulator` (made from row.scene; its
 // material is set from the setup when it differs) and evaluates the loss;
-// with `gradient`, also the backward pass and dL/dx. Throws InvalidInputError
+// with `gradient`, also the backward pass and dL/dx; the seconds by `clock`.
+// A row with a controller block runs closed loop. Throws InvalidInputError
 // if the row still needs PaperRow::Prepare or x has the wrong size, and
 // SolverError when a solve fails.
-RowEvaluation EvaluateRow(const PaperRow& row, Simulator* simulator, const VectorXd& x, bool gradient);
+RowEvaluation EvaluateRow(const PaperRow& row, Simulator* simulator, const VectorXd& x, bool gradient,
+                          RowClock clock = RowClock::kWall);
 
 // Losses of the row's random draws (forward only), in order.
 std::vector<double> RandomDrawLosses(const PaperRow& row, Simulator* simulator);
