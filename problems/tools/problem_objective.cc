@@ -1,5 +1,7 @@
 #include "tools/problem_objective.h"
 
+#include <chrono>
+#include <cstdio>
 #include <exception>
 #include <memory>
 #include <numeric>
@@ -13,7 +15,9 @@
 #include "tools/bench.h"
 #if DIFFPD_WITH_CERES
 #include "calibration/calibrate_problem.h"
+#include "calibration/calibrate_starfish.h"
 #include "diffpd/captured_motion.h"
+#include "shared_data.h"
 #endif
 #if DIFFPD_WITH_IPOPT
 #include "control/trajectory_optimization.h"
@@ -241,6 +245,68 @@ ProblemObjective CalibrationObjective(std::shared_ptr<const CalibrationProblem> 
   };
   return o;
 }
+
+// calibrate-starfish's objective: the default fit's model (E, nu, density,
+// the tendon with its asymmetric servo, the water) on the first
+// kStarfishObjectiveSeconds of its fit window of the cyclic1 recording, at
+// the fit's start.
+constexpr double kStarfishObjectiveStart = 1.0;    // s: the default fit window's start
+constexpr double kStarfishObjectiveSeconds = 0.5;  // s: the first pull of the tendon (it first moves at 1.18 s)
+constexpr int kStarfishObjectiveIterations = 20;   // the default fit's, with the density fitted
+
+ProblemObjective StarfishCalibrationObjective(std::shared_ptr<const StarfishCalibration> problem, int threads) {
+  auto recording = std::make_shared<StarfishRecording>(
+      ReadStarfishRecording(SharedDataPath("starfish/data_horizontal_cyclic1.csv")));
+  auto window = std::make_shared<StarfishWindow>(
+      MakeStarfishWindow(*recording, kStarfishObjectiveStart, kStarfishObjectiveSeconds));
+  const Scene scene = problem->MakeScene();
+  auto guess = std::make_shared<MaterialParameters>(scene.material);
+  auto actuation = std::make_shared<StarfishActuation>(StarfishCalibration::ActuationGuess());
+  if (problem->release_in_model()) actuation->release_lag = actuation->lag;
+  // The model at `options` (its time step is the window's).
+  auto model = [problem, recording, window, guess, actuation](const SolverOptions& options) {
+    return problem->MakeModel(*recording, *window, options, *guess, *actuation, StarfishCalibration::WaterGuess());
+  };
+  ProblemObjective o;
+  o.problem = problem->name();
+  char loss[96];
+  std::snprintf(loss, sizeof(loss), "1/2 |r|^2 of the marker residuals (cyclic1, %.1f s to %.1f s)",
+                kStarfishObjectiveStart, kStarfishObjectiveStart + kStarfishObjectiveSeconds);
+  o.loss = loss;
+  o.defaults = problem->Options(Method::kPdLbfgs, threads);
+  o.defaults.time_step = StarfishTimeStep(*recording, *window, problem->substeps());
+  o.dofs = scene.mesh.num_dofs();
+  o.frictional_contact = HasFrictionalContact(scene);
+  {
+    const auto f = model(o.defaults);
+    o.steps = f->num_steps();
+    o.variables = "the fitted material, tendon and water values (" + std::to_string(f->num_parameters()) + ")";
+  }
+  o.measure = [model](const SolverOptions& options, const ContactOverrides&) {
+    const auto f = model(options);
+    return MeasureFunction(f.get(), f->initial_parameters(), f->RowsOf(0), {}, true);
+  };
+  o.optimiser = "Ceres Levenberg-Marquardt on the marker residuals (the default fit's values and intervals)";
+  o.optimise = [problem, recording, window, guess, actuation, model](const SolverOptions& options, int max_iterations) {
+    return Guarded([&](OptimiserOutcome* out) {
+      const auto start = std::chrono::steady_clock::now();
+      const StarfishFit fit = problem->Fit(*recording, *window, options, *guess, *actuation,
+                                           max_iterations > 0 ? max_iterations : kStarfishObjectiveIterations, nullptr);
+      out->status = fit.termination;
+      out->wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      out->evaluations = fit.statistics.rollouts;
+      out->iterations = fit.iterations;
+      out->reported_loss = fit.final_cost;
+      const auto ref = model(Converged(options));
+      const std::vector<int> rows = ref->RowsOf(0);
+      const std::vector<double> values = StarfishFitValues(fit);
+      const Eigen::Map<const VectorXd> fitted(values.data(), static_cast<Eigen::Index>(values.size()));
+      if (!LossAt(ref.get(), ref->initial_parameters(), rows, {}, true, &out->initial_loss, &out->failure)) return;
+      LossAt(ref.get(), fitted, rows, {}, true, &out->final_loss, &out->failure);
+    });
+  };
+  return o;
+}
 #endif
 
 #if DIFFPD_WITH_IPOPT
@@ -355,9 +421,6 @@ ProblemObjective SceneObjective(std::shared_ptr<const Problem> problem, int thre
 std::vector<std::string> ObjectiveProblemNames() {
   std::vector<std::string> names;
   for (const auto& p : AllProblems()) {
-#if DIFFPD_WITH_CERES
-    if (p->name() == "calibrate-starfish") continue;  // its fit windows have no fixed small instance here
-#endif
     names.push_back(p->name());
   }
   for (const auto& row : PaperRowNames()) names.push_back(kPaperPrefix + row);
@@ -397,14 +460,15 @@ ProblemObjective MakeProblemObjective(const std::string& name, int threads, cons
 #if DIFFPD_WITH_CERES
     if (auto calibration = std::dynamic_pointer_cast<const CalibrationProblem>(problem))
       return CalibrationObjective(calibration, threads);
+    if (auto starfish = std::dynamic_pointer_cast<const StarfishCalibration>(problem))
+      return StarfishCalibrationObjective(starfish, threads);
 #endif
 #if DIFFPD_WITH_IPOPT
     if (auto nlp = std::dynamic_pointer_cast<const TrajectoryOptimizationProblem>(problem))
       return NlpObjective(nlp, threads);
 #endif
-    if (name != "calibrate-starfish")
-      return SceneObjective(refine == 0 ? problem : std::shared_ptr<const Problem>(MakeRefinedProblem(name, refine)),
-                            threads, steps);
+    return SceneObjective(refine == 0 ? problem : std::shared_ptr<const Problem>(MakeRefinedProblem(name, refine)),
+                          threads, steps);
   }
   std::string valid;
   for (const auto& n : ObjectiveProblemNames()) valid += (valid.empty() ? "" : ", ") + n;

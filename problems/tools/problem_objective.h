@@ -21,6 +21,10 @@
 //  - calibrate-cantilever, calibrate-plant, calibrate-bouncing-ball: the fit's
 //    cost 1/2 |r|^2 of the marker residuals against the shipped captured
 //    motion, over the fitted material fields at the fit's initial guess.
+//  - calibrate-starfish: the default fit's cost 1/2 |r|^2 of the marker
+//    residuals on 1.0-1.5 s of the cyclic1 recording (shared data), over its
+//    ten fitted values (E, nu, density, the tendon's slack, lag, length and
+//    release lag, the water's three coefficients) at the fit's start.
 //  - cantilever, falling-cube, cantilever-plane, rolling-sphere,
 //    bouncing-ball (forward scenes, no optimisation of their own): the linear
 //    loss of bench.h, L = c_x . x_K + c_v . v_K, over [x_0, v_0, E, nu, rho];

@@ -91,6 +91,41 @@ TEST(ProblemObjectiveTest, EveryListedProblemNamesItsVariablesAndLoss) {
   EXPECT_NE(std::find(names.begin(), names.end(), "shark-control"), names.end());
 }
 
+// --all sweeps every problem but the closed-loop paper rows, whose small
+// instances are starfish-control's and shark-control's.
+TEST(ProblemObjectiveTest, AllSweepsEveryProblemButTheClosedLoopPaperRows) {
+  const auto names = ObjectiveProblemNames();
+  const auto all = AllSweepProblemNames();
+  auto has = [](const std::vector<std::string>& v, const std::string& n) {
+    return std::find(v.begin(), v.end(), n) != v.end();
+  };
+  for (const char* row : {"paper-starfish", "paper-shark"}) {
+    EXPECT_TRUE(has(names, row)) << row;
+    EXPECT_FALSE(has(all, row)) << row;
+  }
+  EXPECT_EQ(all.size() + 2, names.size());
+  for (const auto& n : all) EXPECT_TRUE(has(names, n)) << n;
+}
+
+// calibrate-starfish's objective is the default fit's model (E, nu, density,
+// slack, lag, length, release lag and the water's three coefficients) on
+// half a second of cyclic1 at 2 steps per camera frame.
+TEST(ProblemObjectiveTest, CalibrateStarfishMeasuresTheDefaultFitsCostOnHalfASecondOfCyclic1) {
+  const auto names = ObjectiveProblemNames();
+  if (std::find(names.begin(), names.end(), "calibrate-starfish") == names.end())
+    GTEST_SKIP() << "calibrate-starfish needs the Ceres adapter, which this build lacks";
+  const ProblemObjective o = MakeProblemObjective("calibrate-starfish", 1);
+  EXPECT_EQ(o.variables, "the fitted material, tendon and water values (10)");
+  EXPECT_EQ(o.steps, 60);
+  EXPECT_FALSE(o.optimiser.empty());
+  const ObjectiveMeasurement m = o.measure(o.defaults, {});
+  ASSERT_TRUE(m.ok()) << m.failure;
+  EXPECT_EQ(m.gradient.size(), 10);
+  EXPECT_TRUE(m.gradient.allFinite());
+  EXPECT_GT(m.loss, 0);
+  EXPECT_GT(m.gradient.norm(), 0);
+}
+
 TEST(ProblemObjectiveTest, UnknownProblemListsTheValidOnes) {
   try {
     MakeProblemObjective("no-such-problem", 1);
