@@ -22,8 +22,7 @@ bool SameMaterial(const MaterialParameters& a, const MaterialParameters& b) {
 
 }  // namespace
 
-RowEvaluation EvaluateRow(const PaperRow& row, Simulator* simulator, const VectorXd& x, bool gradient,
-                          RowClock clock) {
+RowEvaluation EvaluateRow(const PaperRow& row, Simulator* simulator, const VectorXd& x, bool gradient, RowClock clock) {
   if (row.prepare)
     throw InvalidInputError(row.name + ": the row needs its preparatory simulations first (PaperRow::Prepare)");
   const solvers::RolloutSetup setup = row.Setup(x);

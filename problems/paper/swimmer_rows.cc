@@ -24,7 +24,8 @@ PaperRow SwimmerRow(const Swimmer& swimmer, RowSize size, const std::string& pro
   row.time_step = swimmer.time_step;
   row.steps = swimmer.steps;
   const int n = swimmer.scene.mesh.num_vertices();
-  row.base.initial = State{Eigen::Map<const VectorXd>(swimmer.scene.mesh.vertices.data(), 3 * n), VectorXd::Zero(3 * n)};
+  row.base.initial =
+      State{Eigen::Map<const VectorXd>(swimmer.scene.mesh.vertices.data(), 3 * n), VectorXd::Zero(3 * n)};
   row.base.inputs.assign(row.steps, StepInput{});
   row.base.material = swimmer.scene.material;
   row.variables = {std::make_shared<solvers::ControllerBlock>(MakeSwimmerController(swimmer, 42))};
